@@ -1,0 +1,141 @@
+"""The coupled system of the seed paper, Sect. 3.1: a modal model of the host structure (Eq. 7)
+and a sphere with clearance and Hertzian contact at both cavity walls (Eqs. 3-6).
+
+Conventions shared by every integrator in `sim`
+------------------------------------------------
+* SI units. Mode values are mass-normalised: phi in 1/sqrt(kg), participation phi^T M b in sqrt(kg).
+* Both wall directions w_l, w_r are the +x unit vector at the wall (Sect. 3.1), so
+  ``phi_wall_left[j] = phi_j^T w_l`` is the x-value of mode j at the left wall.
+* Modal equations (Eq. 7):  s_j'' + 2 D_j w_j s_j' + w_j^2 s_j + phi_l,j f_l + phi_r,j f_r
+  = -(phi_j^T M b) q_base''(t),  with q_base = a_base cos(Omega t).
+* Sphere (Eq. 3): m_a q_a'' = f_l + f_r (q_a absolute).
+* Indentations (Eqs. 5, 6) with absolute wall displacements q_c = phi^T s + q_base:
+  delta_l = q_cl - q_a - g,  delta_r = q_cr - q_a + g.
+  Forces (Eq. 4): f_l = k_H delta_l^1.5 if delta_l > 0;  f_r = -k_H (-delta_r)^1.5 if delta_r < 0.
+* State exchanged between the integrators and the stepped-sine protocol, always at an excitation
+  phase that is a multiple of 2 pi (q_base = a_base, q_base' = 0):
+  ``y = [s_1..s_n, s_1'..s_n', u_a, u_a']`` with u_a = q_a - q_base (sphere relative to the base).
+  y = 0 is the homogeneous initial condition (everything at rest, sphere centred).
+* Normalisations (Sects. 5, 5.3) always use the *nominal* (starred) parameters, so that results
+  with varied D, g, k_H stay on the paper's axes:
+  a_noabs* = phi_tip,1 (phi_1^T M b) a_base / (2 D*),  a_base* = 2 D* g* / (phi_c,1 phi_1^T M b).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from sim.errors import SimulationInputError
+
+# Table 1 and Sect. 2, 4.1 of the seed paper; Table 2 for the nominal contact parameters.
+SPHERE_MASS = 0.0177  # kg
+CLEARANCE_NOMINAL = 0.58e-3  # m
+K_H_NOMINAL = 282e3 * 1e3**1.5  # N/m^1.5  (282e3 N/mm^1.5, Eq. 8)
+D1_NOMINAL = 0.00085  # Table 2
+
+
+@dataclass(frozen=True)
+class ModalModel:
+    """Modal model of the host structure without the sphere (Eq. 7), for the retained modes.
+
+    Attributes (all arrays of length n_modes, ascending frequency):
+        frequencies_hz: natural frequencies omega_j / (2 pi) in Hz.
+        damping_ratios: modal damping ratios D_j (-).
+        phi_wall_left, phi_wall_right: mass-normalised x-values at the cavity walls (1/sqrt(kg)).
+        phi_tip: mass-normalised x-value at the measurement point (1/sqrt(kg)).
+        participation: phi_j^T M b (sqrt(kg)), b = rigid unit x-translation of the base.
+        source: where the model came from (built-in rig model or a file path).
+    """
+
+    frequencies_hz: np.ndarray
+    damping_ratios: np.ndarray
+    phi_wall_left: np.ndarray
+    phi_wall_right: np.ndarray
+    phi_tip: np.ndarray
+    participation: np.ndarray
+    source: str = "unspecified"
+
+    def __post_init__(self) -> None:
+        names = ("frequencies_hz", "damping_ratios", "phi_wall_left", "phi_wall_right", "phi_tip", "participation")
+        arrays = {}
+        for name in names:
+            value = np.atleast_1d(np.asarray(getattr(self, name), dtype=float)).copy()
+            value.setflags(write=False)
+            object.__setattr__(self, name, value)
+            arrays[name] = value
+        n = arrays["frequencies_hz"].size
+        if n == 0:
+            raise SimulationInputError("modal model has no modes; give at least one frequency")
+        for name, value in arrays.items():
+            if value.ndim != 1 or value.size != n:
+                raise SimulationInputError(f"modal model: '{name}' has {value.size} values but there are {n} modes")
+            if not np.all(np.isfinite(value)):
+                raise SimulationInputError(f"modal model: '{name}' contains non-finite values")
+        if np.any(arrays["frequencies_hz"] <= 0) or np.any(np.diff(arrays["frequencies_hz"]) <= 0):
+            raise SimulationInputError("modal model: frequencies must be positive and strictly ascending")
+        d = arrays["damping_ratios"]
+        if np.any(d <= 0) or np.any(d >= 1):
+            raise SimulationInputError("modal model: damping ratios must lie in (0, 1), e.g. 0.001 for 0.1 %")
+
+    @property
+    def n_modes(self) -> int:
+        return int(self.frequencies_hz.size)
+
+    @property
+    def omega(self) -> np.ndarray:
+        """Natural angular frequencies omega_j (rad/s)."""
+        return 2.0 * np.pi * self.frequencies_hz
+
+    @property
+    def phi_contact(self) -> float:
+        """phi_c of the resonant mode: mean of the two wall values (they coincide in a beam model)."""
+        return 0.5 * float(self.phi_wall_left[0] + self.phi_wall_right[0])
+
+    def with_damping(self, D1: float) -> "ModalModel":
+        """Copy with the damping ratio of mode 1 replaced (the uncertain D of Table 2)."""
+        check_open_unit(D1, "D")
+        d = self.damping_ratios.copy()
+        d[0] = D1
+        return replace(self, damping_ratios=d)
+
+
+@dataclass(frozen=True)
+class Impactor:
+    """The sphere and its contacts (Eqs. 3-6): mass m_a (kg), clearance g (m), k_H (N/m^1.5)."""
+
+    mass: float = SPHERE_MASS
+    clearance: float = CLEARANCE_NOMINAL
+    k_H: float = K_H_NOMINAL
+
+    def __post_init__(self) -> None:
+        for name, label in (("mass", "sphere mass"), ("clearance", "clearance g"), ("k_H", "k_H")):
+            value = float(getattr(self, name))
+            if not np.isfinite(value) or value <= 0:
+                raise SimulationInputError(f"{label} must be a positive number, got {value!r}")
+
+
+@dataclass(frozen=True)
+class Nominal:
+    """The starred parameters used for normalisation (Sect. 5): D*, g*, and the sphere mass."""
+
+    D1: float = D1_NOMINAL
+    clearance: float = CLEARANCE_NOMINAL
+
+
+def a_noabs_star(model: ModalModel, a_base: float, nominal: Nominal = Nominal()) -> float:
+    """Resonant amplitude without absorber (Sect. 5): phi_tip (phi^T M b) a_base / (2 D*), in m."""
+    return abs(model.phi_tip[0] * model.participation[0]) * a_base / (2.0 * nominal.D1)
+
+
+def a_base_star(model: ModalModel, nominal: Nominal = Nominal()) -> float:
+    """Base amplitude reaching the clearance at the contact (Sect. 5.3): 2 D* g* / (phi_c phi^T M b), in m."""
+    return 2.0 * nominal.D1 * nominal.clearance / abs(model.phi_contact * model.participation[0])
+
+
+def check_open_unit(value: float, name: str) -> float:
+    """Validate a damping ratio in (0, 1)."""
+    value = float(value)
+    if not np.isfinite(value) or not 0.0 < value < 1.0:
+        raise SimulationInputError(f"{name} must lie in (0, 1) (a damping ratio, e.g. 0.00085), got {value!r}")
+    return value

@@ -1,0 +1,1 @@
+"""Uncertainty studies (intervals, Sobol indices), runners, figures and the `ies` command line."""

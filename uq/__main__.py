@@ -1,0 +1,5 @@
+import sys
+
+from uq.cli import main
+
+sys.exit(main())

@@ -1,0 +1,1 @@
+"""Subcommands of `ies`; every public module here is one subcommand (see `uq.cli`)."""
