@@ -16,6 +16,12 @@ Conventions shared by every integrator in `sim`
   phase that is a multiple of 2 pi (q_base = a_base, q_base' = 0):
   ``y = [s_1..s_n, s_1'..s_n', u_a, u_a']`` with u_a = q_a - q_base (sphere relative to the base).
   y = 0 is the homogeneous initial condition (everything at rest, sphere centred).
+* Integrator contract (both the paper's ode3 and the exact free-flight integrator):
+  ``run_step(y, n_periods, Omega, a_base, sys: SystemArrays, record) -> (amplitudes, impacts)``
+  advances y in place over n whole excitation periods starting at phase 0 and returns, per period,
+  the magnitude |c_1| of the fundamental Fourier coefficient of q_tip = phi_tip^T s
+  (c_1 = (2/T) int_period q_tip exp(-i Omega t) dt, in m) and the number of contact onsets
+  (open -> closed transitions at either wall) in that period.
 * Normalisations (Sects. 5, 5.3) always use the *nominal* (starred) parameters, so that results
   with varied D, g, k_H stay on the paper's axes:
   a_noabs* = phi_tip,1 (phi_1^T M b) a_base / (2 D*),  a_base* = 2 D* g* / (phi_c,1 phi_1^T M b).
@@ -23,6 +29,7 @@ Conventions shared by every integrator in `sim`
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -139,3 +146,44 @@ def check_open_unit(value: float, name: str) -> float:
     if not np.isfinite(value) or not 0.0 < value < 1.0:
         raise SimulationInputError(f"{name} must lie in (0, 1) (a damping ratio, e.g. 0.00085), got {value!r}")
     return value
+
+
+class SystemArrays(NamedTuple):
+    """Flat, numba-friendly view of the coupled system, passed to the integrator kernels.
+
+    omega, D, phi_l, phi_r, phi_tip, gamma: float64 arrays (n_modes,), gamma = phi^T M b;
+    m_a (kg), k_H (N/m^1.5), g (m): floats.
+    """
+
+    omega: np.ndarray
+    D: np.ndarray
+    phi_l: np.ndarray
+    phi_r: np.ndarray
+    phi_tip: np.ndarray
+    gamma: np.ndarray
+    m_a: float
+    k_H: float
+    g: float
+
+
+def system_arrays(model: ModalModel, impactor: Impactor) -> SystemArrays:
+    """Pack a modal model and an impactor for the kernels (contiguous float64 copies)."""
+    as_f8 = lambda a: np.ascontiguousarray(a, dtype=np.float64).copy()  # noqa: E731
+    return SystemArrays(
+        as_f8(model.omega), as_f8(model.damping_ratios), as_f8(model.phi_wall_left), as_f8(model.phi_wall_right),
+        as_f8(model.phi_tip), as_f8(model.participation), float(impactor.mass), float(impactor.k_H),
+        float(impactor.clearance),
+    )
+
+
+def contact_forces(s: np.ndarray, u_a: float, sys: SystemArrays) -> tuple[float, float]:
+    """Eq. 4-6 in relative coordinates (q_base cancels): returns (f_l, f_r) in N.
+
+    delta_l = phi_l^T s - u_a - g,  delta_r = phi_r^T s - u_a + g.
+    Reference implementation for tests; kernels inline the same law.
+    """
+    delta_l = float(sys.phi_l @ s) - u_a - sys.g
+    delta_r = float(sys.phi_r @ s) - u_a + sys.g
+    f_l = sys.k_H * delta_l**1.5 if delta_l > 0 else 0.0
+    f_r = -sys.k_H * (-delta_r) ** 1.5 if delta_r < 0 else 0.0
+    return f_l, f_r
