@@ -1,0 +1,248 @@
+"""The seed paper's integrator (Sect. 3.2): fixed-step third-order Bogacki-Shampine (MATLAB ``ode3``).
+
+Eqs. 3-7 in the relative coordinates of `sim.system` (y = [s, s', u_a, u_a'], u_a = q_a - q_base):
+
+    s_j''  = -2 D_j w_j s_j' - w_j^2 s_j - phi_l,j f_l - phi_r,j f_r + gamma_j a_base Omega^2 cos(Omega t)
+    u_a''  = (f_l + f_r) / m_a + a_base Omega^2 cos(Omega t)
+
+with the Hertz forces of Eqs. 4-6 (`sim.system.contact_forces`). The scheme is the explicit 3-stage
+Bogacki-Shampine tableau without error control, exactly MATLAB's fixed-step ``ode3``:
+
+    k1 = f(t, y),  k2 = f(t + h/2, y + h/2 k1),  k3 = f(t + 3h/4, y + 3h/4 k2),
+    y+ = y + h (2/9 k1 + 1/3 k2 + 4/9 k3).
+
+Time step (Sect. 3.2): dt = 2 pi / (15 omega_max) (omega_max = omega_9 for the paper's 9 modes), times
+``dt_scale``. So that every excitation period ends on a step (the protocol's whole periods, continuous
+phase), the step actually used is the largest h <= dt with T = N h, N an integer (for the rig at
+eta ~ 1: N ~ 2600, h shorter than dt by < 0.04 %).
+
+Per period the kernel returns |c_1| of q_tip = phi_tip^T s, c_1 = (2/T) int_T q_tip exp(-i Omega t) dt by the
+trapezoidal rule on the step points, and the number of contact onsets (open -> closed at either wall,
+checked at the step points).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from sim.errors import SimulationDiverged, SimulationInputError
+from sim.system import SystemArrays
+
+#: Sect. 3.2: the highest retained mode's period is sampled with 15 time levels.
+STEPS_PER_HIGHEST_PERIOD = 15
+#: Indentation (as a fraction of the clearance) at which the stability check linearises the Hertz contact.
+#: The paper's simulations stay below 40 um = 0.07 g* (seed-rig.toml); 0.1 g leaves a margin.
+STABILITY_INDENTATION_FRACTION = 0.1
+
+# Status codes of the kernel
+_OK, _NONFINITE, _OVERLAP = 0, 1, 2
+# Fast-math flags that keep NaN/inf semantics (the divergence check relies on them).
+_FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
+
+
+def paper_time_step(omega_max: float, dt_scale: float = 1.0) -> float:
+    """dt = dt_scale * 2 pi / (15 omega_max) in s (Sect. 3.2); omega_max in rad/s."""
+    return dt_scale * 2.0 * math.pi / (STEPS_PER_HIGHEST_PERIOD * omega_max)
+
+
+def steps_per_period(Omega: float, dt_max: float, samples_per_period: int = 1) -> int:
+    """Smallest N with T/N <= dt_max (T = 2 pi/Omega) that is a multiple of `samples_per_period`."""
+    period = 2.0 * math.pi / Omega
+    blocks = math.ceil(period / (samples_per_period * dt_max) * (1.0 - 1e-12))
+    return max(1, blocks) * samples_per_period
+
+
+def stability_factor(z: complex) -> float:
+    """|R(z)| of the Bogacki-Shampine 3-stage scheme, R(z) = 1 + z + z^2/2 + z^3/6."""
+    return abs(1.0 + z + z * z / 2.0 + z**3 / 6.0)
+
+
+def check_stability(sys: SystemArrays, h: float) -> None:
+    """Refuse a step that makes ode3 unstable on a mode or on the linearised contact (SimulationInputError).
+
+    Each mode's eigenvalue lambda = omega (-D + i sqrt(1 - D^2)) must satisfy |R(h lambda)| <= 1; the
+    contact is checked as the sphere on a rigid wall linearised at delta = 0.1 g:
+    k = 1.5 k_H delta^0.5, lambda = i sqrt(k / m_a). On the imaginary axis the limit is h omega <= sqrt(3).
+    """
+    candidates = [(float(w), float(d), f"mode {j + 1} ({w / (2 * math.pi):.6g} Hz)")
+                  for j, (w, d) in enumerate(zip(sys.omega, sys.D))]
+    if sys.k_H > 0:
+        delta = STABILITY_INDENTATION_FRACTION * sys.g
+        w_contact = math.sqrt(1.5 * sys.k_H * math.sqrt(delta) / sys.m_a)
+        candidates.append((w_contact, 0.0, f"the Hertz contact ({w_contact / (2 * math.pi):.6g} Hz at delta = {delta:.3g} m)"))
+    for w, d, label in candidates:
+        z = h * w * complex(-d, math.sqrt(max(0.0, 1.0 - d * d)))
+        if stability_factor(z) > 1.0 + 1e-12:
+            limit = math.sqrt(3.0) / w
+            raise SimulationInputError(
+                f"time step {h:.4g} s is too large for ode3 stability on {label}: h*omega = {h * w:.3g} > "
+                f"sqrt(3); use a step below {limit:.3g} s (smaller dt_scale)")
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _deriv(y, cos_t, n, w2, c, phi_l, phi_r, f_modal, f_sphere, m_a, k_H, g, out):
+    """Right-hand side of Eqs. 3-7 in relative coordinates (see module docstring)."""
+    u = y[2 * n]
+    dl = -u - g
+    dr = -u + g
+    for j in range(n):
+        dl += phi_l[j] * y[j]
+        dr += phi_r[j] * y[j]
+    fl = k_H * dl * math.sqrt(dl) if dl > 0.0 else 0.0
+    fr = -k_H * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
+    for j in range(n):
+        out[j] = y[n + j]
+        out[n + j] = -c[j] * y[n + j] - w2[j] * y[j] - phi_l[j] * fl - phi_r[j] * fr + f_modal[j] * cos_t
+    out[2 * n] = y[2 * n + 1]
+    out[2 * n + 1] = (fl + fr) / m_a + f_sphere * cos_t
+
+
+@njit(cache=True, fastmath=_FAST)
+def _advance(y, n_periods, N, h, Omega, a_base, omega, D, phi_l, phi_r, phi_tip, gamma, m_a, k_H, g,
+             cos_stage, cos0, sin0, record, rec_stride, amplitudes, impacts):
+    """Advance y in place over n_periods * N ode3 steps; returns (status, step index of a failure)."""
+    n = omega.size
+    ny = 2 * n + 2
+    w2 = omega * omega
+    c = 2.0 * D * omega
+    f_modal = gamma * (a_base * Omega * Omega)
+    f_sphere = a_base * Omega * Omega
+    k1 = np.empty(ny)
+    k2 = np.empty(ny)
+    k3 = np.empty(ny)
+    yt = np.empty(ny)
+    b1, b2, b3 = h * 2.0 / 9.0, h / 3.0, h * 4.0 / 9.0
+    recording = record.shape[0] > 0
+    rows_per_period = N // rec_stride
+    if recording:
+        record[0, :] = y
+    # contact state at the start (continuous with the end of the previous call)
+    u = y[2 * n]
+    dl = -u - g
+    dr = -u + g
+    for j in range(n):
+        dl += phi_l[j] * y[j]
+        dr += phi_r[j] * y[j]
+    closed_l = dl > 0.0
+    closed_r = dr < 0.0
+    check_overlap = k_H > 0.0
+    for p in range(n_periods):
+        q = 0.0
+        for j in range(n):
+            q += phi_tip[j] * y[j]
+        re = 0.5 * q  # trapezoid end weight, phase 0: cos = 1, sin = 0
+        im = 0.0
+        onsets = 0
+        for k in range(N):
+            _deriv(y, cos_stage[0, k], n, w2, c, phi_l, phi_r, f_modal, f_sphere, m_a, k_H, g, k1)
+            for i in range(ny):
+                yt[i] = y[i] + 0.5 * h * k1[i]
+            _deriv(yt, cos_stage[1, k], n, w2, c, phi_l, phi_r, f_modal, f_sphere, m_a, k_H, g, k2)
+            for i in range(ny):
+                yt[i] = y[i] + 0.75 * h * k2[i]
+            _deriv(yt, cos_stage[2, k], n, w2, c, phi_l, phi_r, f_modal, f_sphere, m_a, k_H, g, k3)
+            for i in range(ny):
+                y[i] += b1 * k1[i] + b2 * k2[i] + b3 * k3[i]
+            # measures at the new step point t_{k+1}
+            u = y[2 * n]
+            q = 0.0
+            dl = -u - g
+            dr = -u + g
+            for j in range(n):
+                q += phi_tip[j] * y[j]
+                dl += phi_l[j] * y[j]
+                dr += phi_r[j] * y[j]
+            kk = k + 1
+            if kk < N:
+                re += q * cos0[kk]
+                im -= q * sin0[kk]
+            else:
+                re += 0.5 * q
+            now_l = dl > 0.0
+            now_r = dr < 0.0
+            if now_l and not closed_l:
+                onsets += 1
+            if now_r and not closed_r:
+                onsets += 1
+            closed_l = now_l
+            closed_r = now_r
+            if check_overlap and (dl > g or -dr > g):
+                return _OVERLAP, p * N + k
+            if recording and kk % rec_stride == 0:
+                record[p * rows_per_period + kk // rec_stride, :] = y
+        amplitudes[p] = 2.0 / N * math.sqrt(re * re + im * im)
+        impacts[p] = onsets
+        for i in range(ny):
+            if not math.isfinite(y[i]):
+                return _NONFINITE, (p + 1) * N
+    return _OK, n_periods * N
+
+
+def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: SystemArrays,
+             record: np.ndarray | None = None, *, dt_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Advance the state y in place over `n_periods` whole excitation periods with ode3 (Sect. 3.2).
+
+    Integrator contract of `sim.system`: y = [s, s', u_a, u_a'] at excitation phase 0 (float64, length
+    2 n_modes + 2); Omega in rad/s; a_base in m. Returns (amplitudes, impacts): per period |c_1| of q_tip
+    in m, and the number of contact onsets (int64).
+
+    record: optional float64 array of shape (n_periods * M + 1, len(y)); it receives the state at M
+    equally spaced instants per period (row 0 = the initial state). The step is then chosen so that these
+    instants are step points (h <= dt still holds).
+
+    dt_scale: multiplies the paper's dt = 2 pi/(15 omega_max) (tests, order studies).
+    Raises SimulationInputError for bad arguments or an unstable step, SimulationDiverged if the state
+    becomes non-finite or an indentation exceeds the clearance (the contact was stepped over).
+    """
+    n = sys.omega.size
+    if not isinstance(y, np.ndarray) or y.dtype != np.float64 or y.shape != (2 * n + 2,) or not y.flags.c_contiguous:
+        raise SimulationInputError(f"state y must be a contiguous float64 array of length {2 * n + 2} (2 n_modes + 2)")
+    n_periods = int(n_periods)
+    if n_periods < 1:
+        raise SimulationInputError(f"n_periods must be at least 1, got {n_periods}")
+    Omega = float(Omega)
+    a_base = float(a_base)
+    if not math.isfinite(Omega) or Omega <= 0:
+        raise SimulationInputError(f"excitation frequency Omega must be positive (rad/s), got {Omega!r}")
+    if not math.isfinite(a_base) or a_base < 0:
+        raise SimulationInputError(f"base amplitude a_base must be >= 0 (m), got {a_base!r}")
+    dt_scale = float(dt_scale)
+    if not math.isfinite(dt_scale) or dt_scale <= 0:
+        raise SimulationInputError(f"dt_scale must be positive, got {dt_scale!r}")
+    if not np.all(np.isfinite(y)):
+        raise SimulationInputError("state y contains non-finite values")
+
+    if record is None:
+        record_arr = np.empty((0, 2 * n + 2))
+        samples = 1
+    else:
+        rows = record.shape[0] - 1 if record.ndim == 2 else -1
+        if (record.dtype != np.float64 or record.ndim != 2 or record.shape[1] != 2 * n + 2 or rows < n_periods
+                or rows % n_periods or not record.flags.c_contiguous):
+            raise SimulationInputError(
+                f"record must be a contiguous float64 array of shape (n_periods * M + 1, {2 * n + 2})")
+        record_arr = record
+        samples = rows // n_periods
+
+    dt_max = paper_time_step(float(np.max(sys.omega)), dt_scale)
+    N = steps_per_period(Omega, dt_max, samples)
+    h = 2.0 * math.pi / Omega / N
+    check_stability(sys, h)
+
+    phase = Omega * h * np.arange(N)
+    cos_stage = np.empty((3, N))
+    for row, c_stage in enumerate((0.0, 0.5, 0.75)):
+        cos_stage[row] = np.cos(phase + c_stage * Omega * h)
+    amplitudes = np.empty(n_periods)
+    impacts = np.zeros(n_periods, dtype=np.int64)
+    status, where = _advance(y, n_periods, N, h, Omega, a_base, sys.omega, sys.D, sys.phi_l, sys.phi_r,
+                             sys.phi_tip, sys.gamma, float(sys.m_a), float(sys.k_H), float(sys.g),
+                             cos_stage, np.cos(phase), np.sin(phase), record_arr, N // samples, amplitudes, impacts)
+    if status != _OK:
+        t = where * h
+        why = "non-finite state" if status == _NONFINITE else "an indentation larger than the clearance"
+        raise SimulationDiverged(
+            f"ode3 diverged after {t:.4g} s of this step ({why}); reduce dt_scale or check k_H, g and the level")
+    return amplitudes, impacts
