@@ -1,0 +1,357 @@
+"""The stepped-sine protocol of the seed paper (Sects. 5.1-5.3) and its aggregation over repetitions.
+
+One *run* (`run_sweep`) starts from homogeneous initial conditions (y = 0, the sphere centred at rest)
+and steps through the frequency grid leg by leg (e.g. up, down, up), carrying the state over from point to
+point with a continuous excitation phase. At each point it waits `wait` seconds and then holds `hold`
+seconds, both rounded to whole excitation periods (at least one hold period), and records the measures of
+`sim.measures` over the hold.
+
+Frequencies: eta = Omega / omega_1 (omega_1 of the model = the nominal natural frequency omega*, Sect. 5.2).
+Random perturbation law (Sect. 5.1: "slightly different, randomly perturbed excitation frequencies in
+each stepped sine run"): every visited point k of a run gets its own relative offset,
+``eta_k' = eta_k (1 + e_k)``, e_k ~ Uniform(-perturbation, +perturbation), drawn in execution order from
+``np.random.default_rng([seed, rep])``; nothing else is random. A run is therefore reproducible from
+(seed, rep) alone, in any order and in any process. The default 5e-4 is a quarter of the default grid
+spacing (0.002), so the grid stays monotone.
+
+Legs and repetitions (`SteppedSine.repetition`):
+* ``"leg"`` (default, the experiment's counting, Sect. 5.1): every leg of every run is one repetition of
+  the frequency response; up-down-up from rest gives three samples per frequency, the later legs starting
+  from the state the previous leg left.
+* ``"run"``: one run is one repetition (the paper's simulations start every run from rest); the visits of
+  a frequency in its legs are pooled as one longer hold (mean over all hold periods, max of the maxima).
+With the single-leg sequences "up" and "down" both choices coincide. The turning point of a multi-leg
+sequence is visited once in each leg.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from sim.errors import SimulationInputError
+from sim.measures import APR, LINEAR, REGIME_CV_THRESHOLD, classify_regime, hold_measures
+from sim.system import (CLEARANCE_NOMINAL, SPHERE_MASS, Impactor, ModalModel, Nominal, SystemArrays,
+                        a_base_star, a_noabs_star, system_arrays)
+
+#: The sweep sequences: each a tuple of legs ("up": increasing eta, "down": decreasing).
+SEQUENCES: dict[str, tuple[str, ...]] = {
+    "up": ("up",),
+    "down": ("down",),
+    "up-down-up": ("up", "down", "up"),
+    "up-down-up-down-up": ("up", "down", "up", "down", "up"),
+}
+REPETITION_UNITS = ("leg", "run")
+
+
+@dataclass(frozen=True)
+class SteppedSine:
+    """A stepped-sine protocol (Sect. 5.1).
+
+    eta_start, eta_stop, n_eta: the grid of eta = Omega/omega_1 (linspace, start < stop, or n_eta = 1);
+    sequence: one of SEQUENCES; wait, hold: s per frequency point (paper: 3 s and 5 s with the IES; 15 s
+    wait without); perturbation: half-width of the uniform relative frequency offset per visited point;
+    repetition: "leg" or "run" (module docstring); integrator: a name of `sim.integrators`;
+    dt_scale: multiple of the paper's ode3 step (ode3 only).
+    """
+
+    eta_start: float = 0.96
+    eta_stop: float = 1.02
+    n_eta: int = 31
+    sequence: str = "up"
+    wait: float = 3.0
+    hold: float = 5.0
+    perturbation: float = 5e-4
+    repetition: str = "leg"
+    integrator: str = "ode3"
+    dt_scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("eta_start", "eta_stop", "wait", "hold", "perturbation", "dt_scale"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise SimulationInputError(f"stepped sine: {name} must be a finite number, got {value!r}")
+        if int(self.n_eta) != self.n_eta or self.n_eta < 1:
+            raise SimulationInputError(f"stepped sine: the eta grid is empty (n = {self.n_eta}); give n >= 1, e.g. 0.96:1.02:31")
+        if self.eta_start <= 0:
+            raise SimulationInputError(f"stepped sine: eta must be positive, got start {self.eta_start}")
+        if self.n_eta > 1 and not self.eta_stop > self.eta_start:
+            raise SimulationInputError(
+                f"stepped sine: eta range {self.eta_start}:{self.eta_stop} is empty or reversed; give START < STOP "
+                "(the direction comes from --sequence)")
+        if self.n_eta == 1 and self.eta_stop != self.eta_start:
+            raise SimulationInputError("stepped sine: a single frequency needs START == STOP, e.g. 0.976:0.976:1")
+        if self.sequence not in SEQUENCES:
+            raise SimulationInputError(f"stepped sine: unknown sequence {self.sequence!r}; choose one of {', '.join(SEQUENCES)}")
+        if self.repetition not in REPETITION_UNITS:
+            raise SimulationInputError(f"stepped sine: repetition must be 'leg' or 'run', got {self.repetition!r}")
+        if self.wait < 0:
+            raise SimulationInputError(f"stepped sine: wait must be >= 0 s, got {self.wait}")
+        if self.hold <= 0:
+            raise SimulationInputError(f"stepped sine: hold must be positive (s), got {self.hold}")
+        if not 0 <= self.perturbation < 0.05:
+            raise SimulationInputError(f"stepped sine: perturbation must lie in [0, 0.05) (relative), got {self.perturbation}")
+        if self.dt_scale <= 0:
+            raise SimulationInputError(f"stepped sine: dt_scale must be positive, got {self.dt_scale}")
+
+    @property
+    def eta(self) -> np.ndarray:
+        """The nominal eta grid, ascending."""
+        return np.linspace(self.eta_start, self.eta_stop, int(self.n_eta))
+
+    @property
+    def legs(self) -> tuple[str, ...]:
+        return SEQUENCES[self.sequence]
+
+    def periods(self, Omega: float) -> tuple[int, int]:
+        """(wait, hold) in whole excitation periods at Omega (rad/s); refuses a hold shorter than one period."""
+        period = 2.0 * math.pi / Omega
+        if self.hold < period * (1.0 - 1e-9):
+            raise SimulationInputError(
+                f"stepped sine: hold {self.hold:g} s is shorter than one excitation period ({period:.4g} s); "
+                "give a longer --hold")
+        return int(round(self.wait / period)), max(1, int(round(self.hold / period)))
+
+
+@dataclass
+class SweepRun:
+    """One stepped-sine run (`run_sweep`): per visited point, in execution order.
+
+    eta: nominal grid value; eta_actual: the perturbed value simulated; leg: leg index (0, 1, ...);
+    mean, max, min, std: per-period amplitudes over the hold / a_noabs*; impacts_per_period: contact
+    onsets per period over the hold; hold_periods: hold length in periods.
+    level = a_base/a_base*; a_base, a_noabs (m); wall_time_s of the run.
+    """
+
+    eta: np.ndarray
+    eta_actual: np.ndarray
+    leg: np.ndarray
+    mean: np.ndarray
+    max: np.ndarray
+    min: np.ndarray
+    std: np.ndarray
+    impacts_per_period: np.ndarray
+    hold_periods: np.ndarray
+    level: float
+    a_base: float
+    a_noabs: float
+    seed: int
+    rep: int
+    protocol: SteppedSine
+    impactor: Impactor | None
+    wall_time_s: float = 0.0
+
+    @property
+    def cv(self) -> np.ndarray:
+        return np.divide(self.std, self.mean, out=np.zeros_like(self.std), where=self.mean > 0)
+
+
+@dataclass
+class SweepResult:
+    """A frequency response aggregated over repetitions (Fig. 5) and its resonant levels (Fig. 6).
+
+    Arrays over the eta grid (ascending): mean, max = averages over the repetition samples of the
+    per-point mean and max amplitude (/ a_noabs*); *_lo, *_hi = their smallest and largest sample (the
+    spread of Fig. 5); *_std = their standard deviation; cv = average amplitude spread std/mean;
+    impacts_per_period = average contact onsets per period; regime per point ('APR', 'SMR', 'linear').
+    resonant_mean, resonant_max: largest mean / max over eta (Sect. 5.2, 5.3); eta_resonant_mean/max where
+    they occur; regime: the regime at eta_resonant_mean; resonant_*_samples: the resonant levels of each
+    repetition sample (their spread, for the uncertainty layer).
+    """
+
+    eta: np.ndarray
+    mean: np.ndarray
+    mean_lo: np.ndarray
+    mean_hi: np.ndarray
+    mean_std: np.ndarray
+    max: np.ndarray
+    max_lo: np.ndarray
+    max_hi: np.ndarray
+    max_std: np.ndarray
+    cv: np.ndarray
+    impacts_per_period: np.ndarray
+    regime_per_eta: list[str]
+    resonant_mean: float
+    resonant_max: float
+    eta_resonant_mean: float
+    eta_resonant_max: float
+    regime: str
+    resonant_mean_samples: np.ndarray
+    resonant_max_samples: np.ndarray
+    n_samples: int
+    n_runs: int
+    level: float
+    a_base: float
+    a_noabs: float
+    protocol: SteppedSine
+    wall_time_s: float
+    extra: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """Plain data for JSON (see `uq.output.dumps`)."""
+        out = {k: getattr(self, k) for k in (
+            "level", "a_base", "a_noabs", "eta", "mean", "max", "mean_lo", "mean_hi", "mean_std", "max_lo",
+            "max_hi", "max_std", "cv", "impacts_per_period", "regime_per_eta", "resonant_mean", "resonant_max",
+            "eta_resonant_mean", "eta_resonant_max", "regime", "resonant_mean_samples", "resonant_max_samples",
+            "n_samples", "n_runs", "wall_time_s")}
+        out["protocol"] = asdict(self.protocol)
+        out["regime_cv_threshold"] = REGIME_CV_THRESHOLD
+        out.update(self.extra)
+        return out
+
+
+def _system(model: ModalModel, impactor: Impactor | None) -> SystemArrays:
+    """System arrays; without impactor k_H = 0 (the sphere never touches: the linear host structure)."""
+    if impactor is not None:
+        return system_arrays(model, impactor)
+    return system_arrays(model, Impactor(SPHERE_MASS, CLEARANCE_NOMINAL))._replace(k_H=0.0)
+
+
+def check_level(level: float) -> float:
+    """Validate the excitation level a_base/a_base* (> 0)."""
+    level = float(level)
+    if not math.isfinite(level) or level <= 0:
+        raise SimulationInputError(f"excitation level a_base/a_base* must be positive, got {level!r}")
+    return level
+
+
+def _check_seed(value: int, name: str) -> int:
+    if int(value) != value or value < 0:
+        raise SimulationInputError(f"{name} must be a non-negative integer, got {value!r}")
+    return int(value)
+
+
+def run_sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *,
+              seed: int, rep: int, nominal: Nominal = Nominal(),
+              progress: Callable[[], None] | None = None) -> SweepRun:
+    """ONE stepped-sine run from rest (Sect. 5.1) at a_base = level * a_base* (nominal D*, g*).
+
+    impactor None simulates the host structure alone. The random frequency offsets come only from
+    ``np.random.default_rng([seed, rep])`` (module docstring). `progress` is called after every point.
+    """
+    from sim.integrators import get_integrator
+
+    level = check_level(level)
+    seed = _check_seed(seed, "seed")
+    rep = _check_seed(rep, "rep")
+    run_step = get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
+    sys = _system(model, impactor)
+    a_base = level * a_base_star(model, nominal)
+    a_noabs = a_noabs_star(model, a_base, nominal)
+    omega_1 = float(model.omega[0])
+    grid = protocol.eta
+    protocol.periods(omega_1 * grid[0] * (1.0 - protocol.perturbation))  # refuse a too short hold up front
+
+    rng = np.random.default_rng([seed, rep])
+    started = time.perf_counter()
+    y = np.zeros(2 * model.n_modes + 2)
+    rows: list[tuple] = []
+    for leg_index, direction in enumerate(protocol.legs):
+        order = grid if direction == "up" else grid[::-1]
+        offsets = rng.uniform(-protocol.perturbation, protocol.perturbation, size=order.size)
+        for eta, offset in zip(order, offsets):
+            eta_actual = float(eta) * (1.0 + float(offset))
+            Omega = eta_actual * omega_1
+            n_wait, n_hold = protocol.periods(Omega)
+            if n_wait:
+                run_step(y, n_wait, Omega, a_base, sys, None)
+            amplitudes, impacts = run_step(y, n_hold, Omega, a_base, sys, None)
+            m = hold_measures(amplitudes, impacts, a_noabs)
+            rows.append((float(eta), eta_actual, leg_index, m.mean, m.max, m.min, m.std, m.impacts_per_period, n_hold))
+            if progress is not None:
+                progress()
+    cols = list(zip(*rows))
+    as_f = lambda i: np.array(cols[i], dtype=float)  # noqa: E731
+    return SweepRun(
+        eta=as_f(0), eta_actual=as_f(1), leg=np.array(cols[2], dtype=int), mean=as_f(3), max=as_f(4),
+        min=as_f(5), std=as_f(6), impacts_per_period=as_f(7), hold_periods=np.array(cols[8], dtype=int),
+        level=level, a_base=a_base, a_noabs=a_noabs, seed=seed, rep=rep, protocol=protocol, impactor=impactor,
+        wall_time_s=time.perf_counter() - started)
+
+
+def _samples(run: SweepRun, grid: np.ndarray) -> list[dict[str, np.ndarray]]:
+    """The repetition samples of one run on the ascending grid (per leg, or pooled per run)."""
+    n = grid.size
+    per_leg = []
+    for leg in np.unique(run.leg):
+        sel = run.leg == leg
+        idx = np.searchsorted(grid, run.eta[sel])
+        sample = {}
+        for key in ("mean", "max", "std", "impacts_per_period", "hold_periods"):
+            arr = np.empty(n)
+            arr[idx] = getattr(run, key)[sel]
+            sample[key] = arr
+        per_leg.append(sample)
+    if run.protocol.repetition == "leg" or len(per_leg) == 1:
+        return per_leg
+    # pool the legs as one longer hold: weighted mean, max of maxima, pooled std (law of total variance)
+    w = np.array([s["hold_periods"] for s in per_leg])
+    mean = np.array([s["mean"] for s in per_leg])
+    pooled_mean = np.sum(w * mean, axis=0) / w.sum(axis=0)
+    second = np.sum(w * (np.array([s["std"] for s in per_leg]) ** 2 + mean**2), axis=0) / w.sum(axis=0)
+    return [{
+        "mean": pooled_mean,
+        "max": np.max([s["max"] for s in per_leg], axis=0),
+        "std": np.sqrt(np.clip(second - pooled_mean**2, 0.0, None)),
+        "impacts_per_period": np.sum(w * np.array([s["impacts_per_period"] for s in per_leg]), axis=0) / w.sum(axis=0),
+        "hold_periods": w.sum(axis=0),
+    }]
+
+
+def aggregate_runs(runs: list[SweepRun]) -> SweepResult:
+    """Aggregate runs of the same protocol and level into a frequency response with its spread (Fig. 5)."""
+    if not runs:
+        raise SimulationInputError("no runs to aggregate; give at least one repetition")
+    first = runs[0]
+    for run in runs[1:]:
+        if run.protocol != first.protocol or run.level != first.level or run.a_base != first.a_base:
+            raise SimulationInputError("runs to aggregate must share the protocol and the excitation level")
+    grid = first.protocol.eta
+    samples = [s for run in runs for s in _samples(run, grid)]
+    stack = {key: np.array([s[key] for s in samples]) for key in ("mean", "max", "std", "impacts_per_period")}
+    cv_samples = np.divide(stack["std"], stack["mean"], out=np.zeros_like(stack["std"]), where=stack["mean"] > 0)
+    mean, mx = stack["mean"].mean(axis=0), stack["max"].mean(axis=0)
+    cv = cv_samples.mean(axis=0)
+    impacts = stack["impacts_per_period"].mean(axis=0)
+    regimes = [str(r) for r in classify_regime(cv, impacts)]
+    i_mean, i_max = int(np.argmax(mean)), int(np.argmax(mx))
+    return SweepResult(
+        eta=grid, mean=mean, mean_lo=stack["mean"].min(axis=0), mean_hi=stack["mean"].max(axis=0),
+        mean_std=stack["mean"].std(axis=0), max=mx, max_lo=stack["max"].min(axis=0), max_hi=stack["max"].max(axis=0),
+        max_std=stack["max"].std(axis=0), cv=cv, impacts_per_period=impacts, regime_per_eta=regimes,
+        resonant_mean=float(mean[i_mean]), resonant_max=float(mx[i_max]),
+        eta_resonant_mean=float(grid[i_mean]), eta_resonant_max=float(grid[i_max]), regime=regimes[i_mean],
+        resonant_mean_samples=stack["mean"].max(axis=1), resonant_max_samples=stack["max"].max(axis=1),
+        n_samples=len(samples), n_runs=len(runs), level=first.level, a_base=first.a_base, a_noabs=first.a_noabs,
+        protocol=first.protocol, wall_time_s=float(sum(r.wall_time_s for r in runs)))
+
+
+def sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *, reps: int,
+          seed: int, nominal: Nominal = Nominal(), progress: bool | None = None) -> SweepResult:
+    """`reps` runs (rep = 0 .. reps-1) of `run_sweep`, aggregated (Sects. 5.1, 5.2).
+
+    progress: show a tqdm bar on stderr (None: only if stderr is a terminal and the sweep is long).
+    """
+    import sys as _sys
+
+    from tqdm import tqdm
+
+    if int(reps) != reps or reps < 1:
+        raise SimulationInputError(f"reps must be a positive integer, got {reps!r}")
+    total = int(reps) * len(protocol.legs) * int(protocol.n_eta)
+    if progress is None:
+        progress = _sys.stderr.isatty() and total * (protocol.wait + protocol.hold) > 60.0
+    started = time.perf_counter()
+    with tqdm(total=total, disable=not progress, unit="pt", desc=f"sweep {level:g}", leave=False) as bar:
+        runs = [run_sweep(model, impactor, level, protocol, seed=seed, rep=rep, nominal=nominal, progress=bar.update)
+                for rep in range(int(reps))]
+    result = aggregate_runs(runs)
+    result.wall_time_s = time.perf_counter() - started
+    return result
+
+
+__all__ = ["SEQUENCES", "SteppedSine", "SweepResult", "SweepRun", "aggregate_runs", "check_level", "run_sweep",
+           "sweep", "APR", "LINEAR"]
