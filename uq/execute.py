@@ -1,0 +1,252 @@
+"""Running interval and Sobol' studies end to end: designs -> tasks -> runner -> statistics -> files.
+
+Data first: every run (runs.csv), the repetition statistics per design point and level (points.csv),
+the bands (bands.csv) or Sobol' indices (sobol.csv), and study.json with the resolved study, code
+version, warnings and timings. Figures (uq.figures) are drawn from the same tables afterwards.
+CSV files hold no timings, so reruns (serial, parallel, Dask, resumed) can be compared byte by byte.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from uq.errors import StudyError
+from uq.interval import Band, Design, DesignPoint, axis_design, band, box_design
+from uq.output import dumps, write_text
+from uq.runner import ResultStore, Task, prepare_output, run_tasks
+from uq.study import Study
+
+
+@dataclass
+class StudyResult:
+    """What a finished study produced: output folder, files, warnings and a short summary."""
+
+    folder: Path
+    files: list[Path] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    summary: dict = field(default_factory=dict)
+
+
+def _fmt(v: Any) -> str:
+    if isinstance(v, (np.integer, np.bool_)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        return repr(float(v)) if np.isfinite(v) else "nan"
+    return str(v)
+
+
+def _write_csv(path: Path, header: Sequence[str], rows: Sequence[Sequence[Any]]) -> Path:
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(header)
+    for row in rows:
+        writer.writerow([_fmt(v) for v in row])
+    write_text(path, buf.getvalue())
+    return path
+
+
+def _warn(result: StudyResult, message: str) -> None:
+    result.warnings.append(message)
+    sys.stderr.write(f"warning: {message}\n")
+
+
+def _tasks(points: Sequence[dict], study: Study) -> list[Task]:
+    return [Task.make(p, level, rep) for p in points for level in study.levels for rep in range(study.repetitions)]
+
+
+def _rep_matrix(results: dict, points: Sequence[dict], study: Study, output: str) -> np.ndarray:
+    """Outputs as an array (n_points, n_levels, n_reps); failed runs are NaN."""
+    arr = np.full((len(points), len(study.levels), study.repetitions), np.nan)
+    for i, p in enumerate(points):
+        for j, level in enumerate(study.levels):
+            for r in range(study.repetitions):
+                rec = results[Task.make(p, level, r)]
+                if not rec["error"]:
+                    arr[i, j, r] = rec["outputs"].get(output, np.nan)
+    return arr
+
+
+def rep_statistics(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mean, standard error of the mean and count of finite runs over the last axis."""
+    finite = np.isfinite(values)
+    n = finite.sum(axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(n > 0, np.nansum(values, axis=-1) / np.maximum(n, 1), np.nan)
+        dev = np.where(finite, values - mean[..., None], 0.0)
+        sd = np.sqrt((dev**2).sum(axis=-1) / (n - 1))
+        se = np.where(n >= 2, sd / np.sqrt(n), 0.0)
+    return mean, se, n
+
+
+def _runs_rows(results: dict, points: Sequence[dict], study: Study, outputs: Sequence[str], names: Sequence[str]):
+    rows = []
+    for p in points:
+        for level in study.levels:
+            for r in range(study.repetitions):
+                rec = results[Task.make(p, level, r)]
+                rows.append([*(p[n] for n in names), level, r, *(float(rec["outputs"].get(o, np.nan)) for o in outputs),
+                             rec["error"]])
+    return rows
+
+
+def _start(study: Study, out: Path | None, resume: bool) -> tuple[Any, Path, StudyResult]:
+    model = study.make_model()
+    model.check()
+    folder = prepare_output(out or study.output, resume=resume)
+    return model, folder, StudyResult(folder)
+
+
+def _metadata(study: Study, model: Any, result: StudyResult, extra: dict) -> Path:
+    meta = {"study": study.to_dict(), "code_version": model.version(), "outputs": list(model.banded_outputs),
+            "warnings": result.warnings, **extra}
+    if hasattr(model, "resolved_protocol"):
+        meta["study"]["protocol_resolved"] = model.resolved_protocol()
+    path = result.folder / "study.json"
+    write_text(path, dumps(meta))
+    return path
+
+
+def interval_designs(study: Study) -> list[Design]:
+    """The designs named in the study: individual (one per varied parameter), joint, residual."""
+    designs: list[Design] = []
+    for name in study.designs:
+        if name == "individual":
+            designs.extend(axis_design(study.space, p.name, study.interior) for p in study.space.varied)
+        elif name == "joint":
+            designs.append(box_design(study.space, study.interior, name="joint", seed=study.seed))
+        elif name == "residual":
+            designs.append(box_design(study.space.fix(**study.fix), study.interior, name="residual", seed=study.seed))
+    if not designs:
+        raise StudyError("the study has no design to run; set [interval] designs")
+    return designs
+
+
+def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, scheduler: str | None = None,
+                       resume: bool = False, progress: bool = True, client: Any = None) -> StudyResult:
+    """Interval study (Figs. 7 and 8): bands of the repetition-mean resonant levels per excitation level."""
+    model, folder, result = _start(study, out, resume)
+    designs = interval_designs(study)
+    nominal = DesignPoint(study.space.nominal(), "nominal", "nominal")
+    unique: dict[tuple, dict] = {nominal.key(): dict(nominal.values)}
+    for d in designs:
+        for p in d.points:
+            unique.setdefault(p.key(), dict(p.values))
+    points = list(unique.values())
+    index = {key: i for i, key in enumerate(unique)}
+    t0 = time.perf_counter()
+    results = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
+                        scheduler=scheduler, progress=progress, client=client)
+    elapsed = time.perf_counter() - t0
+    names, outputs = study.space.names, list(model.banded_outputs)
+    level_labels = [f"level {lv:g}" for lv in study.levels]
+    stats = {o: rep_statistics(_rep_matrix(results, points, study, o)) for o in outputs}
+    n_failed = sum(1 for rec in results.values() if rec["error"])
+    if n_failed:
+        _warn(result, f"{n_failed} of {len(results)} runs failed (see the 'error' column of runs.csv)")
+
+    point_rows, band_rows = [], []
+    bands: dict[tuple[str, str], Band] = {}
+    for d in [Design("nominal", "box", (nominal,))] + designs:
+        rows_idx = [index[p.key()] for p in d.points]
+        for o in outputs:
+            mean, se, n = (a[rows_idx] for a in stats[o])
+            for p, i in zip(d.points, range(len(rows_idx))):
+                for j, level in enumerate(study.levels):
+                    point_rows.append([d.name, p.label, p.role, *(p.values[k] for k in names), level, o,
+                                       mean[i, j], se[i, j], int(n[i, j])])
+            if d.name == "nominal":
+                continue
+            bd = _band_with_failures(d, mean, se, study.z, level_labels)
+            bands[(d.name, o)] = bd
+            for msg in bd.notes:
+                _warn(result, f"{o}: {msg} -> band widened")
+            for j, level in enumerate(study.levels):
+                band_rows.append([d.name, o, level, bd.lower[j], bd.upper[j], bd.corner_lower[j], bd.corner_upper[j],
+                                  int(bd.flagged[j]), bd.violation[j]])
+    result.files.append(_write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
+                                   _runs_rows(results, points, study, model.outputs, names)))
+    result.files.append(_write_csv(folder / "points.csv", ["design", "point", "role", *names, "level", "output",
+                                                           "mean", "se", "n_runs"], point_rows))
+    result.files.append(_write_csv(folder / "bands.csv", ["design", "output", "level", "lower", "upper",
+                                                          "corner_lower", "corner_upper", "flagged", "violation"],
+                                   band_rows))
+    monotone = {f"{d}/{o}": bd.monotone for (d, o), bd in bands.items()}
+    result.summary = {"tasks": len(results), "failed_runs": n_failed, "wall_time_s": elapsed, "monotone": monotone,
+                      "points": len(points)}
+    result.files.append(_metadata(study, model, result, {"summary": result.summary}))
+    return result
+
+
+def _band_with_failures(design: Design, mean: np.ndarray, se: np.ndarray, z: float, labels: list[str]) -> Band:
+    """`band` level by level, leaving out points whose every run failed at that level (noted)."""
+    n_levels = mean.shape[1]
+    parts, notes = [], []
+    for j in range(n_levels):
+        ok = np.isfinite(mean[:, j])
+        if ok.all():
+            parts.append(band(design, mean[:, j], se[:, j], z=z, output_labels=[labels[j]]))
+            continue
+        kept = tuple(p for p, keep in zip(design.points, ok) if keep)
+        if not any(p.role == "corner" for p in kept):
+            nan = np.array([np.nan])
+            parts.append(Band(design.name, nan, nan, nan, nan, np.array([True]), nan))
+            notes.append(f"{design.name}: every corner failed at {labels[j]}; no band")
+            continue
+        sub = Design(design.name, design.kind, kept, design.parameter)
+        parts.append(band(sub, mean[ok, j], se[ok, j], z=z, output_labels=[labels[j]]))
+        notes.append(f"{design.name}: {int((~ok).sum())} point(s) failed at {labels[j]} and were left out")
+    cat = lambda attr: np.concatenate([getattr(b, attr) for b in parts])  # noqa: E731
+    for b in parts:
+        notes.extend(b.notes)
+    return Band(design.name, cat("lower"), cat("upper"), cat("corner_lower"), cat("corner_upper"), cat("flagged"),
+                cat("violation"), notes)
+
+
+def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = None, jobs: int = 1,
+                    scheduler: str | None = None, resume: bool = False, progress: bool = True,
+                    client: Any = None) -> StudyResult:
+    """Sobol' study: S1, ST (bootstrap CI) of the repetition-mean resonant levels per excitation level,
+    with the share of their variance that is repetition noise."""
+    from uq.sobol import sobol_indices, sobol_sample
+
+    model, folder, result = _start(study, out, resume)
+    n = n or study.sobol_n
+    X = sobol_sample(study.space, n, seed=study.seed)
+    points = [study.space.from_values(x) for x in X]
+    t0 = time.perf_counter()
+    results = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
+                        scheduler=scheduler, progress=progress, client=client)
+    elapsed = time.perf_counter() - t0
+    names, outputs = study.space.names, list(model.banded_outputs)
+    rows, summary_rows, per_level = [], [], {}
+    for o in outputs:
+        Y = _rep_matrix(results, points, study, o)
+        for j, level in enumerate(study.levels):
+            res = sobol_indices(study.space, X, Y[:, j, :], num_resamples=study.bootstrap,
+                                confidence=study.confidence, seed=study.seed)
+            for note in res.notes:
+                _warn(result, f"{o} at level {level:g}: {note}")
+            if res.message:
+                _warn(result, f"{o} at level {level:g}: not analysed: {res.message}")
+            for k, pname in enumerate(res.names):
+                rows.append([o, level, pname, res.S1[k], res.S1_conf[k], res.ST[k], res.ST_conf[k]])
+            summary_rows.append([o, level, res.variance, res.noise_variance, res.noise_share, res.failed_runs,
+                                 res.message])
+            per_level[f"{o}@{level:g}"] = {"noise_share": res.noise_share, "failed_runs": res.failed_runs}
+    result.files.append(_write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
+                                   _runs_rows(results, points, study, model.outputs, names)))
+    result.files.append(_write_csv(folder / "sobol.csv", ["output", "level", "parameter", "S1", "S1_conf", "ST",
+                                                          "ST_conf"], rows))
+    result.files.append(_write_csv(folder / "variance.csv", ["output", "level", "variance", "noise_variance",
+                                                             "noise_share", "failed_runs", "message"], summary_rows))
+    result.summary = {"tasks": len(results), "base_sample": n, "points": len(points), "wall_time_s": elapsed,
+                      "per_level": per_level}
+    result.files.append(_metadata(study, model, result, {"summary": result.summary}))
+    return result

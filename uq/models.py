@@ -1,0 +1,202 @@
+"""Response models that a study evaluates: the IES simulator, Ishigami, or a user's Python function.
+
+A model maps (parameter values, excitation level, repetition) to named scalar outputs:
+
+* ``"ies"``: one stepped-sine run of the simulator (`sim.protocol.run_sweep`, Sect. 5.1-5.3 of the
+  seed paper) with D, g, k_H; outputs the run's resonant response levels ``mean`` and ``max``
+  (largest per-frequency mean / max amplitude, normalised by the nominal a_noabs*, Sect. 5) and
+  ``apr`` (1 where the resonant level is reached in the almost periodic regime, else 0).
+* ``"ishigami"``: the Ishigami-Homma function of x1, x2, x3 (output ``value``), a reference for the
+  Sobol' layer that runs through the whole study machinery.
+* ``"package.module:function"``: ``function(params: dict, level: float, rep: int, seed: int)``
+  returning a float (output ``value``) or a dict of floats, e.g. a surrogate of the response.
+
+Models are small picklable objects: they travel to joblib and Dask workers, and their ``version()``
+(a hash of the code that computes the outputs) is part of every cached task's key.
+"""
+from __future__ import annotations
+
+import functools
+import hashlib
+import importlib
+import inspect
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+from uq.errors import StudyError
+from uq.space import Parameter, ParameterSpace, table2_space
+
+_ROOT = Path(__file__).resolve().parent.parent
+
+
+def _hash_files(paths: list[Path]) -> str:
+    digest = hashlib.sha256()
+    for path in sorted(paths):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+@functools.lru_cache(maxsize=None)
+def _source_version(*relative_dirs_or_files: str) -> str:
+    paths: list[Path] = []
+    for rel in relative_dirs_or_files:
+        target = _ROOT / rel
+        paths.extend(sorted(target.rglob("*.py")) if target.is_dir() else [target])
+    return _hash_files(paths)
+
+
+@dataclass(frozen=True)
+class IESModel:
+    """The simulator of the seed rig under a stepped-sine protocol (one task = one run at one level).
+
+    protocol: keyword arguments of `sim.protocol.SteppedSine` (eta grid, sequence, wait, hold, ...);
+    n_modes: modes of the built-in rig model (9 as in the paper).
+    """
+
+    protocol: Mapping[str, Any] = field(default_factory=dict)
+    n_modes: int = 9
+    name: str = "ies"
+
+    parameters = ("D", "g", "k_H")
+    outputs = ("mean", "max", "apr")
+    banded_outputs = ("mean", "max")
+
+    def default_space(self) -> ParameterSpace:
+        return table2_space()
+
+    def version(self) -> str:
+        return _source_version("sim", "uq/models.py")
+
+    def resolved_protocol(self) -> dict:
+        """The protocol with every default filled in (for the study metadata)."""
+        return _protocol_dict(self._stepped_sine())
+
+    def _stepped_sine(self):
+        from sim.protocol import SteppedSine
+
+        try:
+            return SteppedSine(**dict(self.protocol))
+        except TypeError as exc:
+            raise StudyError(f"[excitation]: {exc}; see `ies sweep --help` for the protocol settings")
+
+    def check(self) -> None:
+        """Build the protocol and the rig model once so that bad settings fail before any task runs."""
+        self._stepped_sine()
+        _rig_model(self.n_modes)
+
+    def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, float]:
+        from sim.protocol import run_sweep
+        from sim.system import Impactor
+
+        model = _rig_model(self.n_modes).with_damping(params["D"])
+        impactor = Impactor(clearance=params["g"], k_H=params["k_H"])
+        run = run_sweep(model, impactor, level, self._stepped_sine(), seed=seed, rep=rep)
+        return _run_outputs(run)
+
+
+def _protocol_dict(protocol: Any) -> dict:
+    out = asdict(protocol) if hasattr(protocol, "__dataclass_fields__") else dict(vars(protocol))
+    return {k: (list(v) if isinstance(v, tuple) else v) for k, v in out.items()}
+
+
+def _run_outputs(run: Any) -> dict[str, float]:
+    """Resonant levels of one run: the largest per-frequency mean and max amplitude (a / a_noabs*)."""
+    import numpy as np
+
+    mean = np.asarray(run.mean, dtype=float)
+    maxi = np.asarray(run.max, dtype=float)
+    i = int(np.nanargmax(mean)) if np.isfinite(mean).any() else 0
+    regime = getattr(run, "regime", None)
+    apr = float("nan")
+    if regime is not None:
+        label = regime[i] if not isinstance(regime, str) else regime
+        apr = 1.0 if str(label).lower() in ("apr", "almost periodic", "almost-periodic") else 0.0
+    return {"mean": float(np.nanmax(mean)) if np.isfinite(mean).any() else float("nan"),
+            "max": float(np.nanmax(maxi)) if np.isfinite(maxi).any() else float("nan"),
+            "apr": apr}
+
+
+@functools.lru_cache(maxsize=4)
+def _rig_model(n_modes: int):
+    from sim.rig import seed_rig_model
+
+    return seed_rig_model(n_modes=n_modes)
+
+
+@dataclass(frozen=True)
+class IshigamiModel:
+    """Ishigami-Homma function f = sin x1 + a sin^2 x2 + b x3^4 sin x1 (a = 7, b = 0.1), x_i in [-pi, pi]."""
+
+    a: float = 7.0
+    b: float = 0.1
+    name: str = "ishigami"
+
+    parameters = ("x1", "x2", "x3")
+    outputs = ("value",)
+    banded_outputs = ("value",)
+
+    def default_space(self) -> ParameterSpace:
+        return ParameterSpace(tuple(Parameter(n, 0.0, -math.pi, math.pi, positive=False) for n in self.parameters))
+
+    def version(self) -> str:
+        return _source_version("uq/models.py")
+
+    def check(self) -> None:
+        return None
+
+    def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, float]:
+        x1, x2, x3 = (params[n] for n in self.parameters)
+        return {"value": math.sin(x1) + self.a * math.sin(x2) ** 2 + self.b * x3**4 * math.sin(x1)}
+
+
+@dataclass(frozen=True)
+class FunctionModel:
+    """A user's function ``module:function`` with the call signature (params, level, rep, seed)."""
+
+    target: str
+    parameters: tuple[str, ...] = ()
+    name: str = "function"
+
+    outputs = ("value",)
+    banded_outputs = ("value",)
+
+    def _function(self) -> Callable:
+        module_name, _, attr = self.target.partition(":")
+        try:
+            module = importlib.import_module(module_name)
+            return getattr(module, attr)
+        except (ImportError, AttributeError) as exc:
+            raise StudyError(f"model '{self.target}' cannot be imported ({exc}); give an importable 'module:function'")
+
+    def default_space(self) -> ParameterSpace | None:
+        return None
+
+    def version(self) -> str:
+        func = self._function()
+        try:
+            return _hash_files([Path(inspect.getfile(func))])
+        except (TypeError, OSError):
+            return "unversioned"
+
+    def check(self) -> None:
+        self._function()
+
+    def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, float]:
+        value = self._function()(dict(params), level, rep, seed)
+        if isinstance(value, Mapping):
+            return {str(k): float(v) for k, v in value.items()}
+        return {"value": float(value)}
+
+
+def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, parameters: tuple[str, ...] = ()) -> Any:
+    """The model named by a study's ``model`` key ("ies", "ishigami" or "module:function")."""
+    if spec == "ies":
+        return IESModel(dict(protocol or {}))
+    if spec == "ishigami":
+        return IshigamiModel()
+    if ":" in spec:
+        return FunctionModel(spec, tuple(parameters))
+    raise StudyError(f"unknown model '{spec}'; use \"ies\", \"ishigami\" or an importable \"module:function\"")

@@ -1,0 +1,184 @@
+"""Running study tasks with joblib (local processes) or a Dask cluster, with an on-disk result store.
+
+A task is one model evaluation: (parameter values, excitation level, repetition). Its key is the
+SHA-256 of the task, the model's settings, the study seed and the model's code version, so a stored
+result is reused only for exactly the same computation. Every result is written to its own JSON file
+(atomically) by the controlling process as soon as it arrives; an interrupted study therefore keeps
+every finished task, and `--resume` runs only the missing ones.
+
+Determinism: a task's random stream depends only on (seed, rep) (sim.protocol contract), results are
+stored as JSON floats (exact round trip), and they are collected by key, never by arrival order: the
+same study gives identical numbers serially, with `--jobs N` and on Dask.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import sys
+import time
+from dataclasses import asdict, dataclass, is_dataclass
+from pathlib import Path
+from typing import Any, Callable, Iterable, Mapping, Sequence
+
+from uq.errors import StudyError
+from uq.output import write_text
+
+
+@dataclass(frozen=True)
+class Task:
+    """One model evaluation: parameter values (SI), level a_base / a_base*, repetition index."""
+
+    params: tuple[tuple[str, float], ...]
+    level: float
+    rep: int
+
+    @staticmethod
+    def make(params: Mapping[str, float], level: float, rep: int) -> "Task":
+        return Task(tuple(sorted((k, float(v)) for k, v in params.items())), float(level), int(rep))
+
+
+def _describe(model: Any) -> Any:
+    if is_dataclass(model):
+        return {"class": type(model).__name__, **{k: v for k, v in asdict(model).items()}}
+    return repr(model)
+
+
+def task_key(task: Task, model: Any, seed: int, version: str) -> str:
+    """Stable key of a task (hex SHA-256 of its parameters, the model settings, seed and code version)."""
+    blob = json.dumps({"params": task.params, "level": task.level, "rep": task.rep, "seed": seed,
+                       "model": _describe(model), "version": version}, sort_keys=True, default=str)
+    return hashlib.sha256(blob.encode()).hexdigest()
+
+
+class ResultStore:
+    """One JSON file per finished task under ``folder/tasks``; writes are atomic."""
+
+    def __init__(self, folder: str | Path) -> None:
+        self.folder = Path(folder) / "tasks"
+
+    def _path(self, key: str) -> Path:
+        return self.folder / f"{key}.json"
+
+    def has(self, key: str) -> bool:
+        return self._path(key).is_file()
+
+    def count(self) -> int:
+        return sum(1 for _ in self.folder.glob("*.json")) if self.folder.is_dir() else 0
+
+    def save(self, key: str, task: Task, result: Mapping[str, Any]) -> None:
+        record = {"key": key, "params": dict(task.params), "level": task.level, "rep": task.rep, **result}
+        write_text(self._path(key), json.dumps(record, sort_keys=True, allow_nan=True))
+
+    def load(self, key: str) -> dict:
+        return json.loads(self._path(key).read_text())
+
+
+def prepare_output(folder: str | Path, *, resume: bool) -> Path:
+    """Create the output folder and check it can be written; refuse to overwrite finished results."""
+    folder = Path(folder)
+    try:
+        (folder / "tasks").mkdir(parents=True, exist_ok=True)
+        probe = folder / "tasks" / f".probe-{os.getpid()}"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise StudyError(f"cannot write to output folder {folder} ({reason}); choose another --out") from None
+    if not resume and ResultStore(folder).count():
+        raise StudyError(f"output folder {folder} already holds task results; pass --resume to continue that study "
+                         "or choose another --out")
+    return folder
+
+
+def evaluate(model: Callable, task: Task, seed: int) -> dict:
+    """Run one task; a diverged simulation or non-finite output is recorded as a failed run."""
+    from sim.errors import SimulationDiverged
+
+    start = time.perf_counter()
+    try:
+        outputs = model(dict(task.params), task.level, task.rep, seed)
+        error = ""
+        bad = [k for k, v in outputs.items() if not math.isfinite(v) and k in getattr(model, "banded_outputs", ())]
+        if bad:
+            error = f"non-finite output(s) {', '.join(bad)}"
+    except (SimulationDiverged, FloatingPointError, ZeroDivisionError) as exc:
+        outputs = {name: float("nan") for name in getattr(model, "outputs", ())}
+        error = f"{type(exc).__name__}: {exc}"
+    return {"outputs": outputs, "error": error, "seconds": time.perf_counter() - start}
+
+
+def _run_one(model: Callable, key: str, task: Task, seed: int) -> tuple[str, dict]:
+    return key, evaluate(model, task, seed)
+
+
+def _connect(address: str):
+    """A distributed.Client for `address`, or a one-line StudyError when it cannot be reached."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise StudyError("--scheduler needs dask.distributed: pip install 'ies-workbench[cluster]'") from None
+    try:
+        return Client(address, timeout="5s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise StudyError(f"cannot reach the Dask scheduler at {address} ({type(exc).__name__}); "
+                         "check the address (e.g. tcp://HOST:8786) and that the scheduler is running") from None
+
+
+def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultStore, *, jobs: int = 1,
+              scheduler: str | None = None, progress: bool = True, client: Any = None) -> dict[Task, dict]:
+    """Run every task whose result is not in `store` and return all results by task.
+
+    jobs: local worker processes (joblib/loky; 1 = in this process). scheduler: a Dask scheduler
+    address, used through joblib's Dask backend (`client` may be passed instead, e.g. in tests).
+    Each result is saved as it arrives, so an interruption loses only the tasks in flight.
+    """
+    from tqdm import tqdm
+
+    if jobs < 1:
+        raise StudyError(f"--jobs must be >= 1, got {jobs}")
+    version = model.version()
+    keys = {task: task_key(task, model, seed, version) for task in tasks}
+    unique: dict[str, Task] = {}
+    for task, key in keys.items():
+        if key not in unique and not store.has(key):
+            unique[key] = task
+    pending = list(unique.items())
+    total = len(set(keys.values()))
+    bar = tqdm(total=total, initial=total - len(pending), desc="tasks", unit="run",
+               disable=not progress, file=sys.stderr, dynamic_ncols=True)
+    try:
+        for key, task, result in _dispatch(model, pending, seed, jobs, scheduler, client):
+            store.save(key, task, result)
+            bar.update(1)
+    finally:
+        bar.close()
+    return {task: store.load(key) for task, key in keys.items()}
+
+
+def _dispatch(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int, scheduler: str | None,
+              client: Any) -> Iterable[tuple[str, Task, dict]]:
+    if not pending:
+        return
+    by_key = {k: t for k, t in pending}
+    if scheduler is None and client is None and jobs == 1:
+        for key, task in pending:
+            yield key, task, evaluate(model, task, seed)
+        return
+    from joblib import Parallel, delayed, parallel_config
+
+    calls = (delayed(_run_one)(model, key, task, seed) for key, task in pending)
+    if scheduler is not None or client is not None:
+        own = client is None
+        client = _connect(scheduler) if own else client
+        try:
+            with parallel_config(backend="dask", wait_for_workers_timeout=30):
+                for key, result in Parallel(n_jobs=-1, return_as="generator_unordered")(calls):
+                    yield key, by_key[key], result
+        finally:
+            if own:
+                client.close()
+        return
+    for key, result in Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(calls):
+        yield key, by_key[key], result

@@ -1,0 +1,297 @@
+"""Study files: a TOML description of an uncertainty study, validated with one-line errors.
+
+Layout (every table and key is optional except where noted; SI units)::
+
+    [study]
+    name = "fig7"
+    kind = "interval"            # "interval" or "sobol" (required)
+    model = "ies"                # "ies" (the simulator), "ishigami", or "package.module:function"
+    seed = 1                     # random stream of the repetitions (Sect. 5.1: perturbed frequencies)
+    repetitions = 5
+    output = "results/fig7"      # default output folder (`--out` overrides), relative to the cwd
+
+    [parameters.D]               # listed parameters are varied; unlisted ones stay nominal.
+    nominal = 0.00085            # missing keys default to Table 2 (model "ies")
+    min = 0.00075
+    max = 0.00090
+    [parameters.k_H]             # N/m^1.5, or "1.52 k_H*", or "calibrated:calib.json"
+    max = "1.52 k_H*"
+    best_estimate = "1.25 k_H*"  # the value k_H is fixed at in the residual band (Fig. 8)
+
+    [excitation]                 # passed to the stepped-sine protocol (sim.protocol.SteppedSine)
+    levels = [5.3, 6.7, 7.4]     # a_base / a_base* (Sect. 5.3; nominal D*, g*)
+    eta = { start = 0.95, stop = 1.01, n = 25 }   # or an explicit list of Omega / omega_1*
+    wait = 3.0                   # s
+    hold = 5.0                   # s
+    sequence = "up-down-up"
+    integrator = "exact"
+
+    [interval]
+    designs = ["individual", "joint", "residual"]
+    interior = 1                 # interior points per axis (individual) / in the box (joint, residual)
+    z = 2.0                      # noise multiple below which a monotonicity violation is not flagged
+    fix = { k_H = "best_estimate" }   # parameters held fixed in the residual band
+
+    [sobol]
+    n = 64                       # base sample size (power of two); n (k + 2) points
+    bootstrap = 200
+    confidence = 0.95
+
+Unknown tables or keys, unknown parameters, min > max, non-positive bounds and the like are refused with
+a `StudyError` whose one line names the file, the key and the fix.
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+from uq.errors import StudyError
+from uq.models import make_model
+from uq.space import Parameter, ParameterSpace, resolve_k_H
+
+KINDS = ("interval", "sobol")
+DESIGNS = ("individual", "joint", "residual")
+_KEYS = {
+    "study": {"name", "kind", "model", "seed", "repetitions", "output"},
+    "parameters": None,  # one sub-table per parameter
+    "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation"},
+    "interval": {"designs", "interior", "z", "fix"},
+    "sobol": {"n", "bootstrap", "confidence"},
+}
+_PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
+
+
+@dataclass(frozen=True)
+class Study:
+    """A resolved, validated study (see the module docstring for the file layout)."""
+
+    name: str
+    kind: str
+    model: str
+    space: ParameterSpace
+    levels: tuple[float, ...]
+    repetitions: int
+    seed: int
+    output: Path
+    protocol: Mapping[str, Any] = field(default_factory=dict)
+    designs: tuple[str, ...] = ("individual",)
+    interior: int = 1
+    z: float = 2.0
+    fix: Mapping[str, float] = field(default_factory=dict)
+    sobol_n: int = 64
+    bootstrap: int = 200
+    confidence: float = 0.95
+    source: str = ""
+
+    def make_model(self) -> Any:
+        return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names))
+
+    def to_dict(self) -> dict:
+        """The resolved study as plain data (written to the results' metadata)."""
+        return {
+            "name": self.name, "kind": self.kind, "model": self.model, "seed": self.seed,
+            "repetitions": self.repetitions, "output": str(self.output), "source": self.source,
+            "levels": list(self.levels), "protocol": dict(self.protocol), "parameters": self.space.to_dict(),
+            "interval": {"designs": list(self.designs), "interior": self.interior, "z": self.z, "fix": dict(self.fix)},
+            "sobol": {"n": self.sobol_n, "bootstrap": self.bootstrap, "confidence": self.confidence},
+        }
+
+
+def load_study(path: str | Path) -> Study:
+    """Read and validate a study file; errors are one-line `StudyError`s naming the file."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise StudyError(f"study file {path} not found")
+    except IsADirectoryError:
+        raise StudyError(f"{path} is a folder; give a study .toml file")
+    except tomllib.TOMLDecodeError as exc:
+        raise StudyError(f"{path} is not valid TOML: {exc}")
+    except UnicodeDecodeError:
+        raise StudyError(f"{path} is not a text (TOML) file")
+    try:
+        return parse_study(data, base_dir=path.parent, source=str(path))
+    except StudyError as exc:
+        raise StudyError(f"{path}: {exc}") from None
+
+
+def _number(table: str, key: str, value: Any, *, integer: bool = False, positive: bool = True) -> float:
+    ok = isinstance(value, int) if integer else isinstance(value, (int, float))
+    if isinstance(value, bool) or not ok or not math.isfinite(value):
+        kind = "an integer" if integer else "a number"
+        raise StudyError(f"[{table}] {key} must be {kind}, got {value!r}")
+    if positive and value <= 0:
+        raise StudyError(f"[{table}] {key} must be positive, got {value!r}")
+    return value
+
+
+def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: str = "") -> Study:
+    """Validate the parsed TOML of a study (see `load_study`)."""
+    for table in data:
+        if table not in _KEYS:
+            raise StudyError(f"unknown table [{table}]; known: {', '.join('[' + t + ']' for t in _KEYS)}")
+        if not isinstance(data[table], Mapping):
+            raise StudyError(f"'{table}' must be a table ([{table}])")
+        allowed = _KEYS[table]
+        if allowed is not None:
+            for key in data[table]:
+                if key not in allowed:
+                    raise StudyError(f"unknown key '{key}' in [{table}]; known: {', '.join(sorted(allowed))}")
+    head = data.get("study", {})
+    kind = head.get("kind")
+    if kind not in KINDS:
+        raise StudyError(f"[study] kind must be one of {', '.join(KINDS)}, got {kind!r}")
+    model_spec = head.get("model", "ies")
+    if not isinstance(model_spec, str):
+        raise StudyError(f"[study] model must be a string, got {model_spec!r}")
+    name = str(head.get("name", Path(source).stem if source else kind))
+    seed = int(_number("study", "seed", head.get("seed", 0), integer=True, positive=False))
+    if seed < 0:
+        raise StudyError(f"[study] seed must be >= 0, got {seed}")
+    reps = int(_number("study", "repetitions", head.get("repetitions", 1), integer=True))
+    output = Path(head.get("output", f"results/{name}"))
+
+    space = _parse_parameters(data.get("parameters"), model_spec, base_dir)
+
+    exc = dict(data.get("excitation", {}))
+    levels_raw = exc.pop("levels", [1.0] if model_spec != "ies" else None)
+    if levels_raw is None:
+        raise StudyError("[excitation] levels is missing: give a_base / a_base* values, e.g. levels = [5.3, 6.7, 7.4]")
+    if not isinstance(levels_raw, list) or not levels_raw:
+        raise StudyError(f"[excitation] levels must be a non-empty list of numbers, got {levels_raw!r}")
+    levels = tuple(float(_number("excitation", "levels", v)) for v in levels_raw)
+    if len(set(levels)) != len(levels):
+        raise StudyError("[excitation] levels lists a value twice")
+    protocol = _parse_protocol(exc)
+
+    iv = data.get("interval", {})
+    designs = tuple(iv.get("designs", ["individual"]))
+    for d in designs:
+        if d not in DESIGNS:
+            raise StudyError(f"[interval] unknown design '{d}'; known: {', '.join(DESIGNS)}")
+    interior = int(_number("interval", "interior", iv.get("interior", 1), integer=True, positive=False))
+    if interior < 0:
+        raise StudyError(f"[interval] interior must be >= 0, got {interior}")
+    z = float(_number("interval", "z", iv.get("z", 2.0), positive=False))
+    fix = _parse_fix(iv.get("fix", {"k_H": "best_estimate"} if "k_H" in space.names else {}), space, base_dir)
+    if "residual" in designs and not fix:
+        raise StudyError("[interval] the residual design needs fixed parameters: fix = { k_H = \"best_estimate\" }")
+
+    sb = data.get("sobol", {})
+    sobol_n = int(_number("sobol", "n", sb.get("n", 64), integer=True))
+    if sobol_n < 2 or sobol_n & (sobol_n - 1):
+        raise StudyError(f"[sobol] n = {sobol_n} must be a power of two >= 2 (e.g. 64)")
+    bootstrap = int(_number("sobol", "bootstrap", sb.get("bootstrap", 200), integer=True))
+    confidence = float(_number("sobol", "confidence", sb.get("confidence", 0.95)))
+    if not 0 < confidence < 1:
+        raise StudyError(f"[sobol] confidence must lie in (0, 1), got {confidence}")
+    if kind == "sobol" and not space.varied:
+        raise StudyError("no parameter is varied; give at least one [parameters.NAME] with min < max")
+
+    study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
+                  sobol_n, bootstrap, confidence, source)
+    study.make_model()  # unknown model -> one line now
+    return study
+
+
+def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir: Path) -> ParameterSpace:
+    model = make_model(model_spec, parameters=tuple(table or {}))
+    default = model.default_space()
+    if default is None:  # a user's function: every parameter must be given in full
+        if not table:
+            raise StudyError("a 'module:function' model needs its parameters: [parameters.NAME] with nominal, min, max")
+        params = []
+        for pname, spec in table.items():
+            spec = _check_param_table(pname, spec)
+            missing = {"nominal", "min", "max"} - set(spec)
+            if missing:
+                raise StudyError(f"[parameters.{pname}] needs {', '.join(sorted(missing))}")
+            params.append(Parameter(pname, *(float(_number(f"parameters.{pname}", k, spec[k], positive=False))
+                                             for k in ("nominal", "min", "max")), positive=False))
+        return ParameterSpace(tuple(params))
+    if table is None:
+        return default
+    for pname in table:
+        if pname not in default.names:
+            raise StudyError(f"unknown parameter '{pname}' for model '{model_spec}'; known: {', '.join(default.names)}")
+    extras = dict(default.extras)
+    params = []
+    for p in default.parameters:
+        if p.name not in table:
+            params.append(p.fixed_at(p.nominal))
+            continue
+        spec = _check_param_table(p.name, table[p.name])
+        values = {}
+        for key in ("nominal", "min", "max"):
+            raw = spec.get(key, getattr(p, key))
+            values[key] = resolve_k_H(raw, base_dir=base_dir) if p.name == "k_H" else raw
+        if "best_estimate" in spec:
+            if p.name != "k_H":
+                raise StudyError(f"[parameters.{p.name}] best_estimate is only defined for k_H")
+            extras["k_H_best_estimate"] = resolve_k_H(spec["best_estimate"], base_dir=base_dir)
+            if not extras["k_H_best_estimate"] > 0:
+                raise StudyError("[parameters.k_H] best_estimate must be positive")
+        params.append(Parameter(p.name, values["nominal"], values["min"], values["max"], p.unit, p.label,
+                                p.upper_limit, p.positive))
+    return ParameterSpace(tuple(params), extras)
+
+
+def _check_param_table(name: str, spec: Any) -> Mapping[str, Any]:
+    if not isinstance(spec, Mapping):
+        raise StudyError(f"[parameters.{name}] must be a table with nominal, min, max")
+    for key in spec:
+        if key not in _PARAM_KEYS:
+            raise StudyError(f"unknown key '{key}' in [parameters.{name}]; known: {', '.join(sorted(_PARAM_KEYS))}")
+    return spec
+
+
+def _parse_fix(fix: Any, space: ParameterSpace, base_dir: Path) -> dict[str, float]:
+    if not isinstance(fix, Mapping):
+        raise StudyError(f"[interval] fix must be a table like {{ k_H = \"best_estimate\" }}, got {fix!r}")
+    out = {}
+    for pname, raw in fix.items():
+        if pname not in space.names:
+            raise StudyError(f"[interval] fix: unknown parameter '{pname}'; known: {', '.join(space.names)}")
+        if raw == "best_estimate":
+            if f"{pname}_best_estimate" not in space.extras:
+                raise StudyError(f"[interval] fix: '{pname}' has no best estimate; give a number")
+            value = space.extras[f"{pname}_best_estimate"]
+        elif pname == "k_H":
+            value = resolve_k_H(raw, base_dir=base_dir)
+        else:
+            value = float(_number("interval", f"fix.{pname}", raw, positive=space[pname].positive))
+        out[pname] = float(value)
+    return out
+
+
+def _parse_protocol(exc: Mapping[str, Any]) -> dict[str, Any]:
+    """Protocol settings as given (SteppedSine fills in and validates the rest when the model is built)."""
+    out: dict[str, Any] = {}
+    for key in ("wait", "hold", "perturbation"):
+        if key in exc:
+            out[key] = float(_number("excitation", key, exc[key]))
+    for key in ("sequence", "integrator"):
+        if key in exc:
+            if not isinstance(exc[key], str):
+                raise StudyError(f"[excitation] {key} must be a string, got {exc[key]!r}")
+            out[key] = exc[key]
+    if "eta" in exc:
+        eta = exc["eta"]
+        if isinstance(eta, Mapping):
+            unknown = set(eta) - {"start", "stop", "n"}
+            if unknown or set(eta) != {"start", "stop", "n"}:
+                raise StudyError("[excitation] eta must be { start = ..., stop = ..., n = ... } or a list of values")
+            start, stop = (float(_number("excitation", f"eta.{k}", eta[k])) for k in ("start", "stop"))
+            n = int(_number("excitation", "eta.n", eta["n"], integer=True))
+            if not start < stop or n < 2:
+                raise StudyError(f"[excitation] eta: need start < stop and n >= 2, got {start}, {stop}, {n}")
+            out["eta"] = [start + (stop - start) * i / (n - 1) for i in range(n)]
+        elif isinstance(eta, list) and eta:
+            out["eta"] = [float(_number("excitation", "eta", v)) for v in eta]
+        else:
+            raise StudyError(f"[excitation] eta must be a table or a non-empty list, got {eta!r}")
+    return out
