@@ -1,0 +1,461 @@
+"""Frictionless unilateral contact of a gap map with an elastic half-space (seed paper, Sect. 4.1).
+
+Problem (Signorini conditions, a linear complementarity problem). On a regular grid of square
+elements of side dx, with initial gap h >= 0 (min h = 0: the bodies just touch), rigid approach
+delta and element pressures p, the deformed gap is
+
+    g = h - delta + K p,        p >= 0,  g >= 0,  p * g = 0,
+
+where K is the normal influence operator (Love's rectangle, `bem_contact.influence`). Equivalently
+p minimises 0.5 p.K p + p.(h - delta) over p >= 0, whose gradient is g. Under load control the total
+force sum(p) dx^2 = W is prescribed instead and delta is read off the solution (the mean of h + K p
+over the contact).
+
+Accuracy measures reported with every solution (dimensionless):
+  residual = max_i |min(p_i K_ii, g_i)| / delta  (the natural LCP residual, lengths in units of delta;
+             K_ii p_i is the element's self-displacement),
+  complementarity_error = sum(p |g|) / (sum(p) delta)  (pressure-weighted mean |gap| on the contact).
+
+Only elements with h < delta can touch (K p >= 0 everywhere), so under displacement control every
+solver works on the bounding box of {h < delta}; this is exact, not an approximation.
+
+Solvers, by name (see `SOLVERS`):
+  "pk"        Polonsky & Keer (1999) constrained conjugate gradients on the zero-padded FFT operator;
+              the fast default for any grid, warm-started from x0.
+  "al-jacobi" augmented Lagrangian with Jacobi relaxation on the dense matrix (the paper's method):
+              p <- max(0, p - (omega / K_ii) g), i.e. a multiplier update with per-element penalty.
+  "osqp"      OSQP on the equivalent quadratic program (dense matrix, solution polished).
+  "cvxpy"     cvxpy (Clarabel) on the same quadratic program: a reference for small grids.
+Dense solvers take load control by a safeguarded secant search on delta.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import cached_property, lru_cache
+from typing import Callable
+
+import numpy as np
+
+from bem_contact.errors import ContactInputError, ConvergenceError
+from bem_contact.influence import ConvolutionOperator, love_kernel
+
+
+@dataclass(frozen=True)
+class SolverInfo:
+    """A contact solver: its dense-grid limit (None: any grid), default tolerance and iteration cap."""
+
+    name: str
+    max_nodes: int | None
+    default_tol: float
+    default_maxiter: int
+    description: str
+
+
+SOLVERS: dict[str, SolverInfo] = {
+    "pk": SolverInfo("pk", None, 1e-9, 20000, "Polonsky-Keer constrained CG on the FFT operator (any grid)"),
+    "al-jacobi": SolverInfo("al-jacobi", 64 * 64, 1e-8, 200000, "augmented Lagrangian, Jacobi relaxation (the paper's method; dense)"),
+    "osqp": SolverInfo("osqp", 48 * 48, 1e-8, 200000, "OSQP on the quadratic program (dense)"),
+    "cvxpy": SolverInfo("cvxpy", 32 * 32, 1e-6, 500, "cvxpy / Clarabel on the quadratic program (dense reference)"),
+}
+DEFAULT_SOLVER = "pk"
+
+
+def solver_names() -> list[str]:
+    """Names accepted by `solve_contact` (plus "auto")."""
+    return ["auto", *SOLVERS]
+
+
+@dataclass
+class ContactResult:
+    """Solution of one frictionless contact problem; SI units.
+
+    Attributes:
+        pressure: contact pressure per element (Pa), shape of the gap map.
+        gap: the initial gap used, shifted so that min(gap) = 0 (m).
+        force: total normal force sum(p) dx^2 (N).
+        indentation: rigid approach delta from first touch (m).
+        contact_area: number of loaded elements times dx^2 (m^2).
+        iterations: solver iterations (for load control with a dense solver: summed over the delta search).
+        residual, complementarity_error: accuracy measures (dimensionless; see module docstring).
+        solver: solver name; converged: residual <= tol; tol: the tolerance asked for.
+        dx: grid pitch (m); E_star: contact modulus (Pa).
+    """
+
+    pressure: np.ndarray
+    gap: np.ndarray
+    force: float
+    indentation: float
+    contact_area: float
+    iterations: int
+    residual: float
+    complementarity_error: float
+    solver: str
+    converged: bool
+    tol: float
+    dx: float
+    E_star: float
+    _operator: ConvolutionOperator = field(repr=False, compare=False, default=None)  # type: ignore[assignment]
+
+    @cached_property
+    def displacement(self) -> np.ndarray:
+        """Combined normal surface displacement K p (m), positive where the surfaces are pushed apart."""
+        return self._operator(self.pressure)
+
+    @property
+    def deformed_gap(self) -> np.ndarray:
+        """Gap after loading h - delta + K p (m); >= 0 up to the tolerance, 0 on the contact."""
+        return self.gap - self.indentation + self.displacement
+
+    @property
+    def touches_edge(self) -> bool:
+        """True if any element on the border of the map carries pressure (the map is then too small)."""
+        p = self.pressure
+        return bool((p[0] > 0).any() or (p[-1] > 0).any() or (p[:, 0] > 0).any() or (p[:, -1] > 0).any())
+
+
+# ---------------------------------------------------------------------------------------------
+# shared pieces
+
+
+@lru_cache(maxsize=8)
+def _kernel_table(n: int, m: int, dx: float, E_star: float) -> np.ndarray:
+    table = love_kernel(n, m, dx, E_star)
+    table.setflags(write=False)
+    return table
+
+
+def normal_operator_cached(shape: tuple[int, int], dx: float, E_star: float, workers: int = 1) -> ConvolutionOperator:
+    """Normal operator of a grid, its kernel table cached (a curve reuses it for every indentation)."""
+    return ConvolutionOperator(_kernel_table(int(shape[0]), int(shape[1]), float(dx), float(E_star)), workers)
+
+
+def kkt_measures(p: np.ndarray, g: np.ndarray, self_compliance: float, delta: float) -> tuple[float, float]:
+    """(residual, complementarity_error) of a candidate solution, both dimensionless (module docstring)."""
+    residual = float(np.max(np.abs(np.minimum(p * self_compliance, g)))) / delta
+    total = float(p.sum())
+    complementarity = float(np.sum(p * np.abs(g))) / (total * delta) if total > 0 else 0.0
+    return residual, complementarity
+
+
+def _validate(gap: np.ndarray, dx: float, E_star: float, indentation, force, solver: str, x0) -> tuple[np.ndarray, str]:
+    h = np.asarray(gap, dtype=float)
+    if h.ndim != 2 or h.size == 0:
+        raise ContactInputError(f"gap map must be a non-empty 2-D array (got shape {h.shape}); give h(x, y) on a regular grid")
+    if not np.isfinite(h).all():
+        bad = int((~np.isfinite(h)).sum())
+        raise ContactInputError(f"gap map has {bad} non-finite values (NaN/inf); fill or crop the holes before solving")
+    if not (isinstance(dx, (int, float, np.floating)) and math.isfinite(dx) and dx > 0):
+        raise ContactInputError(f"grid pitch dx = {dx!r} m must be a finite number > 0")
+    if not (isinstance(E_star, (int, float, np.floating)) and math.isfinite(E_star) and E_star > 0):
+        raise ContactInputError(f"contact modulus E* = {E_star!r} Pa must be a finite number > 0 (steel on brass: 75.09e9)")
+    if (indentation is None) == (force is None):
+        raise ContactInputError("give exactly one of indentation= (m) or force= (N)")
+    for name, value, unit in (("indentation", indentation, "m"), ("force", force, "N")):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ContactInputError(f"{name} = {value!r} {unit} must be a finite number > 0")
+    if solver == "auto":
+        solver = DEFAULT_SOLVER
+    if solver not in SOLVERS:
+        raise ContactInputError(f"unknown solver {solver!r}; choose one of {', '.join(solver_names())}")
+    limit = SOLVERS[solver].max_nodes
+    if limit is not None and h.size > limit:
+        raise ContactInputError(
+            f"grid {h.shape[0]}x{h.shape[1]} ({h.size} elements) is too large for the dense solver {solver!r} "
+            f"(at most {limit}); use solver='pk', which handles any grid"
+        )
+    if x0 is not None and np.shape(x0) != h.shape:
+        raise ContactInputError(f"starting pressure x0 has shape {np.shape(x0)}, the gap map {h.shape}; they must match")
+    return h - h.min(), solver
+
+
+def _candidate_box(h: np.ndarray, delta: float) -> tuple[slice, slice]:
+    """Bounding box of the elements that can touch at approach delta (h < delta)."""
+    rows = np.flatnonzero((h < delta).any(axis=1))
+    cols = np.flatnonzero((h < delta).any(axis=0))
+    return slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1)
+
+
+# ---------------------------------------------------------------------------------------------
+# Polonsky & Keer constrained conjugate gradients
+
+
+def polonsky_keer(
+    op: ConvolutionOperator,
+    h: np.ndarray,
+    *,
+    delta: float | None = None,
+    force: float | None = None,
+    area: float,
+    x0: np.ndarray | None,
+    tol: float,
+    maxiter: int,
+) -> tuple[np.ndarray, np.ndarray, float, int, float]:
+    """Polonsky & Keer (1999, Wear 231:206) CG for the contact LCP on operator `op`.
+
+    Displacement control (delta given): projected CG on 0.5 p.K p + p.(h - delta), p >= 0.
+    Load control (force given): the gradient is shifted by its mean over the contact (delta read off)
+    and p is rescaled to the load after each step. Returns (p, u = K p, delta, iterations, residual).
+    """
+    load_control = force is not None
+    kii = op.self_compliance
+    if x0 is not None and np.any(x0 > 0):
+        d = np.maximum(x0, 0.0)
+    elif load_control:
+        d = np.ones_like(h)
+    else:
+        d = np.maximum(delta - h, 0.0)
+    Kd = op(d)
+    if load_control:
+        scale = force / (area * d.sum())
+    else:
+        # exact line search of the energy along d; a useless warm start falls back to the cold one
+        scale = float(np.sum(d * (delta - h))) / float(np.sum(d * Kd))
+        if not scale > 0:
+            d = np.maximum(delta - h, 0.0)
+            Kd = op(d)
+            scale = float(np.sum(d * (delta - h))) / float(np.sum(d * Kd))
+    p = scale * d
+    u = scale * Kd
+    t = np.zeros_like(h)
+    G_old = 1.0
+    restart = True
+    residual = math.inf
+    iterations = 0
+    while True:
+        contact = p > 0
+        if load_control:
+            delta = float(np.mean((h + u)[contact]))
+        g = h + u - delta
+        residual = float(np.max(np.abs(np.minimum(p * kii, g)))) / delta
+        if residual <= tol or iterations >= maxiter:
+            break
+        iterations += 1
+        g_c = np.where(contact, g, 0.0)
+        G = float(np.dot(g_c.ravel(), g_c.ravel()))
+        if restart:
+            t = g_c
+        else:
+            t = g_c + (G / G_old) * np.where(contact, t, 0.0)
+        G_old = G
+        r = op(t)
+        if load_control:
+            r -= np.mean(r[contact])
+        rt = float(np.sum(np.where(contact, r * t, 0.0)))
+        if rt <= 0:  # direction of no curvature: restart from steepest descent
+            restart = True
+            continue
+        tau = float(np.sum(g_c * t)) / rt
+        p -= tau * t
+        np.maximum(p, 0.0, out=p)
+        overlap = (p == 0) & (g < 0)
+        restart = bool(overlap.any())
+        if restart:
+            p[overlap] -= tau * g[overlap]
+        if load_control:
+            p *= force / (area * p.sum())
+        u = op(p)
+    return p, u, float(delta), iterations, residual
+
+
+# ---------------------------------------------------------------------------------------------
+# dense solvers on the candidate elements, in units of delta (lengths) and delta E*/dx (pressures)
+
+
+def _al_jacobi(K: np.ndarray, b: np.ndarray, x0: np.ndarray | None, tol: float, maxiter: int) -> tuple[np.ndarray, int]:
+    """Augmented Lagrangian with Jacobi relaxation: p <- max(0, p - omega g / diag(K)), g = K p + b."""
+    diag = np.diag(K).copy()
+    # relaxation from the largest eigenvalue of D^-1/2 K D^-1/2 (power iteration); omega < 2/lambda_max converges
+    scaled = K / np.sqrt(np.outer(diag, diag))
+    v = np.ones(len(b)) / math.sqrt(len(b))
+    lam = 1.0
+    for _ in range(100):
+        w = scaled @ v
+        lam_new = float(np.linalg.norm(w))
+        v = w / lam_new
+        if abs(lam_new - lam) <= 1e-6 * lam_new:
+            break
+        lam = lam_new
+    step = 1.0 / (lam_new * diag)
+    p = np.maximum(x0, 0.0) if x0 is not None else np.maximum(-b, 0.0) / diag
+    for it in range(1, maxiter + 1):
+        g = K @ p + b
+        p = np.maximum(p - step * g, 0.0)
+        if it % 10 == 0 and np.max(np.abs(np.minimum(p * diag, K @ p + b))) <= tol:
+            return p, it
+    return p, maxiter
+
+
+def _osqp(K: np.ndarray, b: np.ndarray, x0: np.ndarray | None, tol: float, maxiter: int) -> tuple[np.ndarray, int]:
+    """OSQP (Stellato et al. 2020) on min 0.5 p.K p + b.p, p >= 0, with solution polishing."""
+    import osqp
+    import scipy.sparse as sp
+
+    n = len(b)
+    problem = osqp.OSQP()
+    problem.setup(
+        P=sp.triu(sp.csc_matrix(K), format="csc"), q=b, A=sp.identity(n, format="csc"),
+        l=np.zeros(n), u=np.full(n, np.inf), eps_abs=0.1 * tol, eps_rel=0.1 * tol,
+        max_iter=maxiter, polish=True, verbose=False,
+    )
+    if x0 is not None:
+        problem.warm_start(x=np.maximum(x0, 0.0))
+    result = problem.solve()
+    if result.x is None or not np.all(np.isfinite(result.x)):
+        return np.zeros(n), int(result.info.iter)
+    return np.maximum(result.x, 0.0), int(result.info.iter)
+
+
+def _cvxpy(K: np.ndarray, b: np.ndarray, x0: np.ndarray | None, tol: float, maxiter: int) -> tuple[np.ndarray, int]:
+    """cvxpy with Clarabel (interior point) on min 0.5 p.K p + b.p, p >= 0."""
+    import cvxpy as cp
+
+    p = cp.Variable(len(b), nonneg=True)
+    problem = cp.Problem(cp.Minimize(0.5 * cp.quad_form(p, cp.psd_wrap(K)) + b @ p))
+    tight = min(1e-8, 0.01 * tol)
+    try:
+        problem.solve(solver=cp.CLARABEL, max_iter=maxiter, tol_gap_abs=tight, tol_gap_rel=tight, tol_feas=tight)
+    except cp.SolverError:
+        return np.zeros(len(b)), maxiter
+    iterations = int(problem.solver_stats.num_iters or 0)
+    if p.value is None:
+        return np.zeros(len(b)), iterations
+    return np.maximum(np.asarray(p.value, dtype=float), 0.0), iterations
+
+
+_DENSE: dict[str, Callable[..., tuple[np.ndarray, int]]] = {"al-jacobi": _al_jacobi, "osqp": _osqp, "cvxpy": _cvxpy}
+
+
+# ---------------------------------------------------------------------------------------------
+# the entry point
+
+
+def _solve_indentation(h, dx, E_star, delta, solver, tol, x0, maxiter, workers):
+    """Displacement control on the candidate box; returns (p, iterations) on the full grid."""
+    rows, cols = _candidate_box(h, delta)
+    hs = h[rows, cols]
+    op = normal_operator_cached(h.shape, dx, E_star, workers).restricted(*hs.shape)
+    x0s = None if x0 is None else np.asarray(x0, dtype=float)[rows, cols]
+    if solver == "pk":
+        ps, _, _, iterations, _ = polonsky_keer(op, hs, delta=delta, area=dx * dx, x0=x0s, tol=tol, maxiter=maxiter)
+    else:
+        idx = np.flatnonzero(hs.ravel() < delta)
+        unit_p = delta * E_star / dx  # pressures in this unit, lengths in delta: K becomes O(1)
+        K = op.dense()[np.ix_(idx, idx)] * (E_star / dx)
+        b = (hs.ravel()[idx] - delta) / delta
+        start = None if x0s is None else x0s.ravel()[idx] / unit_p
+        solution, iterations = _DENSE[solver](K, b, start, tol, maxiter)
+        ps = np.zeros(hs.size)
+        ps[idx] = solution * unit_p
+        ps = ps.reshape(hs.shape)
+    p = np.zeros_like(h)
+    p[rows, cols] = ps
+    return p, iterations, (rows, cols, op)
+
+
+def _finish(h, dx, E_star, p, delta, iterations, solver, tol, box, workers, maxiter, raise_on_failure):
+    rows, cols, op = box
+    g = h[rows, cols] - delta + op(p[rows, cols])
+    residual, complementarity = kkt_measures(p[rows, cols], g, op.self_compliance, delta)
+    converged = residual <= tol
+    if not converged and raise_on_failure:
+        raise ConvergenceError(
+            f"solver {solver!r} stopped after {iterations} iterations with residual {residual:.3g} > tol {tol:.3g} "
+            f"(maxiter {maxiter}); raise maxiter, loosen tol or use solver='pk'"
+        )
+    return ContactResult(
+        pressure=p, gap=h, force=float(p.sum()) * dx * dx, indentation=float(delta),
+        contact_area=float(np.count_nonzero(p > 0)) * dx * dx, iterations=int(iterations), residual=residual,
+        complementarity_error=complementarity, solver=solver, converged=converged, tol=tol, dx=float(dx),
+        E_star=float(E_star), _operator=normal_operator_cached(h.shape, dx, E_star, workers),
+    )
+
+
+def solve_contact(
+    gap: np.ndarray,
+    dx: float,
+    E_star: float,
+    *,
+    indentation: float | None = None,
+    force: float | None = None,
+    solver: str = "auto",
+    tol: float | None = None,
+    x0: np.ndarray | None = None,
+    maxiter: int | None = None,
+    raise_on_failure: bool = True,
+    workers: int = 1,
+) -> ContactResult:
+    """Frictionless contact of a gap map pressed onto an elastic half-space (Sect. 4.1; Signorini LCP).
+
+    Args:
+        gap: initial separation h(x, y) (m) on a regular grid (axis 0 = x). It is shifted so that
+            min(gap) = 0: the indentation is the rigid approach from first touch (for a crater the
+            first touch may be on its rim, not at its bottom).
+        dx: grid pitch (m), square elements.
+        E_star: contact modulus (Pa), `contact_modulus(a, b)`.
+        indentation: prescribed rigid approach delta (m), or
+        force: prescribed total normal force (N); delta is then read off the solution.
+        solver: "auto" (= "pk"), "pk", "al-jacobi", "osqp" or "cvxpy" (`SOLVERS`).
+        tol: relative LCP residual to reach (default: the solver's `default_tol`).
+        x0: starting pressure (Pa), e.g. the solution at a smaller indentation.
+        maxiter: iteration cap (default: the solver's).
+        raise_on_failure: if True (default) a solve that misses tol raises ConvergenceError;
+            if False the result is returned with converged=False.
+        workers: threads for the FFTs.
+
+    Returns:
+        ContactResult with pressure (Pa), force (N), indentation (m), area (m^2) and accuracy measures.
+    """
+    h, solver = _validate(gap, dx, E_star, indentation, force, solver, x0)
+    info = SOLVERS[solver]
+    tol = info.default_tol if tol is None else float(tol)
+    maxiter = info.default_maxiter if maxiter is None else int(maxiter)
+    if not (tol > 0):
+        raise ContactInputError(f"tol = {tol!r} must be > 0")
+
+    if indentation is not None:
+        p, iterations, box = _solve_indentation(h, dx, E_star, float(indentation), solver, tol, x0, maxiter, workers)
+        return _finish(h, dx, E_star, p, float(indentation), iterations, solver, tol, box, workers, maxiter, raise_on_failure)
+
+    if solver == "pk":
+        op = normal_operator_cached(h.shape, dx, E_star, workers)
+        p, _, delta, iterations, _ = polonsky_keer(
+            op, h, force=float(force), area=dx * dx, x0=None if x0 is None else np.asarray(x0, float), tol=tol, maxiter=maxiter
+        )
+        box = (slice(None), slice(None), op)
+        return _finish(h, dx, E_star, p, delta, iterations, solver, tol, box, workers, maxiter, raise_on_failure)
+    return _solve_force_by_search(h, dx, E_star, float(force), solver, tol, x0, maxiter, workers, raise_on_failure)
+
+
+def _solve_force_by_search(h, dx, E_star, W, solver, tol, x0, maxiter, workers, raise_on_failure) -> ContactResult:
+    """Load control for the dense solvers: find delta with F(delta) = W (F increasing, locally ~ delta^1.5)."""
+    # first guess from below: ignoring the elements' interaction, p_i = (delta - h_i) / K_ii over-estimates
+    # the force at any delta, so its root under-estimates the indentation (and keeps the first solves small)
+    kii = love_kernel(1, 1, dx, E_star)[0, 0]
+    levels = np.sort(h.ravel())
+    cumulative = np.cumsum(levels)
+    counts = np.arange(1, levels.size + 1)
+    # on [levels[k], levels[k+1]] the estimate is (counts[k] delta - cumulative[k]) dx^2 / K_ii
+    k = int(np.searchsorted((counts * levels - cumulative) * dx * dx / kii, W)) - 1
+    delta = (W * kii / (dx * dx) + cumulative[k]) / counts[k]
+    low, high = 0.0, math.inf
+    total = 0
+    for _ in range(60):
+        p, iterations, box = _solve_indentation(h, dx, E_star, delta, solver, tol, x0, maxiter, workers)
+        total += iterations
+        F = float(p.sum()) * dx * dx
+        if abs(F / W - 1.0) <= tol:
+            break
+        if F < W:
+            low = max(low, delta)
+        else:
+            high = min(high, delta)
+        x0 = p
+        proposal = delta * (W / F) ** (2.0 / 3.0) if F > 0 else 2.0 * delta
+        if not (low < proposal < high):
+            proposal = math.sqrt(low * high) if math.isfinite(high) and low > 0 else 0.5 * (low + high) if math.isfinite(high) else 2.0 * delta
+        delta = proposal
+    else:
+        if raise_on_failure:
+            raise ConvergenceError(f"solver {solver!r}: the search for the indentation at force {W:g} N did not converge; use solver='pk'")
+    return _finish(h, dx, E_star, p, delta, total, solver, tol, box, workers, maxiter, raise_on_failure)
