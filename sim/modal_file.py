@@ -1,0 +1,136 @@
+"""Modal-model files: bring the modes of the host structure from any FE tool (seed paper Eq. 7).
+
+Format (TOML, UTF-8). Arrays have one value per retained mode, in ascending frequency order:
+
+    format = "ies-modal-model"       # optional, but if present it must be this
+    version = 1                      # optional, 1
+    source = "CalculiX job beam.inp" # optional free text
+    frequencies_hz = [117.4, 886.0]  # natural frequencies f_j = omega_j / (2 pi), Hz, strictly ascending
+    damping_ratios = [0.00085, 0.0044]  # modal damping ratios D_j, in (0, 1) (0.001 = 0.1 %)
+    phi_wall_left  = [1.376, 1.390]  # mass-normalised x-value of mode j at the left cavity wall, 1/sqrt(kg)
+    phi_wall_right = [1.376, 1.390]  # same at the right cavity wall, 1/sqrt(kg)
+    phi_tip        = [1.324, 1.194]  # same at the measurement point (response output), 1/sqrt(kg)
+    participation  = [1.106, -0.553] # phi_j^T M b, b = unit x-translation of the base, sqrt(kg)
+
+    [units]                          # optional; if present each entry must name the unit above
+    frequencies_hz = "Hz"
+    damping_ratios = "1"
+    phi = "1/sqrt(kg)"
+    participation = "sqrt(kg)"
+
+Signs follow sim/system.py: the wall directions w_l, w_r are both +x, so phi_wall_* are the x-components of
+the mass-normalised modes (phi_j^T M phi_j = 1 kg^0). A mode's overall sign is free, but phi_wall_*, phi_tip
+and participation of that mode must use the same sign.
+"""
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from sim.errors import SimulationInputError
+from sim.system import ModalModel
+
+FORMAT_NAME = "ies-modal-model"
+FORMAT_VERSION = 1
+ARRAY_KEYS = ("frequencies_hz", "damping_ratios", "phi_wall_left", "phi_wall_right", "phi_tip", "participation")
+UNITS = {"frequencies_hz": "Hz", "damping_ratios": "1", "phi": "1/sqrt(kg)", "participation": "sqrt(kg)"}
+
+_HEADER = """\
+# ies modal model of the host structure without the sphere (seed paper Eq. 7); format described in
+# sim/modal_file.py. One value per mode, ascending frequency. Mode values are mass-normalised x-values
+# (1/sqrt(kg)) at the left/right cavity walls and the measurement point; participation = phi^T M b (sqrt(kg)).
+"""
+
+
+def _numbers(path: Path, key: str, value: object) -> np.ndarray:
+    if not isinstance(value, list) or not value:
+        raise SimulationInputError(f"{path}: '{key}' must be a non-empty array of numbers, e.g. {key} = [117.4, 886.0]")
+    for item in value:
+        if isinstance(item, bool) or not isinstance(item, (int, float)):
+            raise SimulationInputError(f"{path}: '{key}' contains the non-numeric value {item!r}; give plain numbers")
+        if not math.isfinite(item):
+            raise SimulationInputError(f"{path}: '{key}' contains {item!r}; every value must be finite")
+    return np.array(value, dtype=float)
+
+
+def load_modal_model(path: str | os.PathLike) -> ModalModel:
+    """Read a modal-model file (format in this module's docstring) into a ModalModel.
+
+    Raises SimulationInputError with one line naming the file and the problem for a missing or unreadable
+    file, invalid TOML, a missing key, a non-numeric entry, arrays of different lengths, frequencies that are
+    not positive and strictly ascending, or damping ratios outside (0, 1).
+    """
+    path = Path(path)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise SimulationInputError(f"modal file {path} not found; give the path of a .toml modal-model file") from None
+    except IsADirectoryError:
+        raise SimulationInputError(f"{path} is a folder, not a modal-model file") from None
+    except UnicodeDecodeError:
+        raise SimulationInputError(f"{path}: not a text (UTF-8 TOML) file") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SimulationInputError(f"{path}: not valid TOML ({exc})") from None
+    if "format" in data and data["format"] != FORMAT_NAME:
+        raise SimulationInputError(f"{path}: format is {data['format']!r}, expected {FORMAT_NAME!r}")
+    if "version" in data and data["version"] != FORMAT_VERSION:
+        raise SimulationInputError(f"{path}: version {data['version']!r} is not supported; this reader knows version {FORMAT_VERSION}")
+    missing = [key for key in ARRAY_KEYS if key not in data]
+    if missing:
+        raise SimulationInputError(f"{path}: missing key(s) {', '.join(missing)}; a modal file needs {', '.join(ARRAY_KEYS)}")
+    units = data.get("units", {})
+    if not isinstance(units, dict):
+        raise SimulationInputError(f"{path}: 'units' must be a table, e.g. [units] frequencies_hz = \"Hz\"")
+    for key, unit in units.items():
+        if key in UNITS and unit != UNITS[key]:
+            raise SimulationInputError(f"{path}: units.{key} is {unit!r} but must be {UNITS[key]!r}; convert the values")
+    arrays = {key: _numbers(path, key, data[key]) for key in ARRAY_KEYS}
+    lengths = {key: a.size for key, a in arrays.items()}
+    n = lengths["frequencies_hz"]
+    wrong = [f"{key} has {size}" for key, size in lengths.items() if size != n]
+    if wrong:
+        raise SimulationInputError(f"{path}: arrays must all have {n} values (one per mode) but {'; '.join(wrong)}")
+    source = data.get("source", str(path))
+    try:
+        return ModalModel(**arrays, source=str(source))
+    except SimulationInputError as exc:
+        raise SimulationInputError(f"{path}: {exc}") from None
+
+
+def modal_model_document(model: ModalModel) -> dict:
+    """The file content of a model as plain data (what save_modal_model writes)."""
+    doc: dict = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "source": model.source}
+    for key in ARRAY_KEYS:
+        doc[key] = [float(v) for v in getattr(model, key)]
+    doc["units"] = dict(UNITS)
+    return doc
+
+
+def save_modal_model(model: ModalModel, path: str | os.PathLike) -> Path:
+    """Write `model` as a modal-model file, atomically (a temporary file renamed onto `path`)."""
+    import tomli_w
+
+    target = Path(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    if not folder.is_dir():
+        raise SimulationInputError(f"cannot write {target}: folder {folder} does not exist; create it or choose another path")
+    if target.is_dir():
+        raise SimulationInputError(f"cannot write {target}: it is a folder; give a file name such as modes.toml")
+    text = _HEADER + tomli_w.dumps(modal_model_document(model))
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=".toml", dir=folder)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        os.replace(tmp, target)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return target
