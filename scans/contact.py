@@ -1,0 +1,160 @@
+"""The gap map between the sphere and a scanned wall, ready for the BEM (Sect. 4.1, Fig. 3c).
+
+gap(x, y) = sphere(x, y) - h(x, y), shifted so that min(gap) = 0, where h is the levelled wall height
+(crater negative, rim positive; see `scans.surface`) and sphere is the IES surface seen from the wall:
+
+* ideal sphere (the paper's Fig. 3c): R - sqrt(R^2 - r^2), the exact spherical cap;
+* flattened sphere: the same with its cap of height `flattening` cut off, max(R - sqrt(R^2 - r^2), f).
+  The paper measured 15.80 mm across the flattened regions for a 15.84 mm sphere: 0.02 mm per side.
+
+Where the sphere sits (the paper does not say; the IES moves along the wall normal only, so it hits
+the crater where it made it):
+* "centroid" (default): above the crater's depth-weighted centroid, sum(-h x) / sum(-h) over the
+  connected depression below the noise threshold. Robust to noise and to the scanner's meshing.
+* "deepest": above the deepest point of the (lightly smoothed) scan.
+For a flat wall (no depression above the noise) both are the centre of the scanned area.
+
+The BEM grid is centred there, with the node convention of `bem_contact` (element centres at
+(i - n // 2) dx, axis 0 = x). Its side is chosen so that it holds every point that could touch at the
+largest indentation: the elastic displacement K p is >= 0 everywhere, so the contact at indentation
+delta lies inside {gap <= delta}; the side is that region's diameter times a safety margin.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.ndimage as ndi
+
+from scans.errors import ScanError
+from scans.raster import HoleReport
+from scans.surface import LevelledSurface
+
+#: the IES radius (Sect. 4.1: nominal diameter 15.84 mm)
+PAPER_RADIUS = 7.92e-3
+#: the largest indentation of the paper's simulations (Sect. 4.1, Fig. 3c)
+PAPER_DELTA_MAX = 40e-6
+#: the sphere's flattening per side (Sect. 4.1: 15.84 mm -> 15.80 mm across the flattened regions)
+PAPER_FLATTENING = 0.02e-3
+#: nominal clearance (Sect. 4.1: (17 - 15.84) / 2 mm)
+PAPER_CLEARANCE = 0.58e-3
+PLACEMENTS = ("centroid", "deepest")
+
+
+@dataclass(frozen=True)
+class Sphere:
+    """The IES surface facing the wall: radius R (m) and the height (m) of the cap cut off by flattening."""
+
+    R: float = PAPER_RADIUS
+    flattening: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.R) and self.R > 0):
+            raise ScanError(f"sphere radius {self.R!r} m must be a finite number > 0 (the IES: 7.92e-3)")
+        if not (math.isfinite(self.flattening) and 0 <= self.flattening < self.R):
+            raise ScanError(f"flattening {self.flattening!r} m must be >= 0 and smaller than the radius (paper: 2e-5)")
+
+    def surface(self, r2: np.ndarray) -> np.ndarray:
+        """Height (m) of the sphere's surface above its lowest point at squared distance r2 (m^2) from the axis."""
+        r2 = np.asarray(r2, float)
+        inside = r2 < self.R**2
+        cap = np.where(inside, r2 / (self.R + np.sqrt(np.where(inside, self.R**2 - r2, 0.0))), np.inf)
+        return np.maximum(cap, self.flattening) - self.flattening
+
+    @property
+    def flat_radius(self) -> float:
+        """Radius (m) of the flat disc left by the flattening."""
+        f = self.flattening
+        return math.sqrt(f * (2 * self.R - f))
+
+    def describe(self) -> str:
+        """Which geometry was used, for the output."""
+        if self.flattening == 0:
+            return f"ideal sphere, R = {self.R * 1e3:.4g} mm"
+        return (f"flattened sphere, R = {self.R * 1e3:.4g} mm with a cap of {self.flattening * 1e3:.4g} mm cut off "
+                f"(flat disc {2 * self.flat_radius * 1e3:.3g} mm across)")
+
+
+@dataclass(frozen=True)
+class ScanContact:
+    """A scanned wall and a sphere placed above it: builds the BEM gap map at any grid size.
+
+    centre: sphere axis in the levelled frame (m); placement: how it was chosen; side: BEM domain side
+    (m); reach: radius (m) of {gap <= delta_max} around the centre, the largest possible contact.
+    """
+
+    surface: LevelledSurface
+    sphere: Sphere
+    centre: tuple[float, float]
+    placement: str
+    side: float
+    reach: float
+    delta_max: float
+    holes: dict[int, HoleReport] = field(default_factory=dict, compare=False)
+
+    def gap_at(self, n: int) -> tuple[np.ndarray, float]:
+        """Initial gap (m, min 0) on the n x n grid of side `self.side`, and the pitch dx (m).
+
+        The signature `calibrate_k_H` expects; the hole report for each n is kept in `self.holes`.
+        """
+        height, dx, holes = self.surface.resample(self.centre, self.side, n)
+        self.holes[n] = holes
+        offsets = (np.arange(n) - n // 2) * dx
+        gap = self.sphere.surface(offsets[:, None] ** 2 + offsets[None, :] ** 2) - height
+        return gap - gap.min(), dx
+
+    def height_at(self, n: int) -> tuple[np.ndarray, float]:
+        """Levelled wall height (m) on the same grid as `gap_at(n)`, for pictures."""
+        height, dx, _ = self.surface.resample(self.centre, self.side, n)
+        return height, dx
+
+
+def scan_contact(
+    surface: LevelledSurface,
+    sphere: Sphere = Sphere(),
+    *,
+    placement: str = "centroid",
+    delta_max: float = PAPER_DELTA_MAX,
+    side: float | None = None,
+    margin: float = 1.15,
+) -> ScanContact:
+    """Place the sphere above the crater and size the BEM domain (see the module docstring).
+
+    side: BEM domain side (m); None chooses margin x the diameter of {gap <= delta_max}. Raises
+    ScanError if that region reaches the edge of the scan (the crater is larger than the scanned area)
+    or does not fit in the given side.
+    """
+    if placement not in PLACEMENTS:
+        raise ScanError(f"unknown sphere placement {placement!r}; use one of {', '.join(PLACEMENTS)}")
+    if not (math.isfinite(delta_max) and delta_max > 0):
+        raise ScanError(f"largest indentation {delta_max!r} m must be > 0 (paper: 40e-6)")
+    centre = surface.centre if placement == "centroid" else surface.deepest
+    overview, pitch = surface.overview, surface.pitch
+    valid = np.isfinite(overview)
+    yy, xx = np.mgrid[0 : overview.shape[0], 0 : overview.shape[1]]
+    dx_c, dy_c = surface.x0 + xx * pitch - centre[0], surface.y0 + yy * pitch - centre[1]
+    gap = np.where(valid, sphere.surface(dx_c**2 + dy_c**2) - np.where(valid, overview, 0.0), np.inf)
+    j, i = np.unravel_index(np.argmin(gap), gap.shape)
+    touching = gap - gap[j, i] <= delta_max
+    labels, _ = ndi.label(touching)
+    region = labels == labels[j, i]
+    reach = float(np.hypot(dx_c[region], dy_c[region]).max() + pitch)
+    edge = ndi.binary_dilation(region) & ~valid
+    on_border = region[0].any() or region[-1].any() or region[:, 0].any() or region[:, -1].any()
+    if edge.any() or on_border:
+        raise ScanError(
+            f"{surface.source}: at {delta_max * 1e6:.3g} um indentation the sphere could touch up to the edge of the "
+            f"scanned area (crater larger than the scan); scan a larger area around the crater"
+        )
+    needed = 2.0 * reach
+    if side is None:
+        side = margin * needed
+    elif not (math.isfinite(side) and side > 0):
+        raise ScanError(f"grid side {side!r} m must be a finite number > 0")
+    elif side < needed:
+        raise ScanError(
+            f"the grid side {side * 1e3:.3g} mm is smaller than the region the sphere can touch at "
+            f"{delta_max * 1e6:.3g} um indentation ({needed * 1e3:.3g} mm across); use a larger side or the automatic one"
+        )
+    return ScanContact(surface, sphere, centre, placement, float(side), reach, float(delta_max))

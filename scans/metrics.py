@@ -1,0 +1,94 @@
+"""Crater metrics and the clearance interval they imply (Sect. 4.1, Table 2).
+
+Definitions (heights from the levelled flat wall, `scans.surface`):
+
+* depth: how far the crater's bottom lies below the flat wall. The bottom is located on the lightly
+  smoothed overview map, then a quadratic surface is fitted by least squares to the scan points within
+  `max(4 triangle sizes, 0.1 x crater radius)` of it and its minimum is taken, so that scanner noise
+  does not deepen the crater (the minimum of noisy points would be biased by about -3 sigma).
+* rim_height: highest point of the pile-up around the crater (smoothed over one triangle size).
+* diameter: diameter of the circle with the same area as the connected depression around the bottom,
+  where the smoothed wall lies below the noise threshold.
+* clearance interval (Sect. 4.1): [nominal, nominal + depth + flattening]; the paper's
+  0.58 mm + 0.012 mm + 0.02 mm = 0.612 mm. The pile-up rim is ignored, as in the paper.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.ndimage as ndi
+
+from scans.errors import ScanError
+from scans.surface import FLAT_MARGIN, LevelledSurface, _smooth
+
+
+@dataclass(frozen=True)
+class CraterMetrics:
+    """Measured crater (all in m): depth below the flat wall (0 for a flat wall), rim height above it,
+    diameter of the depression, centre of the depression, robust noise of the flat wall, and warnings."""
+
+    depth: float
+    rim_height: float
+    diameter: float
+    centre: tuple[float, float]
+    noise: float
+    warnings: list[str] = field(default_factory=list)
+
+
+def crater_metrics(surface: LevelledSurface) -> CraterMetrics:
+    """Depth, rim height and diameter of the crater of a levelled scan (see the module docstring)."""
+    overview, pitch = surface.overview, surface.pitch
+    valid = np.isfinite(overview)
+    smooth = _smooth(overview, valid, 1.0)
+    yy, xx = np.mgrid[0 : overview.shape[0], 0 : overview.shape[1]]
+    xs, ys = surface.x0 + xx * pitch, surface.y0 + yy * pitch
+    warnings: list[str] = []
+    if not surface.has_crater:
+        rim = float(np.nanmax(smooth))
+        return CraterMetrics(0.0, max(rim, 0.0), 0.0, surface.centre, surface.noise,
+                             ["no crater deeper than the noise threshold: treated as a flat wall"])
+    near = valid & (np.hypot(xs - surface.centre[0], ys - surface.centre[1]) <= FLAT_MARGIN * surface.feature_radius)
+    rim = float(np.max(smooth[near], initial=0.0))
+    depth = _bottom_depth(surface)
+    depression = valid & (smooth < -surface.threshold)
+    labels, _ = ndi.label(depression)
+    j = int(round((surface.deepest[1] - surface.y0) / pitch))
+    i = int(round((surface.deepest[0] - surface.x0) / pitch))
+    area = float((labels == labels[j, i]).sum()) * pitch**2 if labels[j, i] else 0.0
+    diameter = 2.0 * math.sqrt(area / math.pi)
+    if rim > depth:
+        warnings.append(
+            f"the pile-up ({rim * 1e6:.3g} um) stands higher than the crater is deep ({depth * 1e6:.3g} um): "
+            "if this scan is an imprint (a resin cast of the crater), use --imprint"
+        )
+    return CraterMetrics(depth, rim, diameter, surface.centre, surface.noise, warnings)
+
+
+def _bottom_depth(surface: LevelledSurface) -> float:
+    """Minimum of a quadratic surface fitted to the scan points around the deepest point (m, positive)."""
+    bx, by = surface.deepest
+    radius = max(4.0 * surface.pitch, 0.1 * surface.feature_radius)
+    x, y, h = (surface.points[:, k] for k in range(3))
+    near = np.hypot(x - bx, y - by) <= radius
+    if near.sum() >= 12:
+        u, v = (x[near] - bx) / radius, (y[near] - by) / radius
+        design = np.column_stack([np.ones_like(u), u, v, u * u, u * v, v * v])
+        c = np.linalg.lstsq(design, h[near], rcond=None)[0]
+        hessian = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
+        if np.all(np.linalg.eigvalsh(hessian) > 0):
+            uv = np.linalg.solve(hessian, -c[1:3])
+            if np.hypot(*uv) <= 1.0:
+                return float(-(c[0] + c[1] * uv[0] + c[2] * uv[1] + c[3] * uv[0] ** 2 + c[4] * uv[0] * uv[1] + c[5] * uv[1] ** 2))
+    # too few points, or no bowl at this scale: the lowest point of the smoothed map
+    valid = np.isfinite(surface.overview)
+    return float(-np.nanmin(_smooth(surface.overview, valid, 1.0)))
+
+
+def clearance_bounds(depth: float, flattening: float, nominal: float) -> tuple[float, float]:
+    """Clearance interval (m) of Sect. 4.1: [nominal, nominal + crater depth + sphere flattening]."""
+    for name, value in (("crater depth", depth), ("flattening", flattening), ("nominal clearance", nominal)):
+        if not (math.isfinite(value) and value >= 0):
+            raise ScanError(f"{name} {value!r} m must be a finite number >= 0")
+    return nominal, nominal + depth + flattening
