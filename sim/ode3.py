@@ -125,9 +125,9 @@ def _advance(y, n_periods, N, h, Omega, a_base, omega, D, phi_l, phi_r, phi_tip,
     for j in range(n):
         dl += phi_l[j] * y[j]
         dr += phi_r[j] * y[j]
-    closed_l = dl > 0.0
-    closed_r = dr < 0.0
-    check_overlap = k_H > 0.0
+    has_contact = k_H > 0.0  # k_H = 0: the host structure alone, no contacts to count
+    closed_l = dl > 0.0 and has_contact
+    closed_r = dr < 0.0 and has_contact
     for p in range(n_periods):
         q = 0.0
         for j in range(n):
@@ -160,15 +160,15 @@ def _advance(y, n_periods, N, h, Omega, a_base, omega, D, phi_l, phi_r, phi_tip,
                 im -= q * sin0[kk]
             else:
                 re += 0.5 * q
-            now_l = dl > 0.0
-            now_r = dr < 0.0
+            now_l = dl > 0.0 and has_contact
+            now_r = dr < 0.0 and has_contact
             if now_l and not closed_l:
                 onsets += 1
             if now_r and not closed_r:
                 onsets += 1
             closed_l = now_l
             closed_r = now_r
-            if check_overlap and (dl > g or -dr > g):
+            if has_contact and (dl > g or -dr > g):
                 return _OVERLAP, p * N + k
             if recording and kk % rec_stride == 0:
                 record[p * rows_per_period + kk // rec_stride, :] = y

@@ -81,8 +81,8 @@ def run(args: argparse.Namespace) -> int:
 
     started = time.perf_counter()
     levels = parse_levels(args.levels)
-    model, impactor = build_system(args)
     protocol = build_protocol(args)
+    model, impactor = build_system(args)
     folder = output_folder(args.out)
     results = []
     for level in tqdm(levels, desc="overview", unit="level", disable=None, leave=False):

@@ -65,8 +65,10 @@ def build_system(args: argparse.Namespace):
     from sim.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor
 
     if args.model:
-        from sim.modal_file import load_modal_model
-
+        try:
+            from sim.modal_file import load_modal_model
+        except ImportError as exc:
+            raise SimulationInputError("modal-model files are not supported in this installation (sim.modal_file missing)") from exc
         model = load_modal_model(args.model)
     else:
         try:
@@ -157,8 +159,8 @@ def run(args: argparse.Namespace) -> int:
 
     started = time.perf_counter()
     level = check_level(args.level)
-    model, impactor = build_system(args)
     protocol = build_protocol(args)
+    model, impactor = build_system(args)
     folder = output_folder(args.out)
     result = sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed)
     data = result.to_dict()
