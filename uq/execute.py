@@ -61,28 +61,20 @@ def _tasks(points: Sequence[dict], study: Study) -> list[Task]:
     return [Task.make(p, level, rep) for p in points for level in study.levels for rep in range(study.repetitions)]
 
 
-def _rep_matrix(results: dict, points: Sequence[dict], study: Study, output: str) -> np.ndarray:
-    """Outputs as an array (n_points, n_levels, n_reps); failed runs are NaN."""
-    arr = np.full((len(points), len(study.levels), study.repetitions), np.nan)
+def statistics(model: Any, results: dict, points: Sequence[dict], study: Study) -> dict[str, tuple[np.ndarray, ...]]:
+    """Per output: (value, standard error, samples), arrays (n_points, n_levels), from the model's own
+    aggregation over the repetitions of each point and level; failed runs are left out (NaN if all)."""
+    outputs = list(model.outputs)
+    shape = (len(points), len(study.levels))
+    stats = {o: (np.full(shape, np.nan), np.full(shape, np.nan), np.zeros(shape, dtype=int)) for o in outputs}
     for i, p in enumerate(points):
         for j, level in enumerate(study.levels):
-            for r in range(study.repetitions):
-                rec = results[Task.make(p, level, r)]
-                if not rec["error"]:
-                    arr[i, j, r] = rec["outputs"].get(output, np.nan)
-    return arr
-
-
-def rep_statistics(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Mean, standard error of the mean and count of finite runs over the last axis."""
-    finite = np.isfinite(values)
-    n = finite.sum(axis=-1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean = np.where(n > 0, np.nansum(values, axis=-1) / np.maximum(n, 1), np.nan)
-        dev = np.where(finite, values - mean[..., None], 0.0)
-        sd = np.sqrt((dev**2).sum(axis=-1) / (n - 1))
-        se = np.where(n >= 2, sd / np.sqrt(n), 0.0)
-    return mean, se, n
+            records = [results[Task.make(p, level, r)] for r in range(study.repetitions)]
+            agg = model.aggregate([rec for rec in records if not rec["error"]])
+            for o in outputs:
+                for k in range(3):
+                    stats[o][k][i, j] = agg[o][k]
+    return stats
 
 
 def _runs_rows(results: dict, points: Sequence[dict], study: Study, outputs: Sequence[str], names: Sequence[str]):
@@ -141,12 +133,12 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     points = list(unique.values())
     index = {key: i for i, key in enumerate(unique)}
     t0 = time.perf_counter()
-    results = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
+    results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
                         scheduler=scheduler, progress=progress, client=client)
     elapsed = time.perf_counter() - t0
     names, outputs = study.space.names, list(model.banded_outputs)
     level_labels = [f"level {lv:g}" for lv in study.levels]
-    stats = {o: rep_statistics(_rep_matrix(results, points, study, o)) for o in outputs}
+    stats = statistics(model, results, points, study)
     n_failed = sum(1 for rec in results.values() if rec["error"])
     if n_failed:
         _warn(result, f"{n_failed} of {len(results)} runs failed (see the 'error' column of runs.csv)")
@@ -155,13 +147,13 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     bands: dict[tuple[str, str], Band] = {}
     for d in [Design("nominal", "box", (nominal,))] + designs:
         rows_idx = [index[p.key()] for p in d.points]
-        for o in outputs:
+        for o in model.outputs:
             mean, se, n = (a[rows_idx] for a in stats[o])
             for p, i in zip(d.points, range(len(rows_idx))):
                 for j, level in enumerate(study.levels):
                     point_rows.append([d.name, p.label, p.role, *(p.values[k] for k in names), level, o,
                                        mean[i, j], se[i, j], int(n[i, j])])
-            if d.name == "nominal":
+            if d.name == "nominal" or o not in outputs:
                 continue
             bd = _band_with_failures(d, mean, se, study.z, level_labels)
             bands[(d.name, o)] = bd
@@ -173,13 +165,13 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     result.files.append(_write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
                                    _runs_rows(results, points, study, model.outputs, names)))
     result.files.append(_write_csv(folder / "points.csv", ["design", "point", "role", *names, "level", "output",
-                                                           "mean", "se", "n_runs"], point_rows))
+                                                           "mean", "se", "n_samples"], point_rows))
     result.files.append(_write_csv(folder / "bands.csv", ["design", "output", "level", "lower", "upper",
                                                           "corner_lower", "corner_upper", "flagged", "violation"],
                                    band_rows))
     monotone = {f"{d}/{o}": bd.monotone for (d, o), bd in bands.items()}
-    result.summary = {"tasks": len(results), "failed_runs": n_failed, "wall_time_s": elapsed, "monotone": monotone,
-                      "points": len(points)}
+    result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
+                      "wall_time_s": elapsed, "monotone": monotone, "points": len(points)}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
     return result
 
@@ -221,16 +213,21 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     X = sobol_sample(study.space, n, seed=study.seed)
     points = [study.space.from_values(x) for x in X]
     t0 = time.perf_counter()
-    results = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
+    results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
                         scheduler=scheduler, progress=progress, client=client)
     elapsed = time.perf_counter() - t0
     names, outputs = study.space.names, list(model.banded_outputs)
     rows, summary_rows, per_level = [], [], {}
+    stats = statistics(model, results, points, study)
+    n_failed = sum(1 for rec in results.values() if rec["error"])
+    if n_failed:
+        _warn(result, f"{n_failed} of {len(results)} runs failed (see the 'error' column of runs.csv); points "
+                      "with some finite runs use those")
     for o in outputs:
-        Y = _rep_matrix(results, points, study, o)
+        value, se, _ = stats[o]
         for j, level in enumerate(study.levels):
-            res = sobol_indices(study.space, X, Y[:, j, :], num_resamples=study.bootstrap,
-                                confidence=study.confidence, seed=study.seed)
+            res = sobol_indices(study.space, X, value[:, j], num_resamples=study.bootstrap,
+                                confidence=study.confidence, seed=study.seed, noise=se[:, j] ** 2)
             for note in res.notes:
                 _warn(result, f"{o} at level {level:g}: {note}")
             if res.message:
@@ -246,7 +243,8 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                                                           "ST_conf"], rows))
     result.files.append(_write_csv(folder / "variance.csv", ["output", "level", "variance", "noise_variance",
                                                              "noise_share", "failed_runs", "message"], summary_rows))
-    result.summary = {"tasks": len(results), "base_sample": n, "points": len(points), "wall_time_s": elapsed,
-                      "per_level": per_level}
+    result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
+                      "base_sample": n, "points": len(points),
+                      "wall_time_s": elapsed, "per_level": per_level}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
     return result

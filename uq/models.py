@@ -9,7 +9,10 @@ A model maps (parameter values, excitation level, repetition) to named scalar ou
 * ``"ishigami"``: the Ishigami-Homma function of x1, x2, x3 (output ``value``), a reference for the
   Sobol' layer that runs through the whole study machinery.
 * ``"package.module:function"``: ``function(params: dict, level: float, rep: int, seed: int)``
-  returning a float (output ``value``) or a dict of floats, e.g. a surrogate of the response.
+  returning a float (output ``value``), e.g. a surrogate of the response.
+
+Each model also aggregates the runs of one (point, level) over the repetitions: ``aggregate(records)``
+-> {output: (value, standard error, samples)}; the simulator does it exactly as `ies sweep` does.
 
 Models are small picklable objects: they travel to joblib and Dask workers, and their ``version()``
 (a hash of the code that computes the outputs) is part of every cached task's key.
@@ -77,24 +80,57 @@ class IESModel:
     def _stepped_sine(self):
         from sim.protocol import SteppedSine
 
+        from sim.errors import SimulationInputError
+
         try:
             return SteppedSine(**dict(self.protocol))
-        except TypeError as exc:
-            raise StudyError(f"[excitation]: {exc}; see `ies sweep --help` for the protocol settings")
+        except (TypeError, SimulationInputError) as exc:
+            raise StudyError(f"[excitation]: {exc}") from None
 
     def check(self) -> None:
         """Build the protocol and the rig model once so that bad settings fail before any task runs."""
         self._stepped_sine()
         _rig_model(self.n_modes)
 
-    def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, float]:
-        from sim.protocol import run_sweep
+    def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, Any]:
+        """One run: its own resonant levels (outputs) and the per-point measures (trace) for aggregation."""
+        from sim.protocol import aggregate_runs, run_sweep
         from sim.system import Impactor
 
         model = _rig_model(self.n_modes).with_damping(params["D"])
         impactor = Impactor(clearance=params["g"], k_H=params["k_H"])
         run = run_sweep(model, impactor, level, self._stepped_sine(), seed=seed, rep=rep)
-        return _run_outputs(run)
+        own = aggregate_runs([run])
+        trace = {key: getattr(run, key).tolist() for key in _TRACE}
+        trace.update(level=run.level, a_base=run.a_base, a_noabs=run.a_noabs, seed=run.seed, rep=run.rep)
+        return {"mean": own.resonant_mean, "max": own.resonant_max, "apr": 1.0 if own.regime == "APR" else 0.0,
+                "trace": trace}
+
+    def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, tuple[float, float, int]]:
+        """Resonant levels over the repetitions of one (point, level), exactly as `sim.protocol.aggregate_runs`
+        (largest repetition-averaged mean / max over eta, Sect. 5.2-5.3), with the standard error from the
+        spread of the repetition samples: {output: (value, standard error, number of samples)}."""
+        import numpy as np
+        from sim.protocol import SweepRun, aggregate_runs
+
+        protocol = self._stepped_sine()
+        runs = []
+        for rec in records:
+            t = rec["trace"]
+            arrays = {key: np.asarray(t[key], dtype=int if key in ("leg", "hold_periods") else float) for key in _TRACE}
+            runs.append(SweepRun(**arrays, level=t["level"], a_base=t["a_base"], a_noabs=t["a_noabs"], seed=t["seed"],
+                                 rep=t["rep"], protocol=protocol, impactor=None))
+        if not runs:
+            return {name: (float("nan"), float("nan"), 0) for name in self.outputs}
+        res = aggregate_runs(runs)
+        n = int(res.n_samples)
+        se = lambda samples: float(np.std(samples, ddof=1) / np.sqrt(n)) if n >= 2 else 0.0  # noqa: E731
+        return {"mean": (res.resonant_mean, se(res.resonant_mean_samples), n),
+                "max": (res.resonant_max, se(res.resonant_max_samples), n),
+                "apr": (1.0 if res.regime == "APR" else 0.0, 0.0, n)}
+
+
+_TRACE = ("eta", "eta_actual", "leg", "mean", "max", "min", "std", "impacts_per_period", "hold_periods")
 
 
 def _protocol_dict(protocol: Any) -> dict:
@@ -102,21 +138,19 @@ def _protocol_dict(protocol: Any) -> dict:
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in out.items()}
 
 
-def _run_outputs(run: Any) -> dict[str, float]:
-    """Resonant levels of one run: the largest per-frequency mean and max amplitude (a / a_noabs*)."""
+def mean_over_repetitions(outputs: tuple[str, ...], records: list[Mapping[str, Any]]) -> dict[str, tuple[float, float, int]]:
+    """Plain repetition statistics of scalar outputs: {output: (mean, standard error, count)}."""
     import numpy as np
 
-    mean = np.asarray(run.mean, dtype=float)
-    maxi = np.asarray(run.max, dtype=float)
-    i = int(np.nanargmax(mean)) if np.isfinite(mean).any() else 0
-    regime = getattr(run, "regime", None)
-    apr = float("nan")
-    if regime is not None:
-        label = regime[i] if not isinstance(regime, str) else regime
-        apr = 1.0 if str(label).lower() in ("apr", "almost periodic", "almost-periodic") else 0.0
-    return {"mean": float(np.nanmax(mean)) if np.isfinite(mean).any() else float("nan"),
-            "max": float(np.nanmax(maxi)) if np.isfinite(maxi).any() else float("nan"),
-            "apr": apr}
+    out = {}
+    for name in outputs:
+        values = np.array([rec["outputs"].get(name, np.nan) for rec in records], dtype=float)
+        values = values[np.isfinite(values)]
+        n = values.size
+        mean = float(values.mean()) if n else float("nan")
+        se = float(values.std(ddof=1) / np.sqrt(n)) if n >= 2 else 0.0
+        out[name] = (mean, se, n)
+    return out
 
 
 @functools.lru_cache(maxsize=4)
@@ -146,6 +180,9 @@ class IshigamiModel:
 
     def check(self) -> None:
         return None
+
+    def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, tuple[float, float, int]]:
+        return mean_over_repetitions(self.outputs, records)
 
     def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, float]:
         x1, x2, x3 = (params[n] for n in self.parameters)
@@ -184,11 +221,11 @@ class FunctionModel:
     def check(self) -> None:
         self._function()
 
+    def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, tuple[float, float, int]]:
+        return mean_over_repetitions(self.outputs, records)
+
     def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, float]:
-        value = self._function()(dict(params), level, rep, seed)
-        if isinstance(value, Mapping):
-            return {str(k): float(v) for k, v in value.items()}
-        return {"value": float(value)}
+        return {"value": float(self._function()(dict(params), level, rep, seed))}
 
 
 def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, parameters: tuple[str, ...] = ()) -> Any:

@@ -98,15 +98,19 @@ def evaluate(model: Callable, task: Task, seed: int) -> dict:
 
     start = time.perf_counter()
     try:
-        outputs = model(dict(task.params), task.level, task.rep, seed)
+        outputs = dict(model(dict(task.params), task.level, task.rep, seed))
+        trace = outputs.pop("trace", None)
         error = ""
         bad = [k for k, v in outputs.items() if not math.isfinite(v) and k in getattr(model, "banded_outputs", ())]
         if bad:
             error = f"non-finite output(s) {', '.join(bad)}"
     except (SimulationDiverged, FloatingPointError, ZeroDivisionError) as exc:
-        outputs = {name: float("nan") for name in getattr(model, "outputs", ())}
+        outputs, trace = {name: float("nan") for name in getattr(model, "outputs", ())}, None
         error = f"{type(exc).__name__}: {exc}"
-    return {"outputs": outputs, "error": error, "seconds": time.perf_counter() - start}
+    record = {"outputs": outputs, "error": error, "seconds": time.perf_counter() - start}
+    if trace is not None:
+        record["trace"] = trace
+    return record
 
 
 def _run_one(model: Callable, key: str, task: Task, seed: int) -> tuple[str, dict]:
@@ -127,8 +131,8 @@ def _connect(address: str):
 
 
 def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultStore, *, jobs: int = 1,
-              scheduler: str | None = None, progress: bool = True, client: Any = None) -> dict[Task, dict]:
-    """Run every task whose result is not in `store` and return all results by task.
+              scheduler: str | None = None, progress: bool = True, client: Any = None) -> tuple[dict[Task, dict], int]:
+    """Run every task whose result is not in `store`; return all results by task and how many ran now.
 
     jobs: local worker processes (joblib/loky; 1 = in this process). scheduler: a Dask scheduler
     address, used through joblib's Dask backend (`client` may be passed instead, e.g. in tests).
@@ -154,7 +158,7 @@ def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultSt
             bar.update(1)
     finally:
         bar.close()
-    return {task: store.load(key) for task, key in keys.items()}
+    return {task: store.load(key) for task, key in keys.items()}, len(pending)
 
 
 def _dispatch(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int, scheduler: str | None,

@@ -79,10 +79,12 @@ def check_runs(Y: np.ndarray, X: np.ndarray | None = None, names: list[str] | No
 
 
 def sobol_indices(space: ParameterSpace, X: np.ndarray, Y: np.ndarray, *, num_resamples: int = 200,
-                  confidence: float = 0.95, seed: int = 0) -> SobolResult:
+                  confidence: float = 0.95, seed: int = 0, noise: np.ndarray | None = None) -> SobolResult:
     """S1 and ST of Y (n_points, or n_points x n_reps) at the sample X of `sobol_sample`.
 
-    Repetitions are averaged; the noise estimate needs >= 2 finite repetitions per point (else 0).
+    Repetitions (columns) are averaged; the noise estimate needs >= 2 finite repetitions per point.
+    Alternatively Y is already a repetition statistic (1-D) and `noise` gives the variance of each
+    value due to the repetition scatter (e.g. the squared standard error).
     """
     from SALib.analyze import sobol as sobol_analyzer
 
@@ -93,6 +95,10 @@ def sobol_indices(space: ParameterSpace, X: np.ndarray, Y: np.ndarray, *, num_re
     if Y.shape[0] != X.shape[0] or Y.shape[0] % (k + 2):
         raise StudyError(f"{Y.shape[0]} outputs do not match the Sobol' sample of {X.shape[0]} points "
                          f"({k} parameters need a multiple of {k + 2})")
+    if noise is not None:
+        noise = np.asarray(noise, dtype=float)
+        if Y.shape[1] != 1 or noise.shape != (Y.shape[0],):
+            raise StudyError("noise must give one variance per point of a 1-D output")
     finite, notes, fatal = check_runs(Y, X, problem["names"])
     nan = np.full(k, np.nan)
     if fatal:
@@ -106,8 +112,11 @@ def sobol_indices(space: ParameterSpace, X: np.ndarray, Y: np.ndarray, *, num_re
         dev2 = np.where(finite, (Y - ybar[:, None]) ** 2, 0.0).sum(axis=1)
         s2 = dev2 / (counts - 1)
     usable = counts >= 2
-    noise_variance = float(np.mean(s2[usable] / counts[usable])) if usable.any() else 0.0
-    if not usable.all() and usable.any():
+    if noise is not None:
+        noise_variance = float(np.mean(noise[np.isfinite(noise)])) if np.isfinite(noise).any() else 0.0
+    else:
+        noise_variance = float(np.mean(s2[usable] / counts[usable])) if usable.any() else 0.0
+    if noise is None and not usable.all() and usable.any():
         notes.append(f"noise estimated from {int(usable.sum())} of {usable.size} points with >= 2 finite runs")
     if variance <= 0:
         return SobolResult(problem["names"], nan, nan, nan, nan, variance, noise_variance, np.nan,

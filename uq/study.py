@@ -20,7 +20,8 @@ Layout (every table and key is optional except where noted; SI units)::
 
     [excitation]                 # passed to the stepped-sine protocol (sim.protocol.SteppedSine)
     levels = [5.3, 6.7, 7.4]     # a_base / a_base* (Sect. 5.3; nominal D*, g*)
-    eta = { start = 0.95, stop = 1.01, n = 25 }   # or an explicit list of Omega / omega_1*
+    eta = { start = 0.95, stop = 1.01, n = 25 }   # Omega / omega_1*
+    repetition = "leg"           # "leg" or "run": what counts as one repetition sample (sim.protocol)
     wait = 3.0                   # s
     hold = 5.0                   # s
     sequence = "up-down-up"
@@ -57,7 +58,7 @@ DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
     "study": {"name", "kind", "model", "seed", "repetitions", "output"},
     "parameters": None,  # one sub-table per parameter
-    "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation"},
+    "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "repetition"},
     "interval": {"designs", "interior", "z", "fix"},
     "sobol": {"n", "bootstrap", "confidence"},
 }
@@ -274,24 +275,17 @@ def _parse_protocol(exc: Mapping[str, Any]) -> dict[str, Any]:
     for key in ("wait", "hold", "perturbation"):
         if key in exc:
             out[key] = float(_number("excitation", key, exc[key]))
-    for key in ("sequence", "integrator"):
+    for key in ("sequence", "integrator", "repetition"):
         if key in exc:
             if not isinstance(exc[key], str):
                 raise StudyError(f"[excitation] {key} must be a string, got {exc[key]!r}")
             out[key] = exc[key]
     if "eta" in exc:
         eta = exc["eta"]
-        if isinstance(eta, Mapping):
-            unknown = set(eta) - {"start", "stop", "n"}
-            if unknown or set(eta) != {"start", "stop", "n"}:
-                raise StudyError("[excitation] eta must be { start = ..., stop = ..., n = ... } or a list of values")
-            start, stop = (float(_number("excitation", f"eta.{k}", eta[k])) for k in ("start", "stop"))
-            n = int(_number("excitation", "eta.n", eta["n"], integer=True))
-            if not start < stop or n < 2:
-                raise StudyError(f"[excitation] eta: need start < stop and n >= 2, got {start}, {stop}, {n}")
-            out["eta"] = [start + (stop - start) * i / (n - 1) for i in range(n)]
-        elif isinstance(eta, list) and eta:
-            out["eta"] = [float(_number("excitation", "eta", v)) for v in eta]
-        else:
-            raise StudyError(f"[excitation] eta must be a table or a non-empty list, got {eta!r}")
+        if not isinstance(eta, Mapping) or set(eta) != {"start", "stop", "n"}:
+            raise StudyError("[excitation] eta must be a table { start = 0.96, stop = 1.02, n = 31 } (Omega / omega_1)")
+        out["eta_start"], out["eta_stop"] = (float(_number("excitation", f"eta.{k}", eta[k])) for k in ("start", "stop"))
+        out["n_eta"] = int(_number("excitation", "eta.n", eta["n"], integer=True))
+        if out["n_eta"] > 1 and not out["eta_start"] < out["eta_stop"]:
+            raise StudyError(f"[excitation] eta: start {out['eta_start']} must be below stop {out['eta_stop']}")
     return out

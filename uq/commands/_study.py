@@ -24,6 +24,7 @@ def report(result, figures: list[Path]) -> None:
     for path in [*result.files, *figures]:
         print(f"  {path.name}")
     s = result.summary
-    print(f"{s['tasks']} runs, {s.get('failed_runs', 0)} failed, {s['wall_time_s']:.1f} s")
+    print(f"{s['tasks']} runs ({s['ran']} run now, {s['reused']} reused), {s['failed_runs']} failed, "
+          f"{s['wall_time_s']:.1f} s")
     if result.warnings:
         print(f"{len(result.warnings)} warning(s), listed in study.json", file=sys.stderr)

@@ -1,0 +1,119 @@
+"""Study files and parameter spaces: Table 2 defaults, k_H sources, one-line errors for bad input."""
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from uq.cli import main
+from uq.errors import StudyError
+from uq.space import K_H_STAR, calibrated_k_H, resolve_k_H, table2_space
+from uq.study import load_study
+
+MINIMAL = """
+[study]
+kind = "interval"
+[excitation]
+levels = [6.7]
+"""
+
+
+def write(tmp_path, text, name="study.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_table2_defaults_and_salib_problem():
+    space = table2_space()
+    assert space["D"].min == 0.00075 and space["D"].max == 0.00090 and space["D"].nominal == 0.00085
+    assert space["g"].max == pytest.approx(0.612e-3)
+    # 282e3 N/mm^1.5 = 282e3 * 1000^1.5 N/m^1.5; the upper bound is +52 % (428e3)
+    assert space["k_H"].nominal == pytest.approx(282e3 * 1e3**1.5)
+    assert space["k_H"].max / space["k_H"].nominal == pytest.approx(428 / 282)
+    assert space.extras["k_H_best_estimate"] == pytest.approx(1.25 * K_H_STAR)
+    problem = space.salib_problem()
+    assert problem["names"] == ["D", "g", "k_H"] and problem["num_vars"] == 3
+    assert problem["bounds"][1] == [0.58e-3, 0.612e-3]
+
+
+def test_k_H_from_ratio_and_calibration(tmp_path):
+    assert resolve_k_H("1.52 k_H*") == pytest.approx(1.52 * K_H_STAR)
+    calib = tmp_path / "calib.json"
+    calib.write_text(json.dumps({"k_H": 1.4e10, "k_H_star": K_H_STAR}))
+    assert calibrated_k_H(calib) == 1.4e10
+    study = load_study(write(tmp_path, MINIMAL + '[parameters.k_H]\nmax = "calibrated:calib.json"\n'))
+    assert study.space["k_H"].max == 1.4e10
+    assert not study.space["D"].varied  # unlisted parameters stay nominal
+
+
+def test_resolved_study_lists_every_setting(tmp_path):
+    study = load_study(write(tmp_path, MINIMAL + "eta = { start = 0.95, stop = 1.0, n = 11 }\nsequence = 'up-down-up'\n"))
+    d = study.to_dict()
+    assert d["levels"] == [6.7] and d["interval"]["fix"]["k_H"] == pytest.approx(1.25 * K_H_STAR)
+    resolved = study.make_model().resolved_protocol()  # every protocol default filled in
+    assert resolved["eta_start"] == 0.95 and resolved["n_eta"] == 11 and resolved["sequence"] == "up-down-up"
+    assert {"wait", "hold", "perturbation", "integrator"} <= set(resolved)
+
+
+@pytest.mark.parametrize("extra, message", [
+    ("[study]\nkind = 'interval'\nbogus = 1\n[excitation]\nlevels=[1.0]\n", "unknown key 'bogus' in [study]"),
+    (MINIMAL + "[parameters.E]\nmin = 1.0\n", "unknown parameter 'E'"),
+    (MINIMAL + "[parameters.g]\nmin = 0.7e-3\nmax = 0.6e-3\n", "min = 0.0007 is larger than max"),
+    (MINIMAL + "[parameters.k_H]\nmin = -1.0\n", "must be a positive number"),
+    (MINIMAL + "[parameters.D]\nmax = 1.5\n", "must be below 1"),
+    (MINIMAL + "[parameters.g]\nnominal = 0.7e-3\n", "outside [min, max]"),
+    (MINIMAL + "[sobol]\nn = 100\n", "power of two"),
+    (MINIMAL + "[extras]\n", "unknown table [extras]"),
+    ("[study]\nkind = 'grid'\n", "kind must be one of"),
+    (MINIMAL + "[interval]\ndesigns = ['diagonal']\n", "unknown design 'diagonal'"),
+    (MINIMAL.replace("levels = [6.7]", "levels = [0.0]"), "levels must be positive"),
+    ("[study]\nkind = 'interval'\nmodel = 'nosuchmodule:f'\n[parameters.a]\nnominal=1\nmin=0\nmax=2\n", "cannot be imported"),
+    ("[study\nkind=", "not valid TOML"),
+])
+def test_bad_study_is_one_line_exit_2(tmp_path, capsys, extra, message):
+    path = write(tmp_path, extra)
+    out = tmp_path / "out"
+    code = main(["interval", str(path), "--out", str(out), "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert message in err, err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert err.startswith("ies interval: error: ")
+    assert not out.exists()  # nothing written
+
+
+def test_missing_study_file(tmp_path, capsys):
+    assert main(["sobol", str(tmp_path / "none.toml")]) == 2
+    assert "not found" in capsys.readouterr().err
+
+
+def test_unwritable_output_folder(tmp_path, capsys):
+    path = write(tmp_path, "[study]\nkind = 'interval'\nmodel = 'ishigami'\n")
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    assert main(["interval", str(path), "--out", str(blocker / "sub"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "cannot write to output folder" in err and len(err.strip().splitlines()) == 1
+    if os.geteuid() != 0:  # root can write anywhere
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o500)
+        assert main(["interval", str(path), "--out", str(locked / "x"), "--quiet"]) == 2
+
+
+def test_existing_results_are_not_overwritten_without_resume(tmp_path, capsys):
+    path = write(tmp_path, "[study]\nkind = 'interval'\nmodel = 'ishigami'\n")
+    out = tmp_path / "out"
+    assert main(["interval", str(path), "--out", str(out), "--quiet", "--no-figures"]) == 0
+    before = sorted((out / "tasks").iterdir())
+    capsys.readouterr()
+    assert main(["interval", str(path), "--out", str(out), "--quiet"]) == 2
+    assert "--resume" in capsys.readouterr().err
+    assert sorted((out / "tasks").iterdir()) == before
+
+
+def test_wrong_kind_for_command(tmp_path, capsys):
+    path = write(tmp_path, "[study]\nkind = 'sobol'\nmodel = 'ishigami'\n")
+    assert main(["interval", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert "run it with `ies sobol`" in capsys.readouterr().err
