@@ -7,29 +7,35 @@ Pipeline (one function per step, data in between)::
     metrics = crater_metrics(surface)                   # depth, rim height, diameter
     contact = scan_contact(surface, Sphere(R=7.92e-3))  # sphere above the crater, BEM domain side
     gap, dx = contact.gap_at(128)                       # gap map for bem_contact (calibrate_k_H)
-"""
-from scans.contact import (
-    PAPER_CLEARANCE,
-    PAPER_DELTA_MAX,
-    PAPER_FLATTENING,
-    PAPER_RADIUS,
-    PLACEMENTS,
-    ScanContact,
-    Sphere,
-    scan_contact,
-)
-from scans.errors import ScanError
-from scans.examples import EXAMPLES, example_path, example_scan, write_examples
-from scans.io import SUPPORTED, UNITS, Scan, check_units, read_scan, write_scan
-from scans.metrics import CraterMetrics, clearance_bounds, crater_metrics
-from scans.raster import HoleReport, fill_holes, rasterize
-from scans.surface import LevelledSurface, level_scan
-from scans.synthetic import FLAT_WALL, PAPER_CRATER, CraterShape, synthetic_scan
 
-__all__ = [
-    "CraterMetrics", "CraterShape", "EXAMPLES", "FLAT_WALL", "HoleReport", "LevelledSurface", "PAPER_CLEARANCE",
-    "PAPER_CRATER", "PAPER_DELTA_MAX", "PAPER_FLATTENING", "PAPER_RADIUS", "PLACEMENTS", "SUPPORTED", "Scan",
-    "ScanContact", "ScanError", "Sphere", "UNITS", "check_units", "clearance_bounds", "crater_metrics",
-    "example_path", "example_scan", "fill_holes", "level_scan", "rasterize", "read_scan", "scan_contact",
-    "synthetic_scan", "write_examples", "write_scan",
-]
+Names are imported lazily so that `import scans.errors` (done by the `ies` entry point) stays cheap.
+"""
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+from scans.errors import ScanError
+
+_WHERE = {
+    "scans.contact": ["PAPER_CLEARANCE", "PAPER_DELTA_MAX", "PAPER_FLATTENING", "PAPER_RADIUS", "PLACEMENTS",
+                      "ScanContact", "Sphere", "scan_contact"],
+    "scans.examples": ["EXAMPLES", "example_path", "example_scan", "write_examples"],
+    "scans.io": ["SUPPORTED", "UNITS", "Scan", "check_units", "read_scan", "write_scan"],
+    "scans.metrics": ["CraterMetrics", "clearance_bounds", "crater_metrics"],
+    "scans.raster": ["HoleReport", "fill_holes", "rasterize"],
+    "scans.surface": ["LevelledSurface", "level_scan"],
+    "scans.synthetic": ["FLAT_WALL", "PAPER_CRATER", "CraterShape", "synthetic_scan"],
+}
+_MODULE_OF = {name: module for module, names in _WHERE.items() for name in names}
+__all__ = ["ScanError", *sorted(_MODULE_OF)]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _MODULE_OF:
+        return getattr(importlib.import_module(_MODULE_OF[name]), name)
+    raise AttributeError(f"module 'scans' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return __all__
