@@ -1,0 +1,110 @@
+"""The stepped-sine protocol (Sect. 5.1): validation, whole periods, reproducible random streams,
+legs vs repetitions, aggregation."""
+import math
+
+import numpy as np
+import pytest
+
+from sim.errors import SimulationInputError
+from sim.protocol import SteppedSine, aggregate_runs, run_sweep, sweep
+from sim.system import Impactor
+
+# short holds keep these tests fast; physics of the hold lengths is tested elsewhere
+FAST = dict(eta_start=0.98, eta_stop=1.0, n_eta=3, wait=0.02, hold=0.03)
+
+
+@pytest.mark.parametrize("bad, message", [
+    (dict(n_eta=0), "empty"),
+    (dict(eta_start=1.02, eta_stop=0.96), "empty or reversed"),
+    (dict(eta_start=1.0, eta_stop=1.0, n_eta=5), "empty or reversed"),
+    (dict(eta_start=-1.0), "positive"),
+    (dict(sequence="sideways"), "unknown sequence"),
+    (dict(hold=0.0), "hold must be positive"),
+    (dict(wait=-1.0), "wait"),
+    (dict(repetition="both"), "repetition"),
+    (dict(perturbation=0.5), "perturbation"),
+    (dict(wait=float("nan")), "finite"),
+])
+def test_invalid_protocols_are_refused(bad, message):
+    with pytest.raises(SimulationInputError, match=message):
+        SteppedSine(**(FAST | bad))
+
+
+def test_hold_shorter_than_one_period_is_refused(three_mode_model):
+    protocol = SteppedSine(**(FAST | dict(hold=0.005)))  # T = 8.7 ms at eta = 0.98
+    with pytest.raises(SimulationInputError, match="shorter than one excitation period"):
+        run_sweep(three_mode_model, Impactor(), 5.0, protocol, seed=0, rep=0)
+
+
+@pytest.mark.parametrize("level", [0.0, -1.0, float("inf")])
+def test_level_must_be_positive(three_mode_model, level):
+    with pytest.raises(SimulationInputError, match="level"):
+        run_sweep(three_mode_model, Impactor(), level, SteppedSine(**FAST), seed=0, rep=0)
+
+
+def test_wait_and_hold_are_whole_periods():
+    protocol = SteppedSine(wait=3.0, hold=5.0)
+    Omega = 2 * math.pi * 117.4
+    assert protocol.periods(Omega) == (352, 587)  # Sect. 5.1: 352 and 587 nominal periods
+
+
+def test_run_is_reproducible_from_seed_and_rep_in_any_order(three_mode_model):
+    protocol = SteppedSine(**(FAST | dict(sequence="up-down-up")))
+    b1 = run_sweep(three_mode_model, Impactor(), 6.0, protocol, seed=7, rep=1)
+    a = run_sweep(three_mode_model, Impactor(), 6.0, protocol, seed=7, rep=0)
+    b2 = run_sweep(three_mode_model, Impactor(), 6.0, protocol, seed=7, rep=1)
+    for key in ("eta_actual", "mean", "max", "std", "impacts_per_period"):
+        np.testing.assert_array_equal(getattr(b1, key), getattr(b2, key))
+    assert not np.array_equal(a.eta_actual, b1.eta_actual)
+    # the documented law: eta' = eta (1 + U(-p, p)) drawn from default_rng([seed, rep]) in execution order
+    rng = np.random.default_rng([7, 1])
+    offsets = np.concatenate([rng.uniform(-5e-4, 5e-4, 3) for _ in range(3)])
+    np.testing.assert_allclose(b1.eta_actual, b1.eta * (1 + offsets), rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(b1.eta, [0.98, 0.99, 1.0, 1.0, 0.99, 0.98, 0.98, 0.99, 1.0])
+    np.testing.assert_array_equal(b1.leg, [0, 0, 0, 1, 1, 1, 2, 2, 2])
+
+
+def test_legs_as_repetitions_or_pooled_per_run(three_mode_model):
+    legs = SteppedSine(**(FAST | dict(sequence="up-down-up", repetition="leg")))
+    pooled = SteppedSine(**(FAST | dict(sequence="up-down-up", repetition="run")))
+    run_l = run_sweep(three_mode_model, Impactor(), 6.0, legs, seed=3, rep=0)
+    run_p = run_sweep(three_mode_model, Impactor(), 6.0, pooled, seed=3, rep=0)
+    np.testing.assert_array_equal(run_l.mean, run_p.mean)  # same stream, same simulation
+    by_leg = aggregate_runs([run_l])
+    by_run = aggregate_runs([run_p])
+    assert by_leg.n_samples == 3 and by_run.n_samples == 1
+    # equal holds: the pooled mean is the average of the legs' means; the pooled max is the largest max
+    np.testing.assert_allclose(by_run.mean, by_leg.mean, rtol=1e-12)
+    np.testing.assert_allclose(by_run.max, by_leg.max_hi, rtol=1e-12)
+    assert np.all(by_leg.mean_lo <= by_leg.mean) and np.all(by_leg.mean <= by_leg.mean_hi)
+
+
+def test_sweep_equals_aggregate_of_single_runs(three_mode_model):
+    protocol = SteppedSine(**FAST)
+    result = sweep(three_mode_model, Impactor(), 6.0, protocol, reps=2, seed=11)
+    runs = [run_sweep(three_mode_model, Impactor(), 6.0, protocol, seed=11, rep=r) for r in range(2)]
+    manual = aggregate_runs(runs[::-1])  # order of the runs does not matter
+    np.testing.assert_allclose(result.mean, manual.mean, rtol=1e-14)
+    np.testing.assert_allclose(result.max, manual.max, rtol=1e-14)
+    assert result.resonant_mean == pytest.approx(manual.resonant_mean, rel=1e-14)
+    assert result.resonant_mean == pytest.approx(result.mean.max())
+    assert result.resonant_max == pytest.approx(result.max.max())
+    assert result.regime == result.regime_per_eta[int(np.argmax(result.mean))]
+    data = result.to_dict()
+    for key in ("eta", "mean", "max", "resonant_mean", "resonant_max", "regime", "impacts_per_period", "wall_time_s"):
+        assert key in data
+
+
+def test_aggregate_refuses_mixed_levels(three_mode_model):
+    protocol = SteppedSine(**FAST)
+    runs = [run_sweep(three_mode_model, Impactor(), level, protocol, seed=0, rep=0) for level in (5.0, 6.0)]
+    with pytest.raises(SimulationInputError, match="share"):
+        aggregate_runs(runs)
+    with pytest.raises(SimulationInputError, match="no runs"):
+        aggregate_runs([])
+
+
+def test_unknown_integrator_is_one_line(three_mode_model):
+    protocol = SteppedSine(**(FAST | dict(integrator="euler")))
+    with pytest.raises(SimulationInputError, match="unknown integrator 'euler'; available"):
+        run_sweep(three_mode_model, Impactor(), 6.0, protocol, seed=0, rep=0)
