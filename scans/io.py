@@ -15,6 +15,7 @@ from __future__ import annotations
 import io
 import os
 import tempfile
+import warnings
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,7 +33,8 @@ SUPPORTED = sorted(set(MESH_SUFFIXES) | POINT_SUFFIXES | ARRAY_SUFFIXES)
 
 #: lateral size (m) of a plausible scanned patch of a cavity wall: from 0.1 mm to 1 m
 PLAUSIBLE_EXTENT = (1e-4, 1.0)
-_TYPICAL_EXTENT = 1e-2  # a 10 mm patch: the unit suggestion aims here
+_TYPICAL_EXTENT = (0.5e-3, 50e-3)  # a crater patch: 0.5 mm to 50 mm
+_PREFERENCE = ("mm", "m", "um", "in", "cm")
 
 
 @dataclass(frozen=True)
@@ -73,8 +75,8 @@ def check_units(raw_extent: float, units: str, source: str = "scan") -> None:
     lo, hi = PLAUSIBLE_EXTENT
     if lo <= extent <= hi:
         return
-    fits = [u for u, s in UNITS.items() if lo <= raw_extent * s <= hi]
-    best = min(fits, key=lambda u: abs(np.log(raw_extent * UNITS[u] / _TYPICAL_EXTENT)), default=None)
+    # suggest the first unit, in the order scanners use them, that makes it a typical crater patch
+    best = next((u for u in _PREFERENCE if _TYPICAL_EXTENT[0] <= raw_extent * UNITS[u] <= _TYPICAL_EXTENT[1]), None)
     hint = f"the file looks like it is in {best}: use --units {best}" if best else "check the file"
     raise ScanError(
         f"{source}: size {raw_extent:.4g} {units} is implausible for a scanned wall patch "
@@ -121,7 +123,9 @@ def _read_mesh(path: Path, file_type: str) -> tuple[np.ndarray, np.ndarray | Non
     import trimesh
 
     try:
-        loaded = trimesh.load(str(path), file_type=file_type, process=True)
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")  # corrupt numbers are caught below, not warned about
+            loaded = trimesh.load(str(path), file_type=file_type, process=True)
     except Exception as exc:  # trimesh raises many kinds on corrupt files
         raise ScanError(f"{path.name}: cannot read as {file_type.upper()} ({_short(exc)}); the file is corrupt or truncated") from None
     if isinstance(loaded, trimesh.Scene):
