@@ -27,16 +27,17 @@ def parse_levels(text: str) -> list[float]:
     from sim.protocol import check_level
     from uq.commands.sweep import parse_grid
 
-    try:
-        if ":" in text:
-            start, stop, n = parse_grid(text, "--levels")
-            if n < 1 or (n > 1 and stop <= start):
-                raise SimulationInputError(f"--levels {text!r} is empty or reversed; give START < STOP and N >= 1")
-            values = list(np.linspace(start, stop, n))
-        else:
+    if ":" in text:
+        start, stop, n = parse_grid(text, "--levels")
+        if n < 1 or (n > 1 and stop <= start):
+            raise SimulationInputError(f"--levels {text!r} is empty or reversed; give START < STOP and N >= 1")
+        values = list(np.linspace(start, stop, n))
+    else:
+        try:
             values = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise SimulationInputError(f"--levels must be numbers like 1.26,5.3,6.7 or a grid START:STOP:N, got {text!r}") from None
+        except ValueError:
+            raise SimulationInputError(
+                f"--levels must be numbers like 1.26,5.3,6.7 or a grid START:STOP:N, got {text!r}") from None
     if not values:
         raise SimulationInputError("--levels is empty; give at least one excitation level")
     return [check_level(v) for v in values]

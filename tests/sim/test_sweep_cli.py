@@ -1,0 +1,104 @@
+"""`ies sweep` and `ies overview`: JSON keys, atomic output, and bad input as one line without traceback."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from sim.modal_file import save_modal_model
+from uq.cli import main
+
+FAST = ["--eta", "0.98:1.0:3", "--wait", "0.02", "--hold", "0.03", "--reps", "2"]
+
+
+@pytest.fixture
+def model_file(tmp_path, three_mode_model):
+    return str(save_modal_model(three_mode_model, tmp_path / "three.toml"))
+
+
+def test_sweep_json_out_and_plot(tmp_path, model_file, capsys):
+    out = tmp_path / "result"
+    plot = tmp_path / "fig5.png"
+    code = main(["sweep", "--level", "6", *FAST, "--model", model_file, "--json", "--out", str(out), "--plot", str(plot)])
+    assert code == 0
+    data = json.loads(capsys.readouterr().out)
+    for key in ("eta", "mean", "max", "resonant_mean", "resonant_max", "regime", "impacts_per_period", "wall_time_s",
+                "mean_lo", "mean_hi", "max_lo", "max_hi", "protocol"):
+        assert key in data
+    assert data["eta"] == pytest.approx([0.98, 0.99, 1.0])
+    assert data["resonant_mean"] == pytest.approx(max(data["mean"]))
+    assert data["n_samples"] == 2 and data["protocol"]["integrator"] == "ode3"
+    table = np.genfromtxt(out / "sweep.csv", delimiter=",", names=True, dtype=None, encoding=None)
+    np.testing.assert_allclose(table["mean"], data["mean"], rtol=1e-12)
+    assert json.loads((out / "sweep.json").read_text())["resonant_max"] == pytest.approx(data["resonant_max"])
+    assert plot.stat().st_size > 1000
+    assert not [p for p in tmp_path.rglob(".*")], "temporary files left behind"
+
+
+def test_sweep_table_output(model_file, capsys):
+    assert main(["sweep", "--level", "6", *FAST, "--model", model_file]) == 0
+    text = capsys.readouterr().out
+    assert "resonant mean" in text and "eta" in text
+
+
+def test_overview_json_and_out(tmp_path, model_file, capsys):
+    out = tmp_path / "ov"
+    code = main(["overview", "--levels", "4,6", *FAST, "--model", model_file, "--json", "--out", str(out),
+                 "--plot", str(tmp_path / "fig6.pdf")])
+    assert code == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["levels"] == [4.0, 6.0] and len(data["resonant_mean"]) == 2 and len(data["regime"]) == 2
+    assert (out / "overview.csv").read_text().startswith("level,resonant_mean")
+    assert (tmp_path / "fig6.pdf").exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--D", "1.5"], "D must lie in (0, 1)"),
+    (["--D", "0"], "D must lie in (0, 1)"),
+    (["--g", "0"], "clearance g must be a positive number"),
+    (["--g=-1e-3"], "clearance g must be a positive number"),
+    (["--k-H", "0"], "k_H must be a positive number"),
+    (["--level", "0"], "level a_base/a_base* must be positive"),
+    (["--level=-2"], "level a_base/a_base* must be positive"),
+    (["--eta", "1.02:0.96:31"], "empty or reversed"),
+    (["--eta", "0.96:1.02:0"], "empty"),
+    (["--eta", "0.96-1.02"], "START:STOP:N"),
+    (["--hold", "0.001"], "shorter than one excitation period"),
+    (["--dt-scale", "10"], "too large for ode3 stability"),
+    (["--integrator", "rk4"], "unknown integrator"),
+])
+def test_bad_input_is_one_line_exit_2(tmp_path, model_file, capsys, args, message):
+    out = tmp_path / "never"
+    base = ["sweep", "--level", "6", *FAST, "--model", model_file, "--out", str(out)]
+    # later options win in argparse, so the bad value overrides the good default
+    code = main(base + args)
+    err = capsys.readouterr().err
+    assert code == 2
+    assert message in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert not (out / "sweep.csv").exists()
+
+
+def test_malformed_model_file(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("frequencies_hz = [117.4, 'x']\n")
+    assert main(["sweep", "--level", "6", *FAST, "--model", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "bad.toml" in err and len(err.strip().splitlines()) == 1
+
+
+def test_bad_overview_levels(model_file, capsys):
+    for levels, message in (("6,0", "must be positive"), ("8:2:4", "empty or reversed"), ("a,b", "must be numbers")):
+        assert main(["overview", "--levels", levels, *FAST, "--model", model_file]) == 2
+        err = capsys.readouterr().err
+        assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_diverging_simulation_exits_3_without_traceback(model_file):
+    """An absurd level drives the walls through the sphere within a step: numerical failure, exit 3, one
+    line (through a real process)."""
+    proc = subprocess.run([sys.executable, "-m", "uq", "sweep", "--level", "1e6", *FAST, "--model", model_file],
+                          capture_output=True, text=True)
+    assert proc.returncode == 3
+    assert "diverged" in proc.stderr and "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
