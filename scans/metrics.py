@@ -6,7 +6,8 @@ Definitions (heights from the levelled flat wall, `scans.surface`):
   smoothed overview map, then a quadratic surface is fitted by least squares to the scan points within
   `max(4 triangle sizes, 0.1 x crater radius)` of it and its minimum is taken, so that scanner noise
   does not deepen the crater (the minimum of noisy points would be biased by about -3 sigma).
-* rim_height: highest point of the pile-up around the crater (smoothed over one triangle size).
+* rim_height: highest point of the pile-up: located on the smoothed map, then refined by a parabola
+  in the distance from the crater's centre fitted to the points there (a ring is curved across only).
 * diameter: diameter of the circle with the same area as the connected depression around the bottom,
   where the smoothed wall lies below the noise threshold.
 * clearance interval (Sect. 4.1): [nominal, nominal + depth + flattening]; the paper's
@@ -50,8 +51,9 @@ def crater_metrics(surface: LevelledSurface) -> CraterMetrics:
         return CraterMetrics(0.0, max(rim, 0.0), 0.0, surface.centre, surface.noise,
                              ["no crater deeper than the noise threshold: treated as a flat wall"])
     near = valid & (np.hypot(xs - surface.centre[0], ys - surface.centre[1]) <= FLAT_MARGIN * surface.feature_radius)
-    rim = float(np.max(smooth[near], initial=0.0))
-    depth = _bottom_depth(surface)
+    crest = np.unravel_index(np.argmax(np.where(near, smooth, -np.inf)), smooth.shape)
+    rim = max(_crest_height(surface, (float(xs[crest]), float(ys[crest])), float(smooth[crest])), 0.0)
+    depth = -_bottom_height(surface, float(np.nanmin(smooth)))
     depression = valid & (smooth < -surface.threshold)
     labels, _ = ndi.label(depression)
     j = int(round((surface.deepest[1] - surface.y0) / pitch))
@@ -66,10 +68,17 @@ def crater_metrics(surface: LevelledSurface) -> CraterMetrics:
     return CraterMetrics(depth, rim, diameter, surface.centre, surface.noise, warnings)
 
 
-def _bottom_depth(surface: LevelledSurface) -> float:
-    """Minimum of a quadratic surface fitted to the scan points around the deepest point (m, positive)."""
+def _fit_radius(surface: LevelledSurface) -> float:
+    return max(4.0 * surface.pitch, 0.1 * surface.feature_radius)
+
+
+def _bottom_height(surface: LevelledSurface, fallback: float) -> float:
+    """Minimum (m) of a quadratic surface fitted to the scan points around the deepest point.
+
+    Falls back to the smoothed map's minimum when the points do not form a bowl at that scale.
+    """
     bx, by = surface.deepest
-    radius = max(4.0 * surface.pitch, 0.1 * surface.feature_radius)
+    radius = _fit_radius(surface)
     x, y, h = (surface.points[:, k] for k in range(3))
     near = np.hypot(x - bx, y - by) <= radius
     if near.sum() >= 12:
@@ -80,10 +89,26 @@ def _bottom_depth(surface: LevelledSurface) -> float:
         if np.all(np.linalg.eigvalsh(hessian) > 0):
             uv = np.linalg.solve(hessian, -c[1:3])
             if np.hypot(*uv) <= 1.0:
-                return float(-(c[0] + c[1] * uv[0] + c[2] * uv[1] + c[3] * uv[0] ** 2 + c[4] * uv[0] * uv[1] + c[5] * uv[1] ** 2))
-    # too few points, or no bowl at this scale: the lowest point of the smoothed map
-    valid = np.isfinite(surface.overview)
-    return float(-np.nanmin(_smooth(surface.overview, valid, 1.0)))
+                return float(c[0] + c[1] * uv[0] + c[2] * uv[1] + c[3] * uv[0] ** 2 + c[4] * uv[0] * uv[1] + c[5] * uv[1] ** 2)
+    return fallback
+
+
+def _crest_height(surface: LevelledSurface, at: tuple[float, float], fallback: float) -> float:
+    """Maximum (m) of a parabola in the radial direction fitted to the scan points around the rim's crest.
+
+    A ring's crest is curved across it, not along it, hence a 1-D fit in the distance from the crater's
+    centre. Falls back to the smoothed map's value when the points do not form a crest at that scale.
+    """
+    radius = _fit_radius(surface)
+    x, y, h = (surface.points[:, k] for k in range(3))
+    near = np.hypot(x - at[0], y - at[1]) <= radius
+    if near.sum() >= 12:
+        crest_r = np.hypot(at[0] - surface.centre[0], at[1] - surface.centre[1])
+        t = (np.hypot(x[near] - surface.centre[0], y[near] - surface.centre[1]) - crest_r) / radius
+        c = np.polynomial.polynomial.polyfit(t, h[near], 2)
+        if c[2] < 0 and abs(c[1] / (2 * c[2])) <= 1.0:
+            return float(c[0] - c[1] ** 2 / (4 * c[2]))
+    return fallback
 
 
 def clearance_bounds(depth: float, flattening: float, nominal: float) -> tuple[float, float]:

@@ -241,7 +241,7 @@ def _features(local: np.ndarray, overview: np.ndarray, x0: float, y0: float, pit
     if valid.sum() < 16:
         raise ScanError(f"{source}: the scan covers too small an area to level (fewer than 16 grid points)")
     h = local[:, 2]
-    noise = _flat_noise(h, 0.0) if noise_hint is None else noise_hint
+    noise = _local_noise(overview, valid) if noise_hint is None else noise_hint
     smooth = _smooth(overview, valid, 1.0)
     span = float(np.nanmax(smooth) - np.nanmin(smooth))
     threshold = max(4.0 * noise, 1e-3 * span, 1e-9)
@@ -267,6 +267,20 @@ def _features(local: np.ndarray, overview: np.ndarray, x0: float, y0: float, pit
     feature_radius = float((above.max() + 1) * 2 * pitch)
     noise = _flat_noise(h[np.hypot(local[:, 0] - centre[0], local[:, 1] - centre[1]) > FLAT_MARGIN * feature_radius], noise)
     return dict(noise=noise, threshold=threshold, feature_radius=feature_radius, centre=centre, deepest=deepest)
+
+
+def _local_noise(height: np.ndarray, valid: np.ndarray) -> float:
+    """Noise from the map's roughness alone, blind to smooth features (craters) of any size.
+
+    The 5-point residual h - mean(4 neighbours) of white noise of deviation s has deviation s sqrt(5/4);
+    a smooth surface contributes only curvature x pitch^2 / 4. Robust (MAD) over the valid pixels.
+    """
+    inner = valid[1:-1, 1:-1] & valid[2:, 1:-1] & valid[:-2, 1:-1] & valid[1:-1, 2:] & valid[1:-1, :-2]
+    if inner.sum() < 16:
+        return 0.0
+    resid = height[1:-1, 1:-1] - 0.25 * (height[2:, 1:-1] + height[:-2, 1:-1] + height[1:-1, 2:] + height[1:-1, :-2])
+    resid = resid[inner]
+    return 1.4826 * float(np.median(np.abs(resid - np.median(resid)))) / np.sqrt(1.25)
 
 
 def _flat_noise(h: np.ndarray, fallback: float) -> float:
