@@ -1,0 +1,763 @@
+"""Exact free-flight integrator with located contacts (issue 5), for Eqs. 3-7 of the seed paper.
+
+Between contacts the system is linear (Sect. 5.5, Eq. 9): each mode is a damped oscillator under the
+harmonic base excitation and the sphere flies at constant absolute velocity. We split every quantity into
+the particular harmonic solution and a homogeneous deviation, in the coordinates of `sim.system`
+(phase time t in [0, T) of the current excitation period, T = 2 pi / Omega):
+
+    s_j = x_j + Re(S_j e^{i Omega t}),   S_j = gamma_j a_base Omega^2 / (omega_j^2 - Omega^2 + 2 i D_j omega_j Omega)
+    u_a = z - a_base cos(Omega t)        (so z'' = (f_l + f_r) / m_a, zero in free flight)
+
+    x_j'' + 2 D_j omega_j x_j' + omega_j^2 x_j = -phi_l,j f_l - phi_r,j f_r.
+
+Free flight: x_j advances with the closed-form damped transition (the homogeneous part of Eq. 9), z
+linearly; no truncation error. Closing functions of the two contacts (contact when c > 0, Eqs. 4-6):
+
+    c_l = delta_l = phi_l^T x + Re(W_l e^{i Omega t}) - z - g,      W_w = phi_w^T S + a_base
+    c_r = -delta_r = -(phi_r^T x + Re(W_r e^{i Omega t}) - z) - g.
+
+No contact is skipped. Free flight runs on a grid of N_grid steps per period; a grid step is accepted
+only if a rigorous upper bound of max c over the step is negative. With A_j the modulus of mode j's
+complex amplitude (it only decays in free flight) the bounds used are (M_w = sum_j |phi_w,j| A_j omega_j^2
++ |W_w| Omega^2 bounds |c''|):
+
+    chord:    max(c_0, c_1) + sum_j |phi_w,j| A_j min(omega_j^2 h^2 / 8, 2) + |W_w| Omega^2 h^2 / 8,
+    Taylor:   max(c_0, c_0 + c_0' h + M_w h^2 / 2)   and its mirror from the step's end.
+
+Otherwise a conservative Newton search walks from the step's start with the largest step that the
+quadratic majorant c + c' h + M_w h^2 / 2 allows: it can never pass a zero of c, and converges
+quadratically onto the first onset (or certifies the step). Grazes with indentation below
+`GAP_TOLERANCE * g` are ignored (force < 1e-13 N at the nominal k_H).
+
+Contact: an embedded Dormand-Prince 5(4) step with error control on all modal states (scaled to m of
+wall/tip displacement), started at the located onset; the release is located by Newton iteration on the
+length of the last step (|c| < GAP_TOLERANCE * g). Chattering is handled because every release is
+followed by the same certified free-flight search.
+
+Measure (Sect. 5): c_1 = (2/T) int_T q_tip e^{-i Omega t} dt is exact: the particular part contributes
+phi_tip^T S per whole period, each free-flight piece of the homogeneous part is integrated in closed
+form, and during contacts the integral is a further component of the Dormand-Prince state (5th order).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from sim.errors import SimulationDiverged, SimulationInputError
+from sim.system import SystemArrays
+
+#: Free-flight grid steps per excitation period (certification cells; no effect on accuracy).
+GRID_PER_PERIOD = 48
+#: Default tolerance of the contact integration, relative to the clearance g (error per step, in m / g).
+CONTACT_RTOL = 1e-9
+#: Onset/release location tolerance on the closing function, relative to g.
+GAP_TOLERANCE = 1e-12
+#: Contact onsets need an approach speed above this (m/s) unless the indentation already exceeds the tolerance.
+MIN_APPROACH_SPEED = 1e-9
+
+# rows of the per-mode constant table
+_SIG, _WD, _W2, _PL, _PR, _PT, _APL, _APR, _SRE, _SIM, _SCX, _SCV = range(12)
+_N_ROWS = 12
+# entries of the scalar parameter vector
+(_OM, _ABASE, _MA, _KH, _G, _WLR, _WLI, _WRR, _WRI, _PRE, _PIM, _TOL, _VMIN, _HG, _ML0, _MR0, _SCZ, _SCZD,
+ _HMAX) = range(19)
+_N_PAR = 19
+# counters
+_C_GRID, _C_SEARCH, _C_EVAL, _C_ACC, _C_REJ, _C_REL, _C_CONTACT = range(7)
+_N_COUNT = 7
+# status codes
+_OK, _NONFINITE, _OVERLAP, _STALLED = 0, 1, 2, 3
+_MAX_SEARCH = 200_000
+
+# Dormand-Prince 5(4) tableau (Dormand & Prince 1980; the coefficients of scipy's RK45 / MATLAB ode45)
+_C2, _C3, _C4, _C5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
+_A21 = 1 / 5
+_A31, _A32 = 3 / 40, 9 / 40
+_A41, _A42, _A43 = 44 / 45, -56 / 15, 32 / 9
+_A51, _A52, _A53, _A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
+_A61, _A62, _A63, _A64, _A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
+_B1, _B3, _B4, _B5, _B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
+_E1, _E3, _E4, _E5, _E6, _E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
+
+
+# ----------------------------------------------------------------------------------------------------------
+# free flight in closed form
+# ----------------------------------------------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _transition(tau, sig, wd, w2):
+    """Damped-oscillator transition over tau: (x, v)(tau) = [[a, b], [c, d]] (x0, v0)."""
+    e = math.exp(-sig * tau)
+    co = math.cos(wd * tau)
+    si = math.sin(wd * tau)
+    return e * (co + sig / wd * si), e * si / wd, -e * w2 / wd * si, e * (co - sig / wd * si)
+
+
+@njit(cache=True, inline="always")
+def _exp_integral(a, b, tau):
+    """E = int_0^tau exp(mu u) du = (exp(mu tau) - 1) / mu for mu = a + i b, without cancellation."""
+    ea = math.exp(a * tau)
+    re = math.expm1(a * tau) * math.cos(b * tau) - 2.0 * math.sin(0.5 * b * tau) ** 2
+    im = ea * math.sin(b * tau)
+    den = a * a + b * b
+    return (re * a + im * b) / den, (im * a - re * b) / den
+
+
+@njit(cache=True)
+def _flight_coefficients(tau, Omega, modes, tr, fa, fb):
+    """Closed-form free flight over tau for every mode.
+
+    tr[:, j] = transition (a, b, c, d); the Fourier integral of phi_tip,j x_j over the piece is
+    int_0^tau phi_tip,j x_j(u) e^{-i Omega u} du = fa_j x_j0 + fb_j v_j0 (fa, fb complex as [re, im] rows).
+    """
+    n = modes.shape[1]
+    for j in range(n):
+        sig = modes[_SIG, j]
+        wd = modes[_WD, j]
+        a, b, c, d = _transition(tau, sig, wd, modes[_W2, j])
+        tr[0, j] = a
+        tr[1, j] = b
+        tr[2, j] = c
+        tr[3, j] = d
+        e1r, e1i = _exp_integral(-sig, wd - Omega, tau)
+        e2r, e2i = _exp_integral(-sig, -(wd + Omega), tau)
+        r = sig / wd
+        # alpha = 1/2 [(1 - i r) E1 + (1 + i r) E2],  beta = 1/2 [(-i / wd) E1 + (i / wd) E2]
+        ar = 0.5 * (e1r + r * e1i + e2r - r * e2i)
+        ai = 0.5 * (e1i - r * e1r + e2i + r * e2r)
+        br = 0.5 * (e1i - e2i) / wd
+        bi = 0.5 * (-e1r + e2r) / wd
+        pt = modes[_PT, j]
+        fa[0, j] = pt * ar
+        fa[1, j] = pt * ai
+        fb[0, j] = pt * br
+        fb[1, j] = pt * bi
+
+
+@njit(cache=True)
+def _apply_flight(Y, Ynew, tau, cos_t, sin_t, tr, fa, fb, n):
+    """Ynew = free flight of Y over tau starting at phase time t (cos_t, sin_t = cos, sin(Omega t))."""
+    fr = 0.0
+    fi = 0.0
+    for j in range(n):
+        x = Y[j]
+        v = Y[n + j]
+        Ynew[j] = tr[0, j] * x + tr[1, j] * v
+        Ynew[n + j] = tr[2, j] * x + tr[3, j] * v
+        fr += fa[0, j] * x + fb[0, j] * v
+        fi += fa[1, j] * x + fb[1, j] * v
+    Ynew[2 * n] = Y[2 * n] + tau * Y[2 * n + 1]
+    Ynew[2 * n + 1] = Y[2 * n + 1]
+    # rotate by e^{-i Omega t}
+    Ynew[2 * n + 2] = Y[2 * n + 2] + fr * cos_t + fi * sin_t
+    Ynew[2 * n + 3] = Y[2 * n + 3] + fi * cos_t - fr * sin_t
+
+
+@njit(cache=True, inline="always")
+def _closing(Y, t, n, modes, par):
+    """(c_l, c_l', c_r, c_r') at phase time t: contact at a wall when its c > 0 (Eqs. 4-6)."""
+    Om = par[_OM]
+    ct = math.cos(Om * t)
+    st = math.sin(Om * t)
+    sl = par[_WLR] * ct - par[_WLI] * st
+    sld = -Om * (par[_WLR] * st + par[_WLI] * ct)
+    sr = par[_WRR] * ct - par[_WRI] * st
+    srd = -Om * (par[_WRR] * st + par[_WRI] * ct)
+    for j in range(n):
+        x = Y[j]
+        v = Y[n + j]
+        sl += modes[_PL, j] * x
+        sld += modes[_PL, j] * v
+        sr += modes[_PR, j] * x
+        srd += modes[_PR, j] * v
+    z = Y[2 * n]
+    zd = Y[2 * n + 1]
+    g = par[_G]
+    return sl - z - g, sld - zd, -(sr - z) - g, -(srd - zd)
+
+
+@njit(cache=True, inline="always")
+def _majorant_step(c, cd, M):
+    """Smallest positive root h of c + cd h + M h^2 / 2 = 0 for c < 0 (inf if there is none)."""
+    if M <= 0.0:
+        return -c / cd if cd > 0.0 else np.inf
+    root = math.sqrt(cd * cd - 2.0 * M * c)
+    if cd > 0.0:
+        return -2.0 * c / (cd + root)
+    return (root - cd) / M
+
+
+@njit(cache=True)
+def _curvature_bounds(Y, n, modes, par):
+    """M_l, M_r: bounds of |c''| valid from now on in free flight (mode envelopes only decay)."""
+    Ml = par[_ML0]
+    Mr = par[_MR0]
+    for j in range(n):
+        x = Y[j]
+        q = (Y[n + j] + modes[_SIG, j] * x) / modes[_WD, j]
+        A = math.sqrt(x * x + q * q) * modes[_W2, j]
+        Ml += modes[_APL, j] * A
+        Mr += modes[_APR, j] * A
+    return Ml, Mr
+
+
+@njit(cache=True)
+def _search(Y, t0, tau_end, n, modes, par, scratch, counters):
+    """First contact onset in (t0, t0 + tau_end] of the free flight from Y, by conservative Newton steps.
+
+    Returns (tau, wall): wall 0 (left) or 1 (right) with the onset at t0 + tau, -1 if the interval is
+    certified contact-free, -2 if the search stalled.
+    """
+    Ml, Mr = _curvature_bounds(Y, n, modes, par)
+    tol = par[_TOL]
+    vmin = par[_VMIN]
+    tau = 0.0
+    for _ in range(_MAX_SEARCH):
+        if tau == 0.0:
+            cl, cld, cr, crd = _closing(Y, t0, n, modes, par)
+        else:
+            for j in range(n):
+                a, b, c, d = _transition(tau, modes[_SIG, j], modes[_WD, j], modes[_W2, j])
+                x = Y[j]
+                v = Y[n + j]
+                scratch[j] = a * x + b * v
+                scratch[n + j] = c * x + d * v
+            scratch[2 * n] = Y[2 * n] + tau * Y[2 * n + 1]
+            scratch[2 * n + 1] = Y[2 * n + 1]
+            cl, cld, cr, crd = _closing(scratch, t0 + tau, n, modes, par)
+        counters[_C_EVAL] += 1
+        if cl > -tol and (cld > vmin or cl > tol):
+            return tau, 0
+        if cr > -tol and (crd > vmin or cr > tol):
+            return tau, 1
+        h = min(_majorant_step(min(cl, -tol), cld, Ml), _majorant_step(min(cr, -tol), crd, Mr))
+        tau += h
+        if tau >= tau_end:
+            return tau_end, -1
+    return tau, -2
+
+
+# ----------------------------------------------------------------------------------------------------------
+# contact: Dormand-Prince 5(4) with error control
+# ----------------------------------------------------------------------------------------------------------
+_FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}  # keeps NaN/inf semantics for the divergence checks
+# kinds of Dormand-Prince step: t = t_a + phi(u), u in [0, 1] (see `_dp_step`)
+_REGULAR, _ONSET, _RELEASE, _GRAZE = 0, 1, 2, 3
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _rhs(ct, st, Y, out, n, modes, par):
+    """Eqs. 3-7 in the deviation coordinates at cos, sin(Omega t) = ct, st, plus the Fourier integrand."""
+    g = par[_G]
+    z = Y[2 * n]
+    dl = par[_WLR] * ct - par[_WLI] * st - z - g
+    dr = par[_WRR] * ct - par[_WRI] * st - z + g
+    q = 0.0
+    for j in range(n):
+        x = Y[j]
+        dl += modes[_PL, j] * x
+        dr += modes[_PR, j] * x
+        q += modes[_PT, j] * x
+    kH = par[_KH]
+    fl = kH * dl * math.sqrt(dl) if dl > 0.0 else 0.0
+    fr = -kH * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
+    for j in range(n):
+        v = Y[n + j]
+        out[j] = v
+        out[n + j] = -2.0 * modes[_SIG, j] * v - modes[_W2, j] * Y[j] - modes[_PL, j] * fl - modes[_PR, j] * fr
+    out[2 * n] = Y[2 * n + 1]
+    out[2 * n + 1] = (fl + fr) / par[_MA]
+    out[2 * n + 2] = q * ct
+    out[2 * n + 3] = -q * st
+
+
+@njit(cache=True, inline="always")
+def _warp(kind, u, s):
+    """(phi(u), phi'(u)) of the step's time map t = t_a + phi(u), u in [0, 1], phi(1) = s.
+
+    At a contact onset (release) the Hertz force behaves like (t - t_on)^1.5 ((t_rel - t)^1.5) and a
+    step in t loses its order (local error O(h^2.5)); with t - t_on = s u^2 (t_rel - t = s (1 - u)^2) the
+    force is a smooth function of u and the step keeps its 5th order. _GRAZE handles both ends at once.
+    """
+    if kind == _REGULAR:
+        return s * u, s
+    if kind == _ONSET:
+        return s * u * u, 2.0 * s * u
+    if kind == _RELEASE:
+        return s * u * (2.0 - u), 2.0 * s * (1.0 - u)
+    return s * u * u * (3.0 - 2.0 * u), 6.0 * s * u * (1.0 - u)
+
+
+@njit(cache=True, inline="always")
+def _rotate(ct, st, angle):
+    """cos, sin(theta + angle) from cos, sin(theta); Taylor series for the small angles of a contact step."""
+    if abs(angle) < 0.02:
+        a2 = angle * angle
+        ca = 1.0 - a2 / 2.0 * (1.0 - a2 / 12.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0)))
+        sa = angle * (1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0 * (1.0 - a2 / 72.0))))
+    else:
+        ca = math.cos(angle)
+        sa = math.sin(angle)
+    return ct * ca - st * sa, st * ca + ct * sa
+
+
+@njit(cache=True, fastmath=_FAST)
+def _dp_step(Y, t, s, kind, K, tmp, Ynew, n, modes, par):
+    """One Dormand-Prince 5(4) step from (t, Y) over the time map of `_warp` (kind, length s in time).
+
+    K holds the raw right-hand sides F: K[0] = F(t, Y) on entry, K[6] = F(t + s, Ynew) on exit (FSAL);
+    dY/du = phi'(u) F(t_a + phi(u), Y). Returns the scaled error estimate (accept if <= 1): max over the
+    mechanical states of |err_i| / scale_i, scales from `_prepare` (m of wall/tip displacement).
+    """
+    m = Y.size
+    Om = par[_OM]
+    ct0 = math.cos(Om * t)
+    st0 = math.sin(Om * t)
+    _, d1 = _warp(kind, 0.0, s)
+    p2, d2 = _warp(kind, _C2, s)
+    p3, d3 = _warp(kind, _C3, s)
+    p4, d4 = _warp(kind, _C4, s)
+    p5, d5 = _warp(kind, _C5, s)
+    _, d6 = _warp(kind, 1.0, s)
+    for i in range(m):
+        tmp[i] = Y[i] + _A21 * d1 * K[0, i]
+    ct, st = _rotate(ct0, st0, Om * p2)
+    _rhs(ct, st, tmp, K[1], n, modes, par)
+    for i in range(m):
+        tmp[i] = Y[i] + _A31 * d1 * K[0, i] + _A32 * d2 * K[1, i]
+    ct, st = _rotate(ct0, st0, Om * p3)
+    _rhs(ct, st, tmp, K[2], n, modes, par)
+    for i in range(m):
+        tmp[i] = Y[i] + _A41 * d1 * K[0, i] + _A42 * d2 * K[1, i] + _A43 * d3 * K[2, i]
+    ct, st = _rotate(ct0, st0, Om * p4)
+    _rhs(ct, st, tmp, K[3], n, modes, par)
+    for i in range(m):
+        tmp[i] = Y[i] + _A51 * d1 * K[0, i] + _A52 * d2 * K[1, i] + _A53 * d3 * K[2, i] + _A54 * d4 * K[3, i]
+    ct, st = _rotate(ct0, st0, Om * p5)
+    _rhs(ct, st, tmp, K[4], n, modes, par)
+    for i in range(m):
+        tmp[i] = (Y[i] + _A61 * d1 * K[0, i] + _A62 * d2 * K[1, i] + _A63 * d3 * K[2, i] + _A64 * d4 * K[3, i]
+                  + _A65 * d5 * K[4, i])
+    ct, st = _rotate(ct0, st0, Om * s)
+    _rhs(ct, st, tmp, K[5], n, modes, par)
+    for i in range(m):
+        Ynew[i] = Y[i] + _B1 * d1 * K[0, i] + _B3 * d3 * K[2, i] + _B4 * d4 * K[3, i] + _B5 * d5 * K[4, i] + _B6 * d6 * K[5, i]
+    _rhs(ct, st, Ynew, K[6], n, modes, par)
+    err = 0.0
+    for i in range(2 * n + 2):
+        e = (_E1 * d1 * K[0, i] + _E3 * d3 * K[2, i] + _E4 * d4 * K[3, i] + _E5 * d5 * K[4, i]
+             + _E6 * d6 * K[5, i] + _E7 * d6 * K[6, i])
+        if i < n:
+            sc = modes[_SCX, i]
+        elif i < 2 * n:
+            sc = modes[_SCV, i - n]
+        elif i == 2 * n:
+            sc = par[_SCZ]
+        else:
+            sc = par[_SCZD]
+        r = abs(e) / sc
+        if r > err:
+            err = r
+    return err
+
+
+@njit(cache=True)
+def _locate_release(Y, t, step, kind, c_end, cd_end, wall_left, K, tmp, Ynew, n, modes, par, counters):
+    """Length s in (0, step] of a step of `kind` from (t, Y) that ends at the release c = 0 (Newton, bracketed).
+
+    On return Ynew holds the state at t + s; returns (s, err of that step).
+    """
+    tol = par[_TOL]
+    lo = 0.0
+    hi = step
+    s = hi - c_end / cd_end if cd_end < 0.0 else 0.5 * hi
+    err = 0.0
+    c_s = c_end
+    for _ in range(60):
+        if not (lo < s < hi):
+            s = 0.5 * (lo + hi)
+        err = _dp_step(Y, t, s, kind, K, tmp, Ynew, n, modes, par)
+        counters[_C_REL] += 1
+        a1, a2, a3, a4 = _closing(Ynew, t + s, n, modes, par)
+        c_s = a1 if wall_left else a3
+        cd_s = a2 if wall_left else a4
+        if c_s > 0.0:
+            lo = s
+        else:
+            hi = s
+        if abs(c_s) <= tol or hi - lo <= 4e-16 * (t + hi):
+            break
+        if cd_s != 0.0:
+            s = s - c_s / cd_s
+    if c_s > tol:
+        s = hi
+        err = _dp_step(Y, t, s, kind, K, tmp, Ynew, n, modes, par)
+    return s, err
+
+
+@njit(cache=True)
+def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, fixed_step):
+    """Integrate a contact phase from (t, Y) until all contacts have opened or t_stop is reached.
+
+    at_onset: t is a located onset (the first step then uses the onset time map). Returns
+    (t, h_next, released, status, extra_onsets). With fixed_step > 0 the step is fixed (order studies)
+    and only cut at t_stop and at the release.
+    """
+    Om = par[_OM]
+    _rhs(math.cos(Om * t), math.sin(Om * t), Y, K[0], n, modes, par)
+    cl, cld, cr, crd = _closing(Y, t, n, modes, par)
+    wall_left = cl > cr  # the wall in contact (or about to be)
+    open_l = cl <= 0.0
+    open_r = cr <= 0.0
+    first = at_onset
+    extra = 0
+    if fixed_step > 0.0:
+        h = fixed_step
+    for _ in range(100_000_000):
+        step = min(h, par[_HMAX])
+        last = step >= t_stop - t
+        if last:
+            step = t_stop - t
+        kind = _ONSET if first else _REGULAR
+        err = _dp_step(Y, t, step, kind, K, tmp, Ynew, n, modes, par)
+        if not math.isfinite(err):
+            return t, h, False, _NONFINITE, extra
+        if fixed_step <= 0.0 and err > 1.0:
+            counters[_C_REJ] += 1
+            h = step * max(0.2, 0.9 * err ** -0.2)
+            continue
+        ncl, ncld, ncr, ncrd = _closing(Ynew, t + step, n, modes, par)
+        if ncl <= 0.0 and ncr <= 0.0:
+            # release inside (t, t + step]: a step with the release time map ending exactly there
+            kind = _GRAZE if first else _RELEASE
+            c_end = ncl if wall_left else ncr
+            cd_end = ncld if wall_left else ncrd
+            s, err = _locate_release(Y, t, step, kind, c_end, cd_end, wall_left, K, tmp, Ynew, n, modes, par,
+                                     counters)
+            if fixed_step <= 0.0 and err > 1.0 and s > 1e-3 * step:
+                # too long for the tolerance: first a shorter (onset or regular) step towards the release
+                counters[_C_REJ] += 1
+                h = s * min(0.5, max(0.2, 0.9 * err ** -0.2))
+                continue
+            for i in range(Y.size):
+                Y[i] = Ynew[i]
+            counters[_C_ACC] += 1
+            return t + s, h, True, _OK, extra
+        # accepted step inside the contact
+        counters[_C_ACC] += 1
+        if (ncl > 0.0 and open_l and not first and not wall_left) or (ncr > 0.0 and open_r and not first and wall_left):
+            extra += 1  # the other wall closed within the contact (not located; physically excluded)
+        open_l = ncl <= 0.0
+        open_r = ncr <= 0.0
+        first = False
+        if ncl > par[_G] or ncr > par[_G]:
+            return t + step, h, False, _OVERLAP, extra
+        for i in range(Y.size):
+            Y[i] = Ynew[i]
+        for i in range(Y.size):
+            K[0, i] = K[6, i]
+        t = t + step
+        if fixed_step <= 0.0 and not last:
+            h = step * min(5.0, max(0.2, 0.9 * max(err, 1e-10) ** -0.2))
+        if last:
+            return t_stop, h, False, _OK, extra
+    return t, h, False, _STALLED, extra
+
+
+# ----------------------------------------------------------------------------------------------------------
+# the period loop
+# ----------------------------------------------------------------------------------------------------------
+@njit(cache=True)
+def _to_state(Y, t, y_out, n, modes, par):
+    """Write [s, s', u_a, u_a'] at phase time t from the deviation state Y (inverse of `_from_state`)."""
+    Om = par[_OM]
+    ct = math.cos(Om * t)
+    st = math.sin(Om * t)
+    for j in range(n):
+        sr = modes[_SRE, j]
+        si = modes[_SIM, j]
+        y_out[j] = Y[j] + sr * ct - si * st
+        y_out[n + j] = Y[n + j] - Om * (sr * st + si * ct)
+    y_out[2 * n] = Y[2 * n] - par[_ABASE] * ct
+    y_out[2 * n + 1] = Y[2 * n + 1] + par[_ABASE] * Om * st
+
+
+@njit(cache=True)
+def _advance(y, n_periods, N, modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_g, record, stride, amplitudes,
+             impacts, counters, fixed_step):
+    """Advance y (phase 0) over n_periods excitation periods; returns (status, period of failure)."""
+    n = modes.shape[1]
+    m = 2 * n + 4
+    Om = par[_OM]
+    T = 2.0 * math.pi / Om
+    hg = par[_HG]
+    Y = np.zeros(m)
+    Ynew = np.zeros(m)
+    tmp = np.zeros(m)
+    K = np.zeros((7, m))
+    tr = np.empty((4, n))
+    fa = np.empty((2, n))
+    fb = np.empty((2, n))
+    A = np.empty(n)
+    # phase 0: s = x + Re(S), s' = v - Omega Im(S), u_a = z - a_base
+    for j in range(n):
+        Y[j] = y[j] - modes[_SRE, j]
+        Y[n + j] = y[n + j] + Om * modes[_SIM, j]
+    Y[2 * n] = y[2 * n] + par[_ABASE]
+    Y[2 * n + 1] = y[2 * n + 1]
+    recording = record.shape[0] > 0
+    rows = N // stride
+    if recording:
+        for i in range(2 * n + 2):
+            record[0, i] = y[i]
+    cl, _, cr, _ = _closing(Y, 0.0, n, modes, par)
+    in_contact = cl > 0.0 or cr > 0.0
+    at_onset = False
+    h_contact = 0.0
+    t = 0.0
+    for p in range(n_periods):
+        Y[2 * n + 2] = 0.0
+        Y[2 * n + 3] = 0.0
+        onsets = 0
+        k = 0  # grid index of the current point (free flight on the grid) or of the last grid point passed
+        A_valid = False
+        t = 0.0 if not in_contact else t
+        while True:
+            if in_contact:
+                ks = (int(t / (stride * hg)) + 1) * stride
+                t_stop = T if ks >= N else ks * hg
+                if h_contact <= 0.0:
+                    h_contact = 0.01 / math.sqrt(modes[_W2, n - 1])
+                t, h_contact, released, status, extra = _contact(Y, t, t_stop, h_contact, at_onset, K, tmp, Ynew, n,
+                                                                 modes, par, counters, fixed_step)
+                at_onset = False
+                onsets += extra
+                if status != _OK:
+                    return status, p
+                if not released:
+                    if t_stop == T:
+                        break
+                    if recording:
+                        _to_state(Y, t, record[p * rows + ks // stride], n, modes, par)
+                    continue
+                in_contact = False
+                k = int(t / hg)
+                if k >= N:
+                    k = N - 1
+                # free flight from the release to the next grid point
+                tau_end = (k + 1) * hg - t
+                tau, wall = _search(Y, t, tau_end, n, modes, par, tmp, counters)
+                if wall == -2:
+                    return _STALLED, p
+                _flight_coefficients(tau, Om, modes, tr, fa, fb)
+                _apply_flight(Y, Ynew, tau, math.cos(Om * t), math.sin(Om * t), tr, fa, fb, n)
+                Y[:] = Ynew
+                if wall >= 0:
+                    t = t + tau
+                    in_contact = True
+                    at_onset = True
+                    onsets += 1
+                    counters[_C_CONTACT] += 1
+                    h_contact = _initial_contact_step(Y, t, n, modes, par)
+                    continue
+                k += 1
+                t = k * hg
+                A_valid = False
+            else:
+                # one grid step k -> k + 1 in closed form, accepted if certified contact-free
+                if not A_valid:
+                    for j in range(n):
+                        x = Y[j]
+                        q = (Y[n + j] + modes[_SIG, j] * x) / modes[_WD, j]
+                        A[j] = math.sqrt(x * x + q * q)
+                    A_valid = True
+                counters[_C_GRID] += 1
+                _apply_flight(Y, Ynew, hg, rot_g[0, k], rot_g[1, k], tr_g, fa_g, fb_g, n)
+                t1 = (k + 1) * hg
+                c0l, c0ld, c0r, c0rd = _closing(Y, t, n, modes, par)
+                c1l, c1ld, c1r, c1rd = _closing(Ynew, t1, n, modes, par)
+                Bl = par[_ML0] * hg * hg / 8.0
+                Br = par[_MR0] * hg * hg / 8.0
+                Ml = par[_ML0]
+                Mr = par[_MR0]
+                for j in range(n):
+                    Bl += modes[_APL, j] * kappa_g[j] * A[j]
+                    Br += modes[_APR, j] * kappa_g[j] * A[j]
+                    Ml += modes[_APL, j] * modes[_W2, j] * A[j]
+                    Mr += modes[_APR, j] * modes[_W2, j] * A[j]
+                ok = (_max_bound(c0l, c0ld, c1l, c1ld, Bl, Ml, hg) < 0.0
+                      and _max_bound(c0r, c0rd, c1r, c1rd, Br, Mr, hg) < 0.0)
+                if not ok:
+                    counters[_C_SEARCH] += 1
+                    tau, wall = _search(Y, t, hg, n, modes, par, tmp, counters)
+                    if wall == -2:
+                        return _STALLED, p
+                    if wall >= 0:
+                        _flight_coefficients(tau, Om, modes, tr, fa, fb)
+                        _apply_flight(Y, Ynew, tau, rot_g[0, k], rot_g[1, k], tr, fa, fb, n)
+                        Y[:] = Ynew
+                        t = t + tau
+                        in_contact = True
+                        at_onset = True
+                        onsets += 1
+                        counters[_C_CONTACT] += 1
+                        h_contact = _initial_contact_step(Y, t, n, modes, par)
+                        A_valid = False
+                        continue
+                Y[:] = Ynew
+                for j in range(n):
+                    A[j] *= dec_g[j]
+                k += 1
+                t = k * hg
+            if recording and k % stride == 0:
+                _to_state(Y, t, record[p * rows + k // stride], n, modes, par)
+            if k >= N:
+                break
+        # c_1 = phi_tip^T S + (2/T) int_T phi_tip^T x e^{-i Omega t} dt
+        cre = par[_PRE] + 2.0 / T * Y[2 * n + 2]
+        cim = par[_PIM] + 2.0 / T * Y[2 * n + 3]
+        amplitudes[p] = math.sqrt(cre * cre + cim * cim)
+        impacts[p] = onsets
+        t = 0.0
+        for i in range(m):
+            if not math.isfinite(Y[i]):
+                return _NONFINITE, p
+    _to_state(Y, 0.0, y, n, modes, par)
+    return _OK, n_periods
+
+
+@njit(cache=True, inline="always")
+def _max_bound(c0, c0d, c1, c1d, B, M, h):
+    """Smallest of the chord and the two Taylor upper bounds of max c over a step of length h."""
+    chord = max(c0, c1) + B
+    left = max(c0, c0 + c0d * h + 0.5 * M * h * h)
+    right = max(c1, c1 - c1d * h + 0.5 * M * h * h)
+    return min(chord, min(left, right))
+
+
+@njit(cache=True)
+def _initial_contact_step(Y, t, n, modes, par):
+    """First step of a contact, tied to the Hertz contact time t_c = 2.9432 delta_max / v0 (rigid wall)."""
+    cl, cld, cr, crd = _closing(Y, t, n, modes, par)
+    v = max(cld, crd, 1e-6)
+    delta_max = (5.0 * par[_MA] * v * v / (4.0 * par[_KH])) ** 0.4
+    return min(0.02 * 2.9432 * delta_max / v, par[_HMAX])
+
+
+# ----------------------------------------------------------------------------------------------------------
+# Python entry point
+# ----------------------------------------------------------------------------------------------------------
+def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float, h_max: float):
+    """Constant tables of the kernel for one excitation (see the module docstring for the symbols)."""
+    omega = np.asarray(sys.omega, dtype=np.float64)
+    D = np.asarray(sys.D, dtype=np.float64)
+    n = omega.size
+    sig = D * omega
+    wd = omega * np.sqrt(1.0 - D * D)
+    S = sys.gamma * a_base * Omega**2 / (omega**2 - Omega**2 + 2j * sig * Omega)
+    Wl = complex(np.dot(sys.phi_l, S)) + a_base
+    Wr = complex(np.dot(sys.phi_r, S)) + a_base
+    P = complex(np.dot(sys.phi_tip, S))
+    atol = rtol * sys.g
+    wpos = np.maximum(np.maximum(np.abs(sys.phi_l), np.abs(sys.phi_r)), np.abs(sys.phi_tip))
+    wpos = np.where(wpos > 0, wpos, 1e-300)
+    modes = np.empty((_N_ROWS, n))
+    modes[_SIG], modes[_WD], modes[_W2] = sig, wd, omega**2
+    modes[_PL], modes[_PR], modes[_PT] = sys.phi_l, sys.phi_r, sys.phi_tip
+    modes[_APL], modes[_APR] = np.abs(sys.phi_l), np.abs(sys.phi_r)
+    modes[_SRE], modes[_SIM] = S.real, S.imag
+    modes[_SCX] = atol / wpos  # error of x_j -> displacement error phi_j x_j in m
+    modes[_SCV] = atol * omega / wpos  # velocity error e_v -> amplitude error e_v / omega_j
+    par = np.zeros(_N_PAR)
+    par[_OM], par[_ABASE], par[_MA], par[_KH], par[_G] = Omega, a_base, sys.m_a, sys.k_H, sys.g
+    par[_WLR], par[_WLI], par[_WRR], par[_WRI] = Wl.real, Wl.imag, Wr.real, Wr.imag
+    par[_PRE], par[_PIM] = P.real, P.imag
+    par[_TOL] = GAP_TOLERANCE * sys.g
+    par[_VMIN] = MIN_APPROACH_SPEED
+    hg = 2.0 * math.pi / Omega / N
+    par[_HG] = hg
+    par[_ML0], par[_MR0] = abs(Wl) * Omega**2, abs(Wr) * Omega**2
+    par[_SCZ] = atol
+    par[_SCZD] = atol * omega[0]
+    par[_HMAX] = h_max
+    tr_g = np.empty((4, n))
+    fa_g = np.empty((2, n))
+    fb_g = np.empty((2, n))
+    _flight_coefficients(hg, Omega, modes, tr_g, fa_g, fb_g)
+    dec_g = np.exp(-sig * hg)
+    kappa_g = np.minimum(omega**2 * hg * hg / 8.0, 2.0)
+    phase = Omega * hg * np.arange(N + 1)
+    rot_g = np.vstack([np.cos(phase), np.sin(phase)])
+    return modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_g
+
+
+def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: SystemArrays,
+             record: np.ndarray | None = None, *, rtol: float = CONTACT_RTOL, grid_per_period: int = GRID_PER_PERIOD,
+             fixed_contact_step: float = 0.0, stats: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Advance y in place over `n_periods` whole excitation periods, exact between contacts (issue 5).
+
+    Integrator contract of `sim.system` (same as `sim.ode3.run_step`): y = [s, s', u_a, u_a'] at
+    excitation phase 0 (float64, length 2 n_modes + 2); Omega in rad/s; a_base in m. Returns
+    (amplitudes, impacts): per period |c_1| of q_tip in m (Sect. 5, exact quadrature) and the number of
+    contact onsets (int64).
+
+    record: optional float64 array (n_periods * M + 1, len(y)) receiving the state at M equally spaced
+    instants per period (row 0 = initial state), exactly at those instants.
+    rtol: contact-integration tolerance relative to g (per step, in m of wall/tip displacement).
+    grid_per_period: free-flight certification cells per period (rounded up to a multiple of M).
+    fixed_contact_step: > 0 replaces the error control in contacts by this fixed step in s (order studies).
+    stats: optional dict that receives the kernel's counters (grid steps, searches, contact steps, ...).
+    Raises SimulationInputError for bad arguments, SimulationDiverged for a non-finite state, an
+    indentation beyond the clearance or a stalled contact search.
+    """
+    n = sys.omega.size
+    if not isinstance(y, np.ndarray) or y.dtype != np.float64 or y.shape != (2 * n + 2,) or not y.flags.c_contiguous:
+        raise SimulationInputError(f"state y must be a contiguous float64 array of length {2 * n + 2} (2 n_modes + 2)")
+    n_periods = int(n_periods)
+    if n_periods < 1:
+        raise SimulationInputError(f"n_periods must be at least 1, got {n_periods}")
+    Omega = float(Omega)
+    a_base = float(a_base)
+    if not math.isfinite(Omega) or Omega <= 0:
+        raise SimulationInputError(f"excitation frequency Omega must be positive (rad/s), got {Omega!r}")
+    if not math.isfinite(a_base) or a_base < 0:
+        raise SimulationInputError(f"base amplitude a_base must be >= 0 (m), got {a_base!r}")
+    rtol = float(rtol)
+    if not math.isfinite(rtol) or not 0.0 < rtol < 1e-2:
+        raise SimulationInputError(f"rtol must lie in (0, 0.01), got {rtol!r}")
+    if not np.all(np.isfinite(y)):
+        raise SimulationInputError("state y contains non-finite values")
+    if not (sys.m_a > 0 and sys.k_H > 0 and sys.g > 0):
+        raise SimulationInputError("sphere mass, k_H and clearance g must be positive")
+    samples = 1
+    record_arr = np.empty((0, 2 * n + 2))
+    if record is not None:
+        rows = record.shape[0] - 1 if record.ndim == 2 else -1
+        if (record.dtype != np.float64 or record.ndim != 2 or record.shape[1] != 2 * n + 2 or rows < n_periods
+                or rows % n_periods or not record.flags.c_contiguous):
+            raise SimulationInputError(
+                f"record must be a contiguous float64 array of shape (n_periods * M + 1, {2 * n + 2})")
+        record_arr = record
+        samples = rows // n_periods
+    N = max(int(grid_per_period), samples)
+    N = -(-N // samples) * samples
+    omega_max = float(np.max(sys.omega))
+    h_max = 0.5 / omega_max  # keeps DOPRI5 far inside its stability region on the highest mode
+    modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_g = _prepare(Omega, a_base, sys, N, rtol, h_max)
+    amplitudes = np.empty(n_periods)
+    impacts = np.zeros(n_periods, dtype=np.int64)
+    counters = np.zeros(_N_COUNT, dtype=np.int64)
+    status, period = _advance(y, n_periods, N, modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_g, record_arr,
+                              N // samples, amplitudes, impacts, counters, float(fixed_contact_step))
+    if stats is not None:
+        names = ("grid_steps", "searches", "search_evaluations", "contact_steps", "rejected_steps",
+                 "release_iterations", "contacts")
+        for name, value in zip(names, counters):
+            stats[name] = stats.get(name, 0) + int(value)
+    if status != _OK:
+        why = {_NONFINITE: "non-finite state", _OVERLAP: "an indentation larger than the clearance",
+               _STALLED: "a contact search or contact phase that did not progress"}[status]
+        raise SimulationDiverged(
+            f"exact integrator failed in period {period + 1} of this step ({why}); check k_H, g and the level")
+    return amplitudes, impacts
