@@ -1,0 +1,136 @@
+"""The sphere-over-scan gap map: exact geometry, domain sizing, and k_H (BEM) invariances of Sect. 4.1."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from scans import (
+    FLAT_WALL,
+    PAPER_CRATER,
+    ScanError,
+    Sphere,
+    example_path,
+    level_scan,
+    read_scan,
+    scan_contact,
+    synthetic_scan,
+    write_scan,
+)
+from scans.examples import EXAMPLES
+
+R = 7.92e-3
+DELTA_MAX = 40e-6
+
+
+def test_flat_scan_gives_bem_contacts_sphere_gap_exactly():
+    from bem_contact import sphere_gap
+
+    contact = scan_contact(level_scan(synthetic_scan(FLAT_WALL, side=3e-3)), Sphere(R))
+    for n in (31, 64):
+        gap, dx = contact.gap_at(n)
+        reference, dx_ref = sphere_gap(n, contact.side, R, shape="sphere")
+        assert dx == dx_ref
+        np.testing.assert_allclose(gap, reference, rtol=0, atol=1e-15)
+        assert contact.holes[n].n_nodes == 0
+
+
+def test_domain_holds_every_point_that_can_touch():
+    contact = scan_contact(level_scan(synthetic_scan(FLAT_WALL, side=3e-3, triangle=20e-6)), Sphere(R), margin=1.15)
+    # on a flat wall {gap <= delta} is the disc r^2 / (R + sqrt(R^2 - r^2)) <= delta
+    exact = math.sqrt(DELTA_MAX * (2 * R - DELTA_MAX))
+    assert contact.reach == pytest.approx(exact, abs=2 * 20e-6)
+    assert contact.side == pytest.approx(1.15 * 2 * contact.reach)
+
+
+def test_flattened_sphere_has_a_flat_disc_of_the_right_size():
+    f = 0.02e-3
+    sphere = Sphere(R, flattening=f)
+    assert sphere.flat_radius == pytest.approx(math.sqrt(f * (2 * R - f)), rel=1e-14)
+    r = np.array([0.0, 0.5 * sphere.flat_radius, 0.999 * sphere.flat_radius, 1.2 * sphere.flat_radius])
+    ideal = Sphere(R).surface(r**2)
+    np.testing.assert_allclose(sphere.surface(r**2), np.maximum(ideal - f, 0.0), atol=1e-18)
+    assert "flattened sphere" in sphere.describe() and "ideal sphere" in Sphere(R).describe()
+    contact = scan_contact(level_scan(synthetic_scan(FLAT_WALL, side=3e-3)), sphere)
+    gap, dx = contact.gap_at(64)
+    assert (gap == 0).sum() * dx * dx == pytest.approx(math.pi * sphere.flat_radius**2, rel=0.1)
+
+
+def test_bad_geometry_is_refused():
+    surface = level_scan(synthetic_scan(FLAT_WALL, side=1.2e-3, triangle=20e-6))
+    with pytest.raises(ScanError, match="edge of the scanned area"):
+        scan_contact(surface, Sphere(R))  # a 1.6 mm contact bound on a 1.2 mm scan
+    big = level_scan(synthetic_scan(PAPER_CRATER, side=4e-3))
+    with pytest.raises(ScanError, match="smaller than the region"):
+        scan_contact(big, Sphere(R), side=1.0e-3)
+    with pytest.raises(ScanError, match="placement"):
+        scan_contact(big, Sphere(R), placement="middle")
+    with pytest.raises(ScanError):
+        Sphere(R, flattening=-1e-6)
+
+
+def test_centroid_and_deepest_placements_agree_on_a_round_crater():
+    surface = level_scan(synthetic_scan(PAPER_CRATER, side=4e-3, noise=0.05e-6))
+    a = scan_contact(surface, placement="centroid")
+    b = scan_contact(surface, placement="deepest")
+    assert math.dist(a.centre, b.centre) < 2 * surface.pitch
+
+
+# ---- k_H through the BEM (bem_contact.calibrate_k_H) ------------------------------------------------------
+
+GRID = 96
+DELTAS = np.linspace(2e-6, 40e-6, 10)
+
+
+def k_H_ratio(scan, imprint=False, sphere=Sphere(R)):
+    from bem_contact import BRASS, STEEL, contact_modulus
+    from bem_contact.calibration import calibrate_k_H
+
+    contact = scan_contact(level_scan(scan, imprint=imprint), sphere)
+    return calibrate_k_H(contact.gap_at, GRID, contact_modulus(STEEL, BRASS), DELTAS, R=R).k_H_ratio
+
+
+def test_shipped_flat_wall_gives_eq_8_within_one_percent():
+    ratio = k_H_ratio(read_scan(example_path("flat")))
+    assert abs(ratio - 1.0) <= 0.01
+
+
+def test_shipped_crater_is_about_as_stiff_as_the_papers():
+    crater = k_H_ratio(read_scan(example_path("crater")))
+    imprint = k_H_ratio(read_scan(example_path("imprint")), imprint=EXAMPLES["imprint"][1])
+    assert 1.42 <= crater <= 1.62  # paper: 1.52 (ideal sphere)
+    assert imprint == pytest.approx(crater, rel=0.01)
+
+
+# one synthetic crater seen by different scans; k_H must not change by 1 % or more (issue 3)
+BASE = dict(side=4e-3, triangle=30e-6, seed=21)
+VARIANTS = {
+    "tilted 5 deg": dict(tilt_deg=5.0, tilt_azimuth_deg=35.0),
+    "shifted": dict(shift=(7e-3, -3e-3, 12e-3)),
+    "rotated 37 deg about the normal": dict(rotation_deg=37.0),
+    "noise 0.1 um": dict(noise=0.1e-6),
+    "meshed 2x finer": dict(triangle=15e-6),
+    "meshed 2x coarser": dict(triangle=60e-6),
+    "imprint": dict(orientation="imprint"),
+}
+
+
+@pytest.fixture(scope="module")
+def base_ratio():
+    return k_H_ratio(synthetic_scan(PAPER_CRATER, **BASE))
+
+
+@pytest.mark.parametrize("name", VARIANTS)
+def test_k_H_is_invariant_to_how_the_crater_was_scanned(base_ratio, name):
+    kwargs = {**BASE, **VARIANTS[name]}
+    ratio = k_H_ratio(synthetic_scan(PAPER_CRATER, **kwargs), imprint=kwargs.get("orientation") == "imprint")
+    assert abs(ratio / base_ratio - 1.0) < 0.01, f"{name}: {ratio:.4f} vs {base_ratio:.4f}"
+
+
+def test_k_H_is_the_same_from_a_file_in_m_and_in_mm(tmp_path, base_ratio):
+    scan = synthetic_scan(PAPER_CRATER, **BASE)
+    in_m = read_scan(write_scan(tmp_path / "m.stl", scan.vertices, scan.faces, units="m"), units="m")
+    in_mm = read_scan(write_scan(tmp_path / "mm.stl", scan.vertices, scan.faces, units="mm"), units="mm")
+    assert k_H_ratio(in_m) == pytest.approx(k_H_ratio(in_mm), rel=1e-4)
+    assert k_H_ratio(in_mm) == pytest.approx(base_ratio, rel=1e-3)
