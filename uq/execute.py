@@ -91,6 +91,8 @@ def _runs_rows(results: dict, points: Sequence[dict], study: Study, outputs: Seq
 def _start(study: Study, out: Path | None, resume: bool) -> tuple[Any, Path, StudyResult]:
     model = study.make_model()
     model.check()
+    if hasattr(model, "with_rig"):
+        model = model.with_rig()
     folder = prepare_output(out or study.output, resume=resume)
     return model, folder, StudyResult(folder)
 

@@ -40,6 +40,8 @@ class Task:
 
 
 def _describe(model: Any) -> Any:
+    if hasattr(model, "describe"):
+        return model.describe()
     if is_dataclass(model):
         return {"class": type(model).__name__, **{k: v for k, v in asdict(model).items()}}
     return repr(model)
