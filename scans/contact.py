@@ -28,8 +28,8 @@ import numpy as np
 import scipy.ndimage as ndi
 
 from scans.errors import ScanError
-from scans.raster import HoleReport
-from scans.surface import LevelledSurface
+from scans.raster import HoleReport, fill_holes
+from scans.surface import LevelledSurface, outside_scan
 
 #: the IES radius (Sect. 4.1: nominal diameter 15.84 mm)
 PAPER_RADIUS = 7.92e-3
@@ -130,8 +130,10 @@ def scan_contact(
     if not (math.isfinite(delta_max) and delta_max > 0):
         raise ScanError(f"largest indentation {delta_max!r} m must be > 0 (paper: 40e-6)")
     centre = surface.centre if placement == "centroid" else surface.deepest
-    overview, pitch = surface.overview, surface.pitch
-    valid = np.isfinite(overview)
+    pitch = surface.pitch
+    # scanner dropouts inside the scan are filled; only what lies beyond the scan's outline is unknown
+    valid = ~outside_scan(surface.overview)
+    overview, _ = fill_holes(surface.overview, pitch)
     yy, xx = np.mgrid[0 : overview.shape[0], 0 : overview.shape[1]]
     dx_c, dy_c = surface.x0 + xx * pitch - centre[0], surface.y0 + yy * pitch - centre[1]
     gap = np.where(valid, sphere.surface(dx_c**2 + dy_c**2) - np.where(valid, overview, 0.0), np.inf)

@@ -3,7 +3,7 @@
 Each grid node takes the height of the scan's own triangle above it (linear interpolation inside the
 triangle, the scanner's surface as delivered); where several triangles cover a node (a fold or an
 overlap) the highest wins, the side the sphere sees. Nodes no triangle covers are holes; they are
-filled by harmonic (Laplace) interpolation from the surrounding surface and reported.
+filled from the surrounding surface (local quadratic plus harmonic correction) and reported.
 """
 from __future__ import annotations
 
@@ -68,7 +68,7 @@ class HoleReport:
     n_holes: int
     n_nodes: int
     largest: float
-    method: str = "harmonic (Laplace) interpolation from the surrounding surface"
+    method: str = "a quadratic fitted around each hole plus a harmonic (Laplace) correction"
 
     def describe(self) -> str:
         """One line for the command output."""
@@ -78,10 +78,14 @@ class HoleReport:
                 f"filled by {self.method}")
 
 
-def fill_holes(height: np.ndarray, dx: float) -> tuple[np.ndarray, HoleReport]:
-    """Fill NaN nodes by solving Laplace's equation with the known nodes as boundary values.
+def fill_holes(height: np.ndarray, dx: float, ring: int = 3) -> tuple[np.ndarray, HoleReport]:
+    """Fill the NaN nodes of a height map, hole by hole, and report them.
 
-    Returns the filled map and a :class:`HoleReport`. Grid edges act as zero-flux boundaries.
+    For each connected hole: a quadratic surface is fitted by least squares to the known nodes within
+    `ring` nodes of it, and the departure from that quadratic is interpolated harmonically (discrete
+    Laplace equation, known nodes as boundary values, zero flux across the map's edge). Quadratics and
+    discrete-harmonic surfaces are reproduced exactly; a crater's curved bottom is not flattened, as a
+    plain Laplace fill would do (by curvature x radius^2 / 2).
     """
     missing = ~np.isfinite(height)
     if not missing.any():
@@ -89,31 +93,60 @@ def fill_holes(height: np.ndarray, dx: float) -> tuple[np.ndarray, HoleReport]:
     if missing.all():
         raise ValueError("no valid height on the grid")
     labels, n_holes = ndi.label(missing)
+    filled = height.copy()
+    for k, box in enumerate(ndi.find_objects(labels), start=1):
+        rows = slice(max(box[0].start - ring, 0), min(box[0].stop + ring, height.shape[0]))
+        cols = slice(max(box[1].start - ring, 0), min(box[1].stop + ring, height.shape[1]))
+        hole = labels[rows, cols] == k
+        window = height[rows, cols]
+        near = ndi.binary_dilation(hole, iterations=ring) & np.isfinite(window)
+        jj, ii = np.mgrid[rows, cols]
+        base = _quadratic_fit(ii[near], jj[near], window[near], ii, jj)
+        residual = np.where(np.isfinite(window), window - base, 0.0)
+        filled[rows, cols] = np.where(hole, base + _laplace_fill(residual, hole, rows.start == 0, cols.start == 0,
+                                                                 rows.stop == height.shape[0], cols.stop == height.shape[1]),
+                                      filled[rows, cols])
     sizes = np.bincount(labels.ravel())[1:]
-    ny, nx = height.shape
-    index = -np.ones(height.shape, dtype=np.int64)
-    index[missing] = np.arange(missing.sum())
-    rows, cols, vals = [], [], []
-    rhs = np.zeros(missing.sum())
-    jj, ii = np.nonzero(missing)
+    largest = 2.0 * np.sqrt(sizes.max() * dx * dx / np.pi)
+    return filled, HoleReport(int(n_holes), int(missing.sum()), float(largest))
+
+
+def _quadratic_fit(i: np.ndarray, j: np.ndarray, h: np.ndarray, ii: np.ndarray, jj: np.ndarray) -> np.ndarray:
+    """Least-squares quadratic (or lower order if too few points) through (i, j, h), evaluated at (ii, jj)."""
+    i0, j0 = i.mean(), j.mean()
+    terms = [lambda a, b: np.ones_like(a, dtype=float), lambda a, b: a - i0, lambda a, b: b - j0,
+             lambda a, b: (a - i0) ** 2, lambda a, b: (a - i0) * (b - j0), lambda a, b: (b - j0) ** 2]
+    use = 6 if h.size >= 12 else 3 if h.size >= 3 else 1
+    design = np.column_stack([t(i, j) for t in terms[:use]])
+    coef = np.linalg.lstsq(design, h, rcond=None)[0]
+    return sum(c * t(ii, jj) for c, t in zip(coef, terms[:use]))
+
+
+def _laplace_fill(values: np.ndarray, hole: np.ndarray, *_edges: bool) -> np.ndarray:
+    """Solve the 5-point Laplace equation on `hole` with `values` elsewhere (zero flux at the window edge)."""
+    ny, nx = values.shape
+    index = -np.ones(values.shape, dtype=np.int64)
+    index[hole] = np.arange(hole.sum())
+    jj, ii = np.nonzero(hole)
     unknown = index[jj, ii]
+    rows, cols, vals = [], [], []
+    rhs = np.zeros(unknown.size)
     degree = np.zeros(unknown.size)
     for dj, di in ((1, 0), (-1, 0), (0, 1), (0, -1)):
         nj, ni = jj + dj, ii + di
         inside = (nj >= 0) & (nj < ny) & (ni >= 0) & (ni < nx)
         degree += inside
         nj_c, ni_c = np.clip(nj, 0, ny - 1), np.clip(ni, 0, nx - 1)
-        neighbour_missing = inside & missing[nj_c, ni_c]
-        known = inside & ~missing[nj_c, ni_c]
-        rows.append(unknown[neighbour_missing])
-        cols.append(index[nj_c, ni_c][neighbour_missing])
-        vals.append(-np.ones(neighbour_missing.sum()))
-        np.add.at(rhs, unknown[known], height[nj_c, ni_c][known])
+        other_hole = inside & hole[nj_c, ni_c]
+        known = inside & ~hole[nj_c, ni_c]
+        rows.append(unknown[other_hole])
+        cols.append(index[nj_c, ni_c][other_hole])
+        vals.append(-np.ones(other_hole.sum()))
+        np.add.at(rhs, unknown[known], values[nj_c, ni_c][known])
     rows.append(unknown)
     cols.append(unknown)
     vals.append(degree)
     matrix = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(unknown.size,) * 2)
-    filled = height.copy()
-    filled[jj, ii] = spla.spsolve(matrix.tocsc(), rhs)
-    largest = 2.0 * np.sqrt(sizes.max() * dx * dx / np.pi)
-    return filled, HoleReport(int(n_holes), int(missing.sum()), float(largest))
+    out = np.zeros(values.shape)
+    out[hole] = spla.spsolve(matrix.tocsc(), rhs) if unknown.size > 1 else rhs / degree
+    return out

@@ -85,10 +85,7 @@ class LevelledSurface:
         height = rasterize(self.points, self.faces, centre[0] + start, centre[1] + start, dx, n, n).T
         missing = ~np.isfinite(height)
         if missing.any():
-            labels, _ = ndi.label(missing)
-            border = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
-            border = border[border > 0]
-            if border.size and np.isin(labels, border).sum() > 0.02 * n * n:
+            if outside_scan(height).sum() > 0.02 * n * n:
                 raise ScanError(
                     f"{self.source}: the {side * 1e3:.3g} mm grid around the crater reaches beyond the scanned area; "
                     "scan a larger area around the crater or use a smaller grid side"
@@ -156,6 +153,16 @@ def level_scan(scan: Scan, imprint: bool = False, iterations: int = 3) -> Levell
         centre=found["centre"], deepest=found["deepest"], flat_fraction=flat_fraction, imprint=imprint,
         source=scan.source,
     )
+
+
+def outside_scan(height: np.ndarray) -> np.ndarray:
+    """Mask of the missing (NaN) pixels connected to the map's border: beyond the scan's outline.
+
+    Missing pixels enclosed by scanned ones are dropouts (holes) to be filled, not outside.
+    """
+    labels, _ = ndi.label(~np.isfinite(height))
+    border = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
+    return np.isin(labels, border[border > 0])
 
 
 def _frame(normal: np.ndarray) -> np.ndarray:

@@ -71,6 +71,7 @@ def synthetic_scan(
     shift: tuple[float, float, float] = (0.0, 0.0, 0.0),
     crater_offset: tuple[float, float] = (0.0, 0.0),
     orientation: str = "crater",
+    dropouts: tuple[tuple[float, float, float], ...] = (),
     seed: int = 0,
 ) -> Scan:
     """A scanned patch (side x side, m) of a wall with `shape`, as a triangle mesh in metres.
@@ -78,7 +79,9 @@ def synthetic_scan(
     triangle: grid spacing (m); noise: standard deviation (m) along the normal; jitter: lateral node
     jitter as a fraction of `triangle`; tilt_deg about the in-plane axis at tilt_azimuth_deg;
     rotation_deg about the normal; shift (m) of the whole scan; crater_offset: crater centre in the
-    patch (m); orientation: "crater" (the wall) or "imprint" (its resin cast); seed: the random seed.
+    patch (m); orientation: "crater" (the wall) or "imprint" (its resin cast); dropouts: discs (x, y,
+    radius) in m, in the patch's frame, where the scanner saw nothing (their triangles are removed);
+    seed: the random seed.
     """
     if orientation not in ("crater", "imprint"):
         raise ScanError(f"orientation must be 'crater' or 'imprint', got {orientation!r}")
@@ -98,6 +101,9 @@ def synthetic_scan(
     idx = np.arange(n * n).reshape(n, n)
     a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(), idx[1:, :-1].ravel()
     faces = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])  # counter-clockwise: +z out
+    for hx, hy, hr in dropouts:
+        centroid = vertices[faces].mean(axis=1)
+        faces = faces[np.hypot(centroid[:, 0] - hx, centroid[:, 1] - hy) > hr]
     if orientation == "imprint":
         vertices = vertices * np.array([1.0, -1.0, -1.0])  # 180 deg about x: the cast taken out and turned over
         faces = faces[:, ::-1]  # the resin's outward side is the other side of the same surface

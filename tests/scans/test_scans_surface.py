@@ -34,10 +34,22 @@ def test_rasterize_is_exact_for_a_plane_and_leaves_uncovered_nodes_nan():
     assert not covered[0, 0] and not covered[-1, -1]  # outside the convex hull of the points
 
 
-def test_fill_holes_is_exact_for_a_discrete_harmonic_surface():
-    # x^2 - y^2 + linear terms satisfies the 5-point Laplace equation exactly
+def test_fill_holes_is_exact_for_quadratics_even_at_the_edge():
+    # a crater's bottom is curved: a plain Laplace fill would flatten it, this fill must not
     x = np.arange(40.0)
-    h = x[None, :] ** 2 - x[:, None] ** 2 + 3 * x[None, :] - 2 * x[:, None]
+    h = 0.3 * x[None, :] ** 2 + 0.1 * x[:, None] ** 2 + 0.05 * x[None, :] * x[:, None] + 3 * x[None, :]
+    holed = h.copy()
+    holed[10:14, 5:9] = np.nan
+    holed[0:3, 0:2] = np.nan
+    filled, report = fill_holes(holed, dx=1e-5)
+    np.testing.assert_allclose(filled, h, rtol=0, atol=1e-12 * np.abs(h).max())
+    assert report.n_holes == 2
+
+
+def test_fill_holes_is_exact_for_a_discrete_harmonic_surface():
+    # a cubic harmonic, x^3 - 3 x y^2, satisfies the 5-point Laplace equation exactly; no quadratic fits it
+    x = np.arange(40.0) - 20.0
+    h = x[None, :] ** 3 - 3 * x[None, :] * x[:, None] ** 2
     holed = h.copy()
     holed[10:14, 5:9] = np.nan
     holed[25, 30] = np.nan
