@@ -1,22 +1,41 @@
 """Boundary-element contact of elastic half-spaces (seed paper, Sect. 4.1, Eq. 8, Fig. 3).
 
-Public API:
-  materials: Material, STEEL, BRASS (Table 1), contact_modulus (E*), tangential_modulus (G*), k_H_star (Eq. 8)
-  geometry: sphere_gap (ideal sphere/paraboloid on a flat wall)
-  influence: normal_operator (Love/Boussinesq), TangentialOperator (Cerruti), ConvolutionOperator
-  solvers: solve_contact -> ContactResult, SOLVERS (by name)
-  calibration: calibrate_k_H -> Calibration (force-indentation curve, k_H fit, error bar)
-  tangential: tangential_stiffness (stuck contact, Cerruti) vs Mindlin k_t = 8 G* a
+Public API (imported lazily, so that `import bem_contact.errors` stays light for the CLI):
+  materials:   Material, STEEL, BRASS (Table 1), contact_modulus (E*), tangential_modulus (G*), k_H_star (Eq. 8)
+  geometry:    sphere_gap (ideal sphere or paraboloid on a flat wall)
+  hertz:       hertz_force, hertz_radius, hertz_pressure, mindlin_tangential_stiffness (analytic references)
+  influence:   normal_operator (Love/Boussinesq), TangentialOperator (Cerruti), ConvolutionOperator
+  solvers:     solve_contact -> ContactResult, SOLVERS (by name)
+  calibration: calibrate_k_H -> Calibration (force-indentation curve, k_H fit, grid-refinement error bar)
+  tangential:  tangential_stiffness (stuck contact, Cerruti), checked against Mindlin k_t = 8 G* a
 """
-from bem_contact.errors import ContactInputError, ConvergenceError
-from bem_contact.geometry import sphere_gap
-from bem_contact.hertz import hertz_force, hertz_pressure, hertz_radius, mindlin_tangential_stiffness
-from bem_contact.influence import ConvolutionOperator, TangentialOperator, normal_operator
-from bem_contact.materials import BRASS, STEEL, Material, contact_modulus, k_H_star, tangential_modulus
-from bem_contact.solvers import SOLVERS, ContactResult, solve_contact
+from __future__ import annotations
 
-__all__ = [
-    "BRASS", "STEEL", "SOLVERS", "ContactInputError", "ContactResult", "ConvergenceError", "ConvolutionOperator",
-    "Material", "TangentialOperator", "contact_modulus", "hertz_force", "hertz_pressure", "hertz_radius",
-    "k_H_star", "mindlin_tangential_stiffness", "normal_operator", "solve_contact", "sphere_gap", "tangential_modulus",
-]
+import importlib
+from typing import Any
+
+from bem_contact.errors import ContactInputError, ConvergenceError
+
+_EXPORTS = {
+    "Material": "materials", "STEEL": "materials", "BRASS": "materials", "contact_modulus": "materials",
+    "tangential_modulus": "materials", "k_H_star": "materials",
+    "sphere_gap": "geometry",
+    "hertz_force": "hertz", "hertz_radius": "hertz", "hertz_pressure": "hertz",
+    "hertz_indentation_from_force": "hertz", "mindlin_tangential_stiffness": "hertz",
+    "ConvolutionOperator": "influence", "TangentialOperator": "influence", "normal_operator": "influence",
+    "solve_contact": "solvers", "ContactResult": "solvers", "SOLVERS": "solvers",
+    "calibrate_k_H": "calibration", "Calibration": "calibration", "force_curve": "calibration", "fit_k_H": "calibration",
+    "tangential_stiffness": "tangential", "sphere_tangential_stiffness": "tangential",
+}
+
+__all__ = ["ContactInputError", "ConvergenceError", *_EXPORTS]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        return getattr(importlib.import_module(f"bem_contact.{_EXPORTS[name]}"), name)
+    raise AttributeError(f"module 'bem_contact' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

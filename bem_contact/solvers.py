@@ -37,6 +37,7 @@ from typing import Callable
 
 import numpy as np
 
+from bem_contact import _pk_kernels as _k
 from bem_contact.errors import ContactInputError, ConvergenceError
 from bem_contact.influence import ConvolutionOperator, love_kernel
 
@@ -169,11 +170,14 @@ def _validate(gap: np.ndarray, dx: float, E_star: float, indentation, force, sol
     return h - h.min(), solver
 
 
-def _candidate_box(h: np.ndarray, delta: float) -> tuple[slice, slice]:
-    """Bounding box of the elements that can touch at approach delta (h < delta)."""
-    rows = np.flatnonzero((h < delta).any(axis=1))
-    cols = np.flatnonzero((h < delta).any(axis=0))
-    return slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1)
+def _candidate_box(h: np.ndarray, level: float, margin: int = 0) -> tuple[slice, slice]:
+    """Bounding box of the elements with h < level, widened by `margin` elements on each side."""
+    rows = np.flatnonzero((h < level).any(axis=1))
+    cols = np.flatnonzero((h < level).any(axis=0))
+    return (
+        slice(max(rows[0] - margin, 0), min(rows[-1] + 1 + margin, h.shape[0])),
+        slice(max(cols[0] - margin, 0), min(cols[-1] + 1 + margin, h.shape[1])),
+    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -215,46 +219,48 @@ def polonsky_keer(
             d = np.maximum(delta - h, 0.0)
             Kd = op(d)
             scale = float(np.sum(d * (delta - h))) / float(np.sum(d * Kd))
-    p = scale * d
-    u = scale * Kd
+    p = np.ascontiguousarray(scale * d)
+    u = np.ascontiguousarray(scale * Kd)
+    h = np.ascontiguousarray(h, dtype=float)
+    g = np.empty_like(h)
     t = np.zeros_like(h)
     G_old = 1.0
     restart = True
     residual = math.inf
     iterations = 0
+    exact = True  # u = K p to round-off; False after cheap incremental updates
+    since_exact = 0
     while True:
-        contact = p > 0
         if load_control:
-            delta = float(np.mean((h + u)[contact]))
-        g = h + u - delta
-        residual = float(np.max(np.abs(np.minimum(p * kii, g)))) / delta
+            delta = _k.contact_mean(h, u, p)
+        worst, G = _k.gap_and_residual(h, u, p, delta, kii, g)
+        residual = worst / delta
         if residual <= tol or iterations >= maxiter:
-            break
+            if exact:
+                break
+            u, exact, since_exact = np.ascontiguousarray(op(p)), True, 0  # confirm on the exact displacement
+            continue
         iterations += 1
-        g_c = np.where(contact, g, 0.0)
-        G = float(np.dot(g_c.ravel(), g_c.ravel()))
-        if restart:
-            t = g_c
-        else:
-            t = g_c + (G / G_old) * np.where(contact, t, 0.0)
+        _k.conjugate_direction(g, p, t, 0.0 if restart else G / G_old)
         G_old = G
-        r = op(t)
+        Kt = np.ascontiguousarray(op(t))
+        rt, gt, st, sk, count = _k.step_sums(Kt, t, g, p)
         if load_control:
-            r -= np.mean(r[contact])
-        rt = float(np.sum(np.where(contact, r * t, 0.0)))
+            rt -= sk / count * st  # the gradient's mean over the contact is the load multiplier
         if rt <= 0:  # direction of no curvature: restart from steepest descent
             restart = True
             continue
-        tau = float(np.sum(g_c * t)) / rt
-        p -= tau * t
-        np.maximum(p, 0.0, out=p)
-        overlap = (p == 0) & (g < 0)
-        restart = bool(overlap.any())
-        if restart:
-            p[overlap] -= tau * g[overlap]
-        if load_control:
-            p *= force / (area * p.sum())
-        u = op(p)
+        tau = gt / rt
+        clipped, overlap, total = _k.update_pressure(p, t, g, tau)
+        restart = overlap > 0
+        scale = force / (area * total) if load_control else 1.0
+        if scale != 1.0:
+            p *= scale
+        if restart or clipped or since_exact >= 50:
+            u, exact, since_exact = np.ascontiguousarray(op(p)), True, 0
+        else:
+            _k.linear_update(u, Kt, tau, scale)  # the step was linear: K p_new = K p - tau K t
+            exact, since_exact = False, since_exact + 1
     return p, u, float(delta), iterations, residual
 
 
@@ -330,33 +336,59 @@ _DENSE: dict[str, Callable[..., tuple[np.ndarray, int]]] = {"al-jacobi": _al_jac
 # the entry point
 
 
-def _solve_indentation(h, dx, E_star, delta, solver, tol, x0, maxiter, workers):
-    """Displacement control on the candidate box; returns (p, iterations) on the full grid."""
-    rows, cols = _candidate_box(h, delta)
+# A smooth contact ends near h = delta / 2 (exactly so for Hertz); "pk" first solves on this smaller box
+# and falls back to the full candidate box only if the check there finds a penetration.
+_INNER_LEVEL = 0.6
+_INNER_MARGIN = 2
+
+
+def _solve_on_box(h, dx, E_star, delta, solver, tol, x0, maxiter, workers, box):
+    """Displacement control restricted to `box`; returns (pressure on the box, iterations)."""
+    rows, cols = box
     hs = h[rows, cols]
     op = normal_operator_cached(h.shape, dx, E_star, workers).restricted(*hs.shape)
     x0s = None if x0 is None else np.asarray(x0, dtype=float)[rows, cols]
     if solver == "pk":
         ps, _, _, iterations, _ = polonsky_keer(op, hs, delta=delta, area=dx * dx, x0=x0s, tol=tol, maxiter=maxiter)
-    else:
-        idx = np.flatnonzero(hs.ravel() < delta)
-        unit_p = delta * E_star / dx  # pressures in this unit, lengths in delta: K becomes O(1)
-        K = op.dense()[np.ix_(idx, idx)] * (E_star / dx)
-        b = (hs.ravel()[idx] - delta) / delta
-        start = None if x0s is None else x0s.ravel()[idx] / unit_p
-        solution, iterations = _DENSE[solver](K, b, start, tol, maxiter)
-        ps = np.zeros(hs.size)
-        ps[idx] = solution * unit_p
-        ps = ps.reshape(hs.shape)
+        return ps, iterations
+    idx = np.flatnonzero(hs.ravel() < delta)
+    unit_p = delta * E_star / dx  # pressures in this unit, lengths in delta: K becomes O(1)
+    K = op.dense()[np.ix_(idx, idx)] * (E_star / dx)
+    b = (hs.ravel()[idx] - delta) / delta
+    start = None if x0s is None else x0s.ravel()[idx] / unit_p
+    solution, iterations = _DENSE[solver](K, b, start, tol, maxiter)
+    ps = np.zeros(hs.size)
+    ps[idx] = solution * unit_p
+    return ps.reshape(hs.shape), iterations
+
+
+def _solve_indentation(h, dx, E_star, delta, solver, tol, x0, maxiter, workers):
+    """Displacement control; returns (p on the full grid, iterations, residual, complementarity error).
+
+    The accuracy measures are evaluated on the whole candidate box {h < delta}: outside it p = 0 and g > 0."""
+    full = _candidate_box(h, delta)
+    op = normal_operator_cached(h.shape, dx, E_star, workers).restricted(full[0].stop - full[0].start, full[1].stop - full[1].start)
+    boxes = [full]
+    if solver == "pk":
+        inner = _candidate_box(h, _INNER_LEVEL * delta, _INNER_MARGIN)
+        if (inner[0].stop - inner[0].start) * (inner[1].stop - inner[1].start) < 0.8 * op.shape[0] * op.shape[1]:
+            boxes.insert(0, inner)
     p = np.zeros_like(h)
-    p[rows, cols] = ps
-    return p, iterations, (rows, cols, op)
+    total = 0
+    for box in boxes:
+        ps, iterations = _solve_on_box(h, dx, E_star, delta, solver, tol, x0, maxiter, workers, box)
+        total += iterations
+        p[...] = 0.0
+        p[box] = ps
+        g = h[full] - delta + op(p[full])
+        residual, complementarity = kkt_measures(p[full], g, op.self_compliance, delta)
+        if residual <= tol:
+            break
+        x0 = p.copy()
+    return p, total, residual, complementarity
 
 
-def _finish(h, dx, E_star, p, delta, iterations, solver, tol, box, workers, maxiter, raise_on_failure):
-    rows, cols, op = box
-    g = h[rows, cols] - delta + op(p[rows, cols])
-    residual, complementarity = kkt_measures(p[rows, cols], g, op.self_compliance, delta)
+def _finish(h, dx, E_star, p, delta, iterations, residual, complementarity, solver, tol, workers, maxiter, raise_on_failure):
     converged = residual <= tol
     if not converged and raise_on_failure:
         raise ConvergenceError(
@@ -414,16 +446,16 @@ def solve_contact(
         raise ContactInputError(f"tol = {tol!r} must be > 0")
 
     if indentation is not None:
-        p, iterations, box = _solve_indentation(h, dx, E_star, float(indentation), solver, tol, x0, maxiter, workers)
-        return _finish(h, dx, E_star, p, float(indentation), iterations, solver, tol, box, workers, maxiter, raise_on_failure)
+        p, iterations, residual, compl = _solve_indentation(h, dx, E_star, float(indentation), solver, tol, x0, maxiter, workers)
+        return _finish(h, dx, E_star, p, float(indentation), iterations, residual, compl, solver, tol, workers, maxiter, raise_on_failure)
 
     if solver == "pk":
         op = normal_operator_cached(h.shape, dx, E_star, workers)
         p, _, delta, iterations, _ = polonsky_keer(
             op, h, force=float(force), area=dx * dx, x0=None if x0 is None else np.asarray(x0, float), tol=tol, maxiter=maxiter
         )
-        box = (slice(None), slice(None), op)
-        return _finish(h, dx, E_star, p, delta, iterations, solver, tol, box, workers, maxiter, raise_on_failure)
+        residual, compl = kkt_measures(p, h - delta + op(p), op.self_compliance, delta)
+        return _finish(h, dx, E_star, p, delta, iterations, residual, compl, solver, tol, workers, maxiter, raise_on_failure)
     return _solve_force_by_search(h, dx, E_star, float(force), solver, tol, x0, maxiter, workers, raise_on_failure)
 
 
@@ -441,7 +473,7 @@ def _solve_force_by_search(h, dx, E_star, W, solver, tol, x0, maxiter, workers, 
     low, high = 0.0, math.inf
     total = 0
     for _ in range(60):
-        p, iterations, box = _solve_indentation(h, dx, E_star, delta, solver, tol, x0, maxiter, workers)
+        p, iterations, residual, compl = _solve_indentation(h, dx, E_star, delta, solver, tol, x0, maxiter, workers)
         total += iterations
         F = float(p.sum()) * dx * dx
         if abs(F / W - 1.0) <= tol:
@@ -458,4 +490,4 @@ def _solve_force_by_search(h, dx, E_star, W, solver, tol, x0, maxiter, workers, 
     else:
         if raise_on_failure:
             raise ConvergenceError(f"solver {solver!r}: the search for the indentation at force {W:g} N did not converge; use solver='pk'")
-    return _finish(h, dx, E_star, p, delta, total, solver, tol, box, workers, maxiter, raise_on_failure)
+    return _finish(h, dx, E_star, p, delta, total, residual, compl, solver, tol, workers, maxiter, raise_on_failure)
