@@ -8,6 +8,7 @@ import numpy as np
 from bem_contact.errors import ContactInputError
 
 SHAPES = ("paraboloid", "sphere")
+MAX_GRID = 4096  # elements across; the zero-padded FFT operator of a larger grid needs > 1 GB
 
 
 def grid_coordinates(n: int, side: float) -> tuple[np.ndarray, float]:
@@ -17,6 +18,8 @@ def grid_coordinates(n: int, side: float) -> tuple[np.ndarray, float]:
     """
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise ContactInputError(f"grid size n = {n!r} must be a whole number >= 1 (for example 256)")
+    if n > MAX_GRID:
+        raise ContactInputError(f"grid size n = {n} is too large (at most {MAX_GRID}: the FFT operator would need > 1 GB); 512 is already accurate to ~1e-5")
     if not (math.isfinite(side) and side > 0):
         raise ContactInputError(f"domain side = {side!r} m must be a finite number > 0 (for example 2.5e-3)")
     dx = side / n

@@ -60,6 +60,7 @@ SOLVERS: dict[str, SolverInfo] = {
     "cvxpy": SolverInfo("cvxpy", 32 * 32, 1e-6, 500, "cvxpy / Clarabel on the quadratic program (dense reference)"),
 }
 DEFAULT_SOLVER = "pk"
+MAX_ELEMENTS = 4096 * 4096  # the zero-padded FFT operator of a larger map needs > 1 GB
 
 
 def solver_names() -> list[str]:
@@ -143,6 +144,8 @@ def _validate(gap: np.ndarray, dx: float, E_star: float, indentation, force, sol
     h = np.asarray(gap, dtype=float)
     if h.ndim != 2 or h.size == 0:
         raise ContactInputError(f"gap map must be a non-empty 2-D array (got shape {h.shape}); give h(x, y) on a regular grid")
+    if h.size > MAX_ELEMENTS:
+        raise ContactInputError(f"gap map {h.shape[0]}x{h.shape[1]} is too large (at most {MAX_ELEMENTS} elements, e.g. 4096x4096); resample it coarser")
     if not np.isfinite(h).all():
         bad = int((~np.isfinite(h)).sum())
         raise ContactInputError(f"gap map has {bad} non-finite values (NaN/inf); fill or crop the holes before solving")
