@@ -159,7 +159,8 @@ class SweepResult:
     impacts_per_period = average contact onsets per period; regime per point ('APR', 'SMR', 'linear').
     resonant_mean, resonant_max: largest mean / max over eta (Sect. 5.2, 5.3); eta_resonant_mean/max where
     they occur; regime: the regime at eta_resonant_mean; resonant_*_samples: the resonant levels of each
-    repetition sample (their spread, for the uncertainty layer).
+    repetition sample (their spread, for the uncertainty layer); mean/max/cv/impacts_samples: the
+    (n_samples, n_eta) data behind the averages, samples ordered run by run, leg by leg.
     """
 
     eta: np.ndarray
@@ -181,6 +182,10 @@ class SweepResult:
     regime: str
     resonant_mean_samples: np.ndarray
     resonant_max_samples: np.ndarray
+    mean_samples: np.ndarray
+    max_samples: np.ndarray
+    cv_samples: np.ndarray
+    impacts_samples: np.ndarray
     n_samples: int
     n_runs: int
     level: float
@@ -196,7 +201,7 @@ class SweepResult:
             "level", "a_base", "a_noabs", "eta", "mean", "max", "mean_lo", "mean_hi", "mean_std", "max_lo",
             "max_hi", "max_std", "cv", "impacts_per_period", "regime_per_eta", "resonant_mean", "resonant_max",
             "eta_resonant_mean", "eta_resonant_max", "regime", "resonant_mean_samples", "resonant_max_samples",
-            "n_samples", "n_runs", "wall_time_s")}
+            "mean_samples", "max_samples", "cv_samples", "impacts_samples", "n_samples", "n_runs", "wall_time_s")}
         out["protocol"] = asdict(self.protocol)
         out["regime_cv_threshold"] = REGIME_CV_THRESHOLD
         out.update(self.extra)
@@ -325,7 +330,8 @@ def aggregate_runs(runs: list[SweepRun]) -> SweepResult:
         resonant_mean=float(mean[i_mean]), resonant_max=float(mx[i_max]),
         eta_resonant_mean=float(grid[i_mean]), eta_resonant_max=float(grid[i_max]), regime=regimes[i_mean],
         resonant_mean_samples=stack["mean"].max(axis=1), resonant_max_samples=stack["max"].max(axis=1),
-        n_samples=len(samples), n_runs=len(runs), level=first.level, a_base=first.a_base, a_noabs=first.a_noabs,
+        mean_samples=stack["mean"], max_samples=stack["max"], cv_samples=cv_samples,
+        impacts_samples=stack["impacts_per_period"], n_samples=len(samples), n_runs=len(runs), level=first.level, a_base=first.a_base, a_noabs=first.a_noabs,
         protocol=first.protocol, wall_time_s=float(sum(r.wall_time_s for r in runs)))
 
 
