@@ -305,7 +305,7 @@ def _osqp(K: np.ndarray, b: np.ndarray, x0: np.ndarray | None, tol: float, maxit
     problem.setup(
         P=sp.triu(sp.csc_matrix(K), format="csc"), q=b, A=sp.identity(n, format="csc"),
         l=np.zeros(n), u=np.full(n, np.inf), eps_abs=0.1 * tol, eps_rel=0.1 * tol,
-        max_iter=maxiter, polish=True, verbose=False,
+        max_iter=maxiter, polishing=True, verbose=False,
     )
     if x0 is not None:
         problem.warm_start(x=np.maximum(x0, 0.0))
@@ -321,7 +321,7 @@ def _cvxpy(K: np.ndarray, b: np.ndarray, x0: np.ndarray | None, tol: float, maxi
 
     p = cp.Variable(len(b), nonneg=True)
     problem = cp.Problem(cp.Minimize(0.5 * cp.quad_form(p, cp.psd_wrap(K)) + b @ p))
-    tight = min(1e-8, 0.01 * tol)
+    tight = min(1e-10, 0.01 * tol)
     try:
         problem.solve(solver=cp.CLARABEL, max_iter=maxiter, tol_gap_abs=tight, tol_gap_rel=tight, tol_feas=tight)
     except cp.SolverError:
