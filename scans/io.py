@@ -16,7 +16,6 @@ import io
 import os
 import tempfile
 import warnings
-import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -178,7 +177,7 @@ def _read_array(path: Path, pixel_size: float | None) -> tuple[np.ndarray, np.nd
                 arrays = {k: loaded[k] for k in loaded.files}
         else:
             arrays = {"height": loaded}
-    except (ValueError, OSError, EOFError, zipfile.BadZipFile, KeyError) as exc:
+    except Exception as exc:  # numpy raises ValueError, OSError, EOFError, TokenError, BadZipFile, ... on corrupt files
         raise ScanError(f"{path.name}: cannot read as {path.suffix} array ({_short(exc)}); the file is corrupt or truncated") from None
     height = next((arrays[k] for k in ("height", "heights", "z", "h") if k in arrays), None)
     if height is None and len(arrays) == 1:

@@ -120,6 +120,8 @@ def level_scan(scan: Scan, imprint: bool = False, iterations: int = 3) -> Levell
     outward = _outward_hint(vertices, scan.faces)
     if normal @ outward < 0:
         normal = -normal
+    if scan.faces is not None:
+        _check_one_sided(vertices, scan.faces, normal, scan.source)
     if imprint:
         normal = -normal
     axes = _frame(normal)
@@ -183,6 +185,19 @@ def _outward_hint(vertices: np.ndarray, faces: np.ndarray | None) -> np.ndarray:
         if area2 > 0 and np.linalg.norm(mean) > 0.1 * area2:
             return mean
     return np.array([0.0, 0.0, 1.0])
+
+
+def _check_one_sided(vertices: np.ndarray, faces: np.ndarray, outward: np.ndarray, source: str) -> None:
+    """Refuse a mesh that is not one surface seen from one side (a closed body, a folded or two-sided scan)."""
+    tri = vertices[faces]
+    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area = np.linalg.norm(normals, axis=1)
+    away = float(area[normals @ outward < 0].sum() / max(area.sum(), 1e-300))
+    if away > 0.05:
+        raise ScanError(
+            f"{source}: {100 * away:.0f}% of the surface faces away from the wall (a closed body, or sides and back "
+            "scanned too); crop the scan to the wall around the crater"
+        )
 
 
 def _triangulate(u: np.ndarray, v: np.ndarray, source: str) -> np.ndarray:

@@ -139,3 +139,13 @@ def test_clearance_bounds_reproduce_the_paper():
     assert lo == pytest.approx(0.58e-3) and hi == pytest.approx(0.612e-3, rel=1e-12)
     with pytest.raises(ScanError):
         clearance_bounds(-1e-6, 0.0, 0.58e-3)
+
+
+def test_a_closed_body_is_refused():
+    import trimesh
+
+    from scans import Scan
+
+    box = trimesh.creation.box(extents=(4e-3, 4e-3, 1e-3))
+    with pytest.raises(ScanError, match="faces away from the wall"):
+        level_scan(Scan(np.asarray(box.vertices), np.asarray(box.faces, dtype=np.int64), "mesh", "box.stl"))
