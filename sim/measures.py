@@ -21,8 +21,9 @@ import numpy as np
 from sim.system import ModalModel, Nominal
 
 #: cv = std/mean of the per-period amplitudes above which the response counts as strongly modulated.
-#: Chosen from simulations at a_base/a_base* = 7.4 (Fig. 4): APR at eta = 0.976 has cv ~ 0.01-0.03,
-#: SMR at eta = 0.99 has cv ~ 0.3-0.6; 0.1 separates them with a wide margin either way.
+#: Chosen from simulations of the rig model at a_base/a_base* = 7.4 (Fig. 4; down-sweep, 3 runs): inside the
+#: APR branch (eta = 0.976-0.980) cv = 0.02-0.05, in the SMR (eta = 0.984-1.006) cv = 0.24-0.55; points at
+#: the edge of the APR branch fall in between (0.09-0.14) and may switch label between runs.
 REGIME_CV_THRESHOLD = 0.1
 APR, SMR, LINEAR = "APR", "SMR", "linear"
 
