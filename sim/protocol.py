@@ -45,6 +45,13 @@ SEQUENCES: dict[str, tuple[str, ...]] = {
     "up-down-up-down-up": ("up", "down", "up", "down", "up"),
 }
 REPETITION_UNITS = ("leg", "run")
+#: Initial conditions of a run: "rest" = y = 0 at excitation phase 0 (sphere centred, at rest relative to the
+#: base and, as the base velocity is zero there, in the inertial frame); "base-velocity" = homogeneous
+#: initial conditions in relative coordinates under q_base = a_base sin(Omega t), i.e. at the instant of peak
+#: base velocity: the sphere starts with the absolute velocity a_base Omega and (frictionless) drifts into a
+#: wall. We start it at phase 0 with u_a' = a_base Omega (the host's start-up transient differs slightly;
+#: it has decayed after the wait).
+STARTS = ("rest", "base-velocity")
 
 
 @dataclass(frozen=True)
@@ -55,7 +62,8 @@ class SteppedSine:
     sequence: one of SEQUENCES; wait, hold: s per frequency point (paper: 3 s and 5 s with the IES; 15 s
     wait without); perturbation: half-width of the uniform relative frequency offset per visited point;
     repetition: "leg" or "run" (module docstring); integrator: a name of `sim.integrators`;
-    dt_scale: multiple of the paper's ode3 step (ode3 only).
+    dt_scale: multiple of the paper's ode3 step (ode3 only); start: initial conditions of each run
+    (STARTS).
     """
 
     eta_start: float = 0.96
@@ -68,6 +76,7 @@ class SteppedSine:
     repetition: str = "leg"
     integrator: str = "ode3"
     dt_scale: float = 1.0
+    start: str = "rest"
 
     def __post_init__(self) -> None:
         for name in ("eta_start", "eta_stop", "wait", "hold", "perturbation", "dt_scale"):
@@ -88,6 +97,8 @@ class SteppedSine:
             raise SimulationInputError(f"stepped sine: unknown sequence {self.sequence!r}; choose one of {', '.join(SEQUENCES)}")
         if self.repetition not in REPETITION_UNITS:
             raise SimulationInputError(f"stepped sine: repetition must be 'leg' or 'run', got {self.repetition!r}")
+        if self.start not in STARTS:
+            raise SimulationInputError(f"stepped sine: start must be one of {', '.join(STARTS)}, got {self.start!r}")
         if self.wait < 0:
             raise SimulationInputError(f"stepped sine: wait must be >= 0 s, got {self.wait}")
         if self.hold <= 0:
@@ -260,6 +271,8 @@ def run_sweep(model: ModalModel, impactor: Impactor | None, level: float, protoc
         for eta, offset in zip(order, offsets):
             eta_actual = float(eta) * (1.0 + float(offset))
             Omega = eta_actual * omega_1
+            if not rows and protocol.start == "base-velocity":
+                y[2 * model.n_modes + 1] = a_base * Omega
             n_wait, n_hold = protocol.periods(Omega)
             if n_wait:
                 run_step(y, n_wait, Omega, a_base, sys, None)

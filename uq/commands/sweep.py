@@ -31,6 +31,9 @@ def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int
     parser.add_argument("--sequence", default="up", choices=SEQUENCE_CHOICES, help="sweep legs per run (default up)")
     parser.add_argument("--repetition", default="leg", choices=("leg", "run"),
                         help="what counts as one repetition: each leg (the experiment's counting, default) or each run from rest")
+    parser.add_argument("--start", default="rest", choices=("rest", "base-velocity"),
+                        help="initial conditions of each run: at rest (default) or with the base's peak velocity "
+                             "(homogeneous relative ICs under a sine excitation: the sphere drifts into a wall)")
     parser.add_argument("--wait", type=float, default=3.0, metavar="S", help="wait time per frequency in s (default 3)")
     parser.add_argument("--hold", type=float, default=5.0, metavar="S", help="hold time per frequency in s (default 5)")
     parser.add_argument("--reps", type=int, default=default_reps, metavar="N",
@@ -91,7 +94,7 @@ def build_protocol(args: argparse.Namespace):
     start, stop, n = parse_grid(args.eta, "--eta")
     return SteppedSine(eta_start=start, eta_stop=stop, n_eta=n, sequence=args.sequence, wait=args.wait,
                        hold=args.hold, perturbation=args.perturbation, repetition=args.repetition,
-                       integrator=args.integrator, dt_scale=args.dt_scale)
+                       integrator=args.integrator, dt_scale=args.dt_scale, start=args.start)
 
 
 def output_folder(path: str | None) -> Path | None:
