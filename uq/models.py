@@ -42,8 +42,8 @@ def _hash_files(paths: list[Path]) -> str:
     return digest.hexdigest()[:16]
 
 
-@functools.lru_cache(maxsize=None)
 def _source_version(*relative_dirs_or_files: str) -> str:
+    """Hash of the source files (read now, not cached: the code on disk may change between runs)."""
     paths: list[Path] = []
     for rel in relative_dirs_or_files:
         target = _ROOT / rel

@@ -91,6 +91,8 @@ def prepare_output(folder: str | Path, *, resume: bool) -> Path:
     if not resume and ResultStore(folder).count():
         raise StudyError(f"output folder {folder} already holds task results; pass --resume to continue that study "
                          "or choose another --out")
+    for stale in (folder / "tasks").glob(".*.json"):  # a temporary file of a write cut off by SIGKILL
+        stale.unlink(missing_ok=True)
     return folder
 
 
