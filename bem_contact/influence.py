@@ -139,9 +139,13 @@ class ConvolutionOperator:
         if self._kernel_hat is None:
             self._prepare()
         n, m = self.shape
-        spectrum = scipy.fft.rfft2(p, s=self._fft_shape, workers=self.workers)
+        N0, N1 = self._fft_shape
+        # pruned 2-D transform: the zero rows of the padded input and the unused output rows are skipped
+        spectrum = scipy.fft.rfft(p, n=N1, axis=1, workers=self.workers)
+        spectrum = scipy.fft.fft(spectrum, n=N0, axis=0, workers=self.workers, overwrite_x=True)
         spectrum *= self._kernel_hat
-        return scipy.fft.irfft2(spectrum, s=self._fft_shape, workers=self.workers)[:n, :m]
+        spectrum = scipy.fft.ifft(spectrum, axis=0, workers=self.workers, overwrite_x=True)[:n]
+        return scipy.fft.irfft(spectrum, n=N1, axis=1, workers=self.workers)[:, :m]
 
     def dense(self) -> np.ndarray:
         """Explicit (n m) x (n m) matrix in C order of the grid; refused when it would not fit in memory."""

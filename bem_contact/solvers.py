@@ -54,7 +54,7 @@ class SolverInfo:
 
 
 SOLVERS: dict[str, SolverInfo] = {
-    "pk": SolverInfo("pk", None, 1e-9, 20000, "Polonsky-Keer constrained CG on the FFT operator (any grid)"),
+    "pk": SolverInfo("pk", None, 1e-8, 20000, "Polonsky-Keer constrained CG on the FFT operator (any grid)"),
     "al-jacobi": SolverInfo("al-jacobi", 64 * 64, 1e-8, 200000, "augmented Lagrangian, Jacobi relaxation (the paper's method; dense)"),
     "osqp": SolverInfo("osqp", 48 * 48, 1e-8, 200000, "OSQP on the quadratic program (dense)"),
     "cvxpy": SolverInfo("cvxpy", 32 * 32, 1e-6, 500, "cvxpy / Clarabel on the quadratic program (dense reference)"),
