@@ -21,11 +21,14 @@ Idealisation (the paper used a 3D CalculiX model, Fig. 2c; its geometry is only 
 * Contact height: the sphere centre. The sphere (R = 7.92 mm) rests on the edges of the 8 mm groove, so its
   centre is sqrt(R^2 - 4^2) = 6.84 mm above the cavity floor. The measurement point is 12 mm below it.
 * Sections: Timoshenko beam with Cowper's shear coefficients (solid rectangle 10(1+nu)/(12+11nu), thin-walled
-  box formula for the tube, centre-line dimensions); consistent mass including rotary inertia.
+  box formula for the tube, centre-line dimensions); cubic elements (w and theta), consistent mass including
+  rotary inertia; mesh nodes sit exactly at the contact and measurement heights.
 * Mode values at the left and right walls are the section's x-deflection at the contact height (they coincide
   in a beam model). Signs per sim/system.py: each mode is scaled so that its x-value at the contact is
-  positive; b is the unit x-translation of every node (rotations 0), so phi^T M b is the participation of
-  Eq. 2/7.
+  positive; b is the unit x-translation of every node (rotations 0), and the participation phi^T M b of
+  Eqs. 2, 7 uses the base inertia load M b of the unclamped mesh restricted to the free DOFs.
+* The updated E is an effective modulus (240.8 GPa, see update_rig): it absorbs what the published geometry
+  leaves open (exact free length, clamping, neck shape). Hertz constants elsewhere keep E_s = 207 GPa.
 
 All quantities in SI units.
 """
