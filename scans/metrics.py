@@ -3,8 +3,8 @@
 Definitions (heights from the levelled flat wall, `scans.surface`):
 
 * depth: how far the crater's bottom lies below the flat wall. The bottom is located on the lightly
-  smoothed overview map, then a quadratic surface is fitted by least squares to the scan points within
-  `max(4 triangle sizes, 0.1 x crater radius)` of it and its minimum is taken, so that scanner noise
+  smoothed overview map, then a quadratic surface is fitted by least squares to the scan points of the
+  bottom's lowest tenth of the depth (at least 3 triangle sizes across) and its minimum is taken, so that scanner noise
   does not deepen the crater (the minimum of noisy points would be biased by about -3 sigma).
 * rim_height: highest point of the pile-up: located on the smoothed map, then refined by a parabola
   in the distance from the crater's centre fitted to the points there (a ring is curved across only).
@@ -75,10 +75,18 @@ def _fit_radius(surface: LevelledSurface) -> float:
 def _bottom_height(surface: LevelledSurface, fallback: float) -> float:
     """Minimum (m) of a quadratic surface fitted to the scan points around the deepest point.
 
-    Falls back to the smoothed map's minimum when the points do not form a bowl at that scale.
+    The fit covers the bottom's lowest tenth of the depth (a quadratic's own scale, so the bowl's
+    higher-order terms stay small), at least 3 triangle sizes. Falls back to the smoothed map's
+    minimum when the points do not form a bowl at that scale.
     """
     bx, by = surface.deepest
-    radius = _fit_radius(surface)
+    smooth = _smooth(surface.overview, np.isfinite(surface.overview), 1.0)
+    low = np.nan_to_num(smooth, nan=np.inf) < fallback + 0.1 * abs(fallback)
+    labels, _ = ndi.label(low)
+    j = int(round((by - surface.y0) / surface.pitch))
+    i = int(round((bx - surface.x0) / surface.pitch))
+    area = float((labels == labels[j, i]).sum()) * surface.pitch**2 if labels[j, i] else 0.0
+    radius = max(3.0 * surface.pitch, np.sqrt(area / np.pi))
     x, y, h = (surface.points[:, k] for k in range(3))
     near = np.hypot(x - bx, y - by) <= radius
     if near.sum() >= 12:
