@@ -223,7 +223,7 @@ def test_static_deflection_unit_load_method_and_modal_superposition(rig):
     tip = mesh.static_response(mesh.base_load)[mesh.w_dof(z_m)]
     assert tip == pytest.approx(bending + shear, rel=1e-9)
     modal = np.sum(rig.phi_tip * rig.participation / (2 * np.pi * rig.frequencies_hz) ** 2)
-    assert modal == pytest.approx(tip, rel=1e-3)
+    assert modal == pytest.approx(tip, rel=1e-5)  # 9 modes suffice for the quasi-static response (-3e-7)
 
 
 def test_contact_and_measurement_heights():
