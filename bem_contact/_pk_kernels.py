@@ -64,8 +64,8 @@ def step_sums(Kt: np.ndarray, t: np.ndarray, g: np.ndarray, p: np.ndarray):
 
 
 @numba.njit(cache=True)
-def update_pressure(p: np.ndarray, t: np.ndarray, g: np.ndarray, tau: float):
-    """p <- max(p - tau t, 0); elements that stay unloaded but penetrate (g < 0) get -tau g.
+def update_pressure(p: np.ndarray, t: np.ndarray, g: np.ndarray, tau: float, tau_overlap: float):
+    """p <- max(p - tau t, 0); elements that stay unloaded but penetrate (g < 0) get -tau_overlap g.
 
     Returns (number clipped, number newly loaded by overlap, sum p)."""
     clipped = 0
@@ -78,7 +78,7 @@ def update_pressure(p: np.ndarray, t: np.ndarray, g: np.ndarray, tau: float):
                 value = 0.0
                 clipped += 1
             if value == 0.0 and g[i, j] < 0.0:
-                value = -tau * g[i, j]
+                value = -tau_overlap * g[i, j]
                 overlap += 1
             p[i, j] = value
             total += value

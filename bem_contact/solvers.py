@@ -250,11 +250,11 @@ def polonsky_keer(
         rt, gt, st, sk, count = _k.step_sums(Kt, t, g, p)
         if load_control:
             rt -= sk / count * st  # the gradient's mean over the contact is the load multiplier
-        if rt <= 0:  # direction of no curvature: restart from steepest descent
-            restart = True
-            continue
-        tau = gt / rt
-        clipped, overlap, total = _k.update_pressure(p, t, g, tau)
+        # the contact may already be in equilibrium while elements outside penetrate (t = 0): then only
+        # load those, with the self-compliance step 1/K_ii (PK's tau would be 0 and the iteration would stall)
+        tau = gt / rt if rt > 0 else 0.0
+        tau_overlap = tau if tau * kii > 1e-6 else 1.0 / kii
+        clipped, overlap, total = _k.update_pressure(p, t, g, tau, tau_overlap)
         restart = overlap > 0
         scale = force / (area * total) if load_control else 1.0
         if scale != 1.0:

@@ -55,6 +55,15 @@ def test_warm_start_gives_the_same_solution():
     assert warm.force == pytest.approx(cold.force, rel=1e-8)
 
 
+def test_warm_start_from_a_single_loaded_element_does_not_stall():
+    """Regression: a converged one-element contact has zero gradient on its contact, so PK's step was 0."""
+    gap, dx = sphere_gap(16, 2.5e-3, R)
+    first = solve_contact(gap, dx, E_STAR, indentation=2e-6)
+    assert np.count_nonzero(first.pressure) == 1
+    warm = solve_contact(gap, dx, E_STAR, indentation=9.6e-6, x0=first.pressure, maxiter=200)
+    assert warm.force == pytest.approx(solve_contact(gap, dx, E_STAR, indentation=9.6e-6).force, rel=1e-7)
+
+
 def test_contact_outside_the_inner_box_is_found():
     """A low plateau (h = 0.8 delta) beside the first-touch bump: pk's first, smaller box misses it and the
     check on the full candidate box must bring it in (compared with the dense solver)."""
@@ -136,6 +145,8 @@ def rough_problems(draw):
 def test_solvers_agree_and_complementarity_holds_on_random_maps(problem):
     gap, dx, delta = problem
     results = [solve_contact(gap, dx, E_STAR, indentation=delta, solver=name) for name in ("pk", "al-jacobi", "osqp")]
+    smaller = solve_contact(gap, dx, E_STAR, indentation=delta / 3)
+    results.append(solve_contact(gap, dx, E_STAR, indentation=delta, x0=smaller.pressure))  # warm-started pk
     for result in results:
         assert_complementarity(result, slack=1.0)
     forces = [r.force for r in results]
