@@ -140,6 +140,22 @@ def test_cowper_box_reduces_to_rectangle_and_rejects_bad_sections():
         Section(0.01, 0.01, 0.02, 0.005)
 
 
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_random_stepped_beams_match_exact_solution(seed):
+    """Random stepped beams (3-5 segments, solid and hollow sections, stubby to slender)."""
+    rng = np.random.default_rng(seed)
+    segments = []
+    for _ in range(rng.integers(3, 6)):
+        wx, wy = rng.uniform(0.01, 0.04, size=2)
+        hole = rng.uniform(0.3, 0.8) if rng.random() < 0.4 else 0.0
+        segments.append(Segment(rng.uniform(0.01, 0.15), Section(wx, wy, hole * wx, hole * wy)))
+    props = segment_properties(segments, E_STEEL)
+    mesh = assemble_beam(segments, E_STEEL, NU_STEEL, RHO_STEEL, 0.004)
+    omega, _ = mass_normalised_modes(mesh, 6)
+    exact = exact_frequencies(props, 1.05 * omega[-1] / (2 * np.pi))[:6]
+    assert np.max(np.abs(omega / (2 * np.pi) / exact - 1)) < 1e-7
+
+
 # ---------------------------------------------------------------------------------------------- the rig
 @pytest.fixture(scope="module")
 def rig():
