@@ -58,7 +58,7 @@ def _table(data: dict) -> str:
     lines.append(f"a_base* = {data['a_base_star']:.4e} m   ode3 step dt = 2 pi/(15 omega_{data['n_modes']}) = {data['dt']:.4e} s")
     rig = data.get("rig")
     if rig:
-        errors = ", ".join(f"{100 * e:+.3f} %" for e in rig["f_model_error"])
+        errors = ", ".join(f"{round(100 * e, 4) + 0.0:+.4f} %" for e in rig["f_model_error"])
         p = rig["updated_parameters"]
         lines.append(f"updated: E = {p['E_Pa'] / 1e9:.2f} GPa, neck {1e3 * p['neck_length_m']:.2f} mm long, "
                      f"{1e3 * p['neck_width_x_m']:.2f} x {1e3 * p['neck_width_y_m']:.2f} mm (x, y)")
