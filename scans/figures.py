@@ -48,7 +48,8 @@ def calibration_figure(
     ax_map.plot([cx], [cy], "k+", ms=10, label=f"sphere axis ({contact.placement})")
     ax_map.set_xlabel("x (mm)")
     ax_map.set_ylabel("y (mm)")
-    ax_map.set_title(f"(a) {surface.source}: depth {metrics.depth * 1e6:.2f} um, rim {metrics.rim_height * 1e6:.2f} um")
+    ax_map.set_title(f"(a) {surface.source}\ndepth {metrics.depth * 1e6:.2f} um, rim {metrics.rim_height * 1e6:.2f} um",
+                     fontsize=9)
     ax_map.legend(loc="upper right", fontsize=7)
 
     d_um = np.asarray(deltas) * 1e6
@@ -58,7 +59,7 @@ def calibration_figure(
     ax_curve.plot(fine * 1e6, k_H_star * fine**1.5, "--", color="0.4", label="flat wall, Eq. 8 (k_H*)")
     ax_curve.set_xlabel("indentation (um)")
     ax_curve.set_ylabel("normal force (N)")
-    ax_curve.set_title(f"(b) {contact.sphere.describe()}")
+    ax_curve.set_title("(b) " + contact.sphere.describe().replace(" with ", "\nwith "), fontsize=9)
     ax_curve.grid(alpha=0.3)
     ax_curve.legend(loc="upper left", fontsize=8)
     if title:

@@ -72,6 +72,10 @@ class LevelledSurface:
         """Angle (deg) between the wall normal and the scanner's z axis."""
         return float(np.degrees(np.arccos(min(1.0, abs(self.axes[2, 2])))))
 
+    def to_scanner(self, x: float, y: float, h: float = 0.0) -> np.ndarray:
+        """The point (x, y, h) of the levelled frame in the scanner's coordinates (m)."""
+        return self.origin + x * self.axes[0] + y * self.axes[1] + h * self.axes[2]
+
     def resample(self, centre: tuple[float, float], side: float, n: int) -> tuple[np.ndarray, float, HoleReport]:
         """Levelled heights (m) on the n x n BEM grid of pitch dx = side / n around `centre` (m).
 

@@ -1,10 +1,14 @@
 """`ies calibrate`: the Hertzian spring constant k_H from a boundary-element force-indentation curve
-(seed paper, Sect. 4.1, Eq. 8, Fig. 3c).
+(seed paper, Sect. 4.1, Eq. 8, Fig. 3).
 
-`ies calibrate --flat` presses the ideal sphere (R = 7.92 mm, brass) on the flat steel wall (Table 1),
-computes the force at 20 indentations from 2 to 40 um, fits f = k_H delta^1.5 and compares with k_H*
-of Eq. 8; the error bar comes from repeating the curve on a grid half as fine. The library
-(`bem_contact.calibration.calibrate_k_H`) does the work; this module only chooses the gap map
+`ies calibrate [SCAN]` reads a scanned crater (or, with --imprint, its resin imprint, as in the paper),
+levels it on the flat wall, places the sphere above the crater and calibrates k_H on the gap map
+sphere - wall; it also reports the crater metrics and the clearance interval of Sect. 4.1. With no
+SCAN it uses the shipped paper-like crater (`scans/data/paper_crater.ply`).
+`ies calibrate --flat` presses the ideal sphere (R = 7.92 mm, brass) on the flat steel wall (Table 1).
+Both compute the force at 20 indentations from 2 to 40 um, fit f = k_H delta^1.5 and compare with k_H*
+of Eq. 8; the error bar comes from repeating the curve on a grid half as fine. The libraries
+(`scans`, `bem_contact.calibration.calibrate_k_H`) do the work; this module only chooses the gap map
 (see `gap_source`), prints and plots.
 """
 from __future__ import annotations
@@ -14,10 +18,12 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 NAME = "calibrate"
-HELP = "calibrate the Hertzian spring constant k_H by BEM contact (flat wall; Sect. 4.1, Eq. 8, Fig. 3c)"
+HELP = "calibrate the Hertzian spring constant k_H by BEM contact on a scanned crater or the flat wall (Sect. 4.1, Eq. 8, Fig. 3)"
 
 SPHERE_RADIUS = 7.92e-3  # m, Sect. 2
 DEFAULT_SIDE_MM = 2.5  # contact radius at 40 um is 0.56 mm: the domain holds it with room to spare
+PAPER_FLATTENING_MM = 0.02  # Sect. 4.1: sphere diameter 15.80 mm in the flattened regions, 15.84 nominal
+PAPER_CLEARANCE_MM = 0.58  # Sect. 4.1: (17 - 15.84) / 2
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -25,12 +31,30 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from bem_contact.solvers import solver_names
 
     source = parser.add_argument_group("gap map (what is pressed on the wall)")
-    source.add_argument("--flat", action="store_true", help="the ideal sphere on the flat wall (the default for now)")
+    source.add_argument("scan", nargs="?", metavar="SCAN",
+                        help="scanned wall or imprint: STL, PLY, OBJ, OFF mesh, XYZ/CSV points, NPY/NPZ height map "
+                             "(default: the shipped paper-like crater)")
+    source.add_argument("--flat", action="store_true", help="the ideal sphere on the flat wall instead of a scan")
     source.add_argument("--shape", choices=SHAPES, default="paraboloid",
                         help="sphere geometry on the flat wall: Hertz's paraboloid (default; Eq. 8 is exact for it) "
                              "or the exact spherical cap (k_H about 0.04 %% lower)")
-    source.add_argument("--side-mm", type=float, default=DEFAULT_SIDE_MM, metavar="MM",
-                        help=f"side of the square contact domain in mm (default {DEFAULT_SIDE_MM})")
+    source.add_argument("--side-mm", type=float, default=None, metavar="MM",
+                        help=f"side of the square contact domain in mm (flat wall: default {DEFAULT_SIDE_MM}; "
+                             "scan: default automatic, holding every point that can touch at the largest indentation)")
+    scan = parser.add_argument_group("scan (Sect. 4.1)")
+    scan.add_argument("--units", default="mm", metavar="UNIT", help="length unit of the scan file: m, cm, mm, um, in (default mm)")
+    scan.add_argument("--imprint", action="store_true", help="the scan is a resin imprint (cast) of the crater: invert it")
+    scan.add_argument("--pixel-size", type=float, default=None, metavar="SIZE",
+                      help="pixel size of a bare .npy height map, in --units (.npz files carry their own)")
+    scan.add_argument("--flattening", type=float, default=PAPER_FLATTENING_MM, metavar="MM",
+                      help=f"sphere flattening per side in mm, added to the clearance bound (default {PAPER_FLATTENING_MM}, "
+                           "15.84 -> 15.80 mm in the paper)")
+    scan.add_argument("--sphere", choices=("ideal", "flattened"), default="ideal",
+                      help="sphere in the BEM: ideal (default, as the paper's Fig. 3c) or flattened (cap of --flattening cut off)")
+    scan.add_argument("--placement", choices=("centroid", "deepest"), default="centroid",
+                      help="sphere axis above the crater's depth-weighted centroid (default) or its deepest point")
+    scan.add_argument("--clearance", type=float, default=PAPER_CLEARANCE_MM, metavar="MM",
+                      help=f"nominal clearance in mm (default {PAPER_CLEARANCE_MM} = (17 - 15.84) / 2)")
     numerics = parser.add_argument_group("numerics")
     numerics.add_argument("--grid", type=int, default=256, metavar="N",
                           help="elements across the domain (default 256); the error bar uses N/2")
@@ -60,9 +84,10 @@ def flat_wall(args: argparse.Namespace) -> GapSource:
     from bem_contact.errors import ContactInputError
     from bem_contact.geometry import sphere_gap
 
-    if not args.side_mm > 0:
-        raise ContactInputError(f"--side-mm {args.side_mm} must be > 0 (default {DEFAULT_SIDE_MM})")
-    side = args.side_mm * 1e-3
+    side_mm = DEFAULT_SIDE_MM if args.side_mm is None else args.side_mm
+    if not side_mm > 0:
+        raise ContactInputError(f"--side-mm {side_mm} must be > 0 (default {DEFAULT_SIDE_MM})")
+    side = side_mm * 1e-3
     return GapSource(
         gap_at=lambda n: sphere_gap(n, side, SPHERE_RADIUS, args.shape),
         label=f"flat wall, ideal sphere ({args.shape}) R = {SPHERE_RADIUS * 1e3:g} mm",
@@ -70,10 +95,80 @@ def flat_wall(args: argparse.Namespace) -> GapSource:
     )
 
 
+def scanned_wall(args: argparse.Namespace) -> GapSource:
+    """The sphere above a scanned crater (Sect. 4.1, Fig. 3b): read, level, measure, place the sphere.
+
+    Everything that can be wrong with the scan is checked here, before any BEM work or file output.
+    """
+    import math
+
+    from scans import (PAPER_CRATER, ScanError, Sphere, clearance_bounds, crater_metrics, example_path,
+                       level_scan, read_scan, scan_contact)
+
+    for name in ("flattening", "clearance"):
+        value = getattr(args, name)
+        if not (math.isfinite(value) and value >= 0):
+            raise ScanError(f"--{name} {value} mm must be a finite number >= 0")
+    if args.pixel_size is not None and not (math.isfinite(args.pixel_size) and args.pixel_size > 0):
+        raise ScanError(f"--pixel-size {args.pixel_size} must be > 0 (in --units)")
+    path = args.scan if args.scan is not None else example_path("crater")
+    scan = read_scan(path, units=args.units, pixel_size=args.pixel_size)
+    surface = level_scan(scan, imprint=args.imprint)
+    metrics = crater_metrics(surface)
+    flattening = args.flattening * 1e-3
+    sphere = Sphere(SPHERE_RADIUS, flattening if args.sphere == "flattened" else 0.0)
+    side = None if args.side_mm is None else args.side_mm * 1e-3
+    contact = scan_contact(surface, sphere, placement=args.placement, delta_max=args.delta_max_um * 1e-6, side=side)
+    clearance_min, clearance_max = clearance_bounds(metrics.depth, flattening, args.clearance * 1e-3)
+    facts: dict[str, Any] = {
+        "geometry": "scan",
+        "scan": str(path),
+        "scan_kind": scan.kind,
+        "scan_points": len(scan.vertices),
+        "units_in_file": scan.units,
+        "imprint": surface.imprint,
+        "sphere": sphere.describe(),
+        "R": SPHERE_RADIUS,
+        "sphere_flattening_in_bem": sphere.flattening,
+        "placement": contact.placement,
+        "sphere_axis_point": surface.to_scanner(*contact.centre),
+        "sphere_axis_direction": surface.axes[2],
+        "side": contact.side,
+        "wall_tilt_deg": surface.tilt_deg(),
+        "noise": metrics.noise,
+        "flat_fraction": surface.flat_fraction,
+        "crater_depth": metrics.depth,
+        "rim_height": metrics.rim_height,
+        "crater_diameter": metrics.diameter,
+        "clearance_nominal": args.clearance * 1e-3,
+        "flattening": flattening,
+        "clearance_min": clearance_min,
+        "clearance_max": clearance_max,
+        "warnings": list(metrics.warnings),
+    }
+    if args.scan is None:
+        facts["scan_note"] = (f"shipped example: synthetic crater {PAPER_CRATER.depth * 1e6:g} um deep, "
+                              f"{PAPER_CRATER.pileup * 1e6:g} um pile-up (scans.examples)")
+
+    def gap_at(n: int):
+        gap, dx = contact.gap_at(n)
+        facts.setdefault("holes", {})[str(n)] = contact.holes[n].describe()
+        return gap, dx
+
+    label = f"{scan.source}{' (imprint, inverted)' if surface.imprint else ''}, {sphere.describe()}"
+    facts["_contact"], facts["_metrics"] = contact, metrics  # for the plot; not in the JSON
+    return GapSource(gap_at=gap_at, label=label, facts=facts)
+
+
 def gap_source(args: argparse.Namespace) -> GapSource:
-    """Choose the gap map from the arguments. Scanned craters plug in here (a SCAN argument and its
-    options); until then, with or without --flat, the flat wall is calibrated."""
-    return flat_wall(args)
+    """Choose the gap map from the arguments: --flat, or a scan (SCAN, default the shipped crater)."""
+    from scans import ScanError
+
+    if args.flat:
+        if args.scan is not None:
+            raise ScanError("give either a SCAN file or --flat, not both")
+        return flat_wall(args)
+    return scanned_wall(args)
 
 
 def calibrate(args: argparse.Namespace):
@@ -93,19 +188,30 @@ def calibrate(args: argparse.Namespace):
     source = gap_source(args)
     E_star = contact_modulus(STEEL, BRASS)
     deltas = np.round(np.linspace(args.delta_min_um, args.delta_max_um, args.points) * 1e-6, 13)  # m, no float noise
-    result = calibrate_k_H(source.gap_at, args.grid, E_star, deltas, solver=args.solver, R=SPHERE_RADIUS)
+    import sys
+
+    from tqdm import tqdm
+
+    # progress on stderr for long runs (fine grids); silent when stderr is not a terminal
+    with tqdm(total=2 * len(deltas), desc="contact solves", unit="solve", leave=False, disable=not sys.stderr.isatty()) as bar:
+        result = calibrate_k_H(source.gap_at, args.grid, E_star, deltas, solver=args.solver, R=SPHERE_RADIUS, on_solve=bar.update)
     return result, source, E_star
 
 
 def summary(result, source: GapSource, E_star: float) -> dict[str, Any]:
     """The JSON object of `ies calibrate --json` (SI units)."""
     data = result.summary()
-    data.update(source.facts)
+    data.update({k: v for k, v in source.facts.items() if not k.startswith("_")})
     data["E_star"] = E_star
     data["materials"] = {"wall": "steel, E = 207 GPa, nu = 0.3", "sphere": "brass, E = 102 GPa, nu = 0.3"}
     data["units"] = {"k_H": "N/m^1.5", "k_H_star": "N/m^1.5", "k_H_error": "N/m^1.5", "deltas": "m (from first touch)",
                      "forces": "N", "contact_areas": "m^2", "dx": "m", "side": "m", "R": "m", "E_star": "Pa",
                      "fit_residual": "1 (||f - k_H delta^1.5|| / ||f||)", "k_H_ratio": "1 (k_H / k_H*, Eq. 8)"}
+    if data.get("geometry") == "scan":
+        data["units"].update({k: "m" for k in ("crater_depth", "rim_height", "crater_diameter", "clearance_min",
+                                                "clearance_max", "clearance_nominal", "flattening", "noise",
+                                                "sphere_flattening_in_bem", "sphere_axis_point")})
+        data["units"].update({"wall_tilt_deg": "deg", "flat_fraction": "1", "sphere_axis_direction": "1 (unit normal)"})
     return data
 
 
@@ -120,6 +226,27 @@ def _text(data: dict[str, Any], label: str) -> str:
         f"k_H/k_H* = {data['k_H_ratio']:.6f}  +- {data['k_H_error'] / data['k_H_star']:.1e}",
         f"fit residual ||f - k_H delta^1.5|| / ||f|| = {data['fit_residual']:.2e}",
     ]
+    if data.get("geometry") == "scan":
+        from scans.io import unit_scale
+
+        um, unit = 1e6, unit_scale(data["units_in_file"])
+        lines[:0] = [
+            f"scan {data['scan']}: {data['scan_kind']}, {data['scan_points']} points, read in {data['units_in_file']}"
+            + (", imprint inverted" if data["imprint"] else ""),
+            f"levelled on the flat wall ({100 * data['flat_fraction']:.0f} % of the scan): tilt {data['wall_tilt_deg']:.2f} deg, "
+            f"noise {data['noise'] * um:.3g} um",
+            f"crater: depth {data['crater_depth'] * um:.2f} um, rim {data['rim_height'] * um:.2f} um, "
+            f"diameter {data['crater_diameter'] * 1e3:.3f} mm",
+            f"sphere axis on the crater's {data['placement']}, through ("
+            + ", ".join(f"{v / unit:.4g}" for v in data["sphere_axis_point"]) + f") {data['units_in_file']} in the scan's frame; "
+            f"domain {data['side'] * 1e3:.3f} mm; holes: {data['holes'][str(data['grid'])]}",
+        ]
+        lines += [
+            f"clearance: {data['clearance_min'] * 1e3:.3f} to {data['clearance_max'] * 1e3:.3f} mm "
+            f"(nominal {data['clearance_nominal'] * 1e3:g} + crater {data['crater_depth'] * 1e3:.4f} "
+            f"+ flattening {data['flattening'] * 1e3:g} mm, Sect. 4.1)",
+        ]
+        lines += [f"warning: {w}" for w in data["warnings"]]
     return "\n".join(lines)
 
 
@@ -150,12 +277,24 @@ def plot(data: dict[str, Any], label: str, path: str) -> None:
         plt.close(fig)
 
 
+def scan_plot(data: dict[str, Any], source: GapSource, path: str) -> None:
+    """Levelled crater map beside the force-indentation curve, its fit and Eq. 8 (Fig. 3b, 3c), atomically."""
+    from scans.figures import calibration_figure
+    from uq.output import save_figure
+
+    fig = calibration_figure(source.facts["_contact"], source.facts["_metrics"], data["deltas"], data["forces"],
+                             data["k_H"], data["k_H_star"])
+    save_figure(fig, path)
+
+
 def run(args: argparse.Namespace) -> int:
     from uq.output import dumps
 
     result, source, E_star = calibrate(args)
     data = summary(result, source, E_star)
-    if args.plot:
+    if args.plot and data.get("geometry") == "scan":
+        scan_plot(data, source, args.plot)
+    elif args.plot:
         plot(data, source.label, args.plot)
     print(dumps(data) if args.json else _text(data, source.label))
     return 0
