@@ -100,11 +100,20 @@ def _check_deltas(deltas) -> np.ndarray:
 
 
 def force_curve(
-    gap: np.ndarray, dx: float, E_star: float, deltas, *, solver: str = "auto", tol: float | None = None, workers: int = 1
+    gap: np.ndarray,
+    dx: float,
+    E_star: float,
+    deltas,
+    *,
+    solver: str = "auto",
+    tol: float | None = None,
+    workers: int = 1,
+    on_solve: Callable[[], None] | None = None,
 ) -> ForceCurve:
     """Forces (N) at the approaches `deltas` (m) for one gap map, each solve warm-started from the last.
 
-    Raises ContactInputError if the contact reaches the edge of the map (the domain is then too small).
+    `on_solve()` is called after each solve (progress display). Raises ContactInputError if the contact
+    reaches the edge of the map (the domain is then too small).
     """
     d = _check_deltas(deltas)
     forces = np.empty_like(d)
@@ -112,7 +121,6 @@ def force_curve(
     pressure = None
     iterations = 0
     max_residual = 0.0
-    name = solver
     for i, delta in enumerate(d):
         result = solve_contact(gap, dx, E_star, indentation=float(delta), solver=solver, tol=tol, x0=pressure, workers=workers)
         if result.touches_edge:
@@ -123,7 +131,8 @@ def force_curve(
         forces[i], areas[i], pressure = result.force, result.contact_area, result.pressure
         iterations += result.iterations
         max_residual = max(max_residual, result.residual)
-        name = result.solver
+        if on_solve is not None:
+            on_solve()
     return ForceCurve(d, forces, areas, iterations, max_residual, tuple(np.shape(gap)), float(dx))
 
 
@@ -137,6 +146,7 @@ def calibrate_k_H(
     R: float | None = None,
     tol: float | None = None,
     workers: int = 1,
+    on_solve: Callable[[], None] | None = None,
 ) -> Calibration:
     """Calibrate k_H of any gap map (flat wall, scanned crater) with a grid-refinement error bar (Sect. 4.1).
 
@@ -146,6 +156,8 @@ def calibrate_k_H(
         E_star: contact modulus (Pa).
         deltas: approaches from first touch (m), e.g. np.linspace(2e-6, 40e-6, 20).
         solver: solver name (see `bem_contact.solvers.SOLVERS`); R: sphere radius (m) for k_H* (Eq. 8).
+        tol: LCP residual per solve (default: the solver's); workers: FFT threads.
+        on_solve: called after each of the 2 x len(deltas) solves (progress display).
     """
     if not (isinstance(grid, (int, np.integer)) and grid >= 8):
         raise ContactInputError(f"grid = {grid!r} must be a whole number >= 8 (the error bar uses grid // 2)")
@@ -154,7 +166,7 @@ def calibrate_k_H(
     curves = []
     for n in (grid, grid // 2):
         gap, dx = gap_at(n)
-        curves.append(force_curve(gap, dx, E_star, deltas, solver=solver, tol=tol, workers=workers))
+        curves.append(force_curve(gap, dx, E_star, deltas, solver=solver, tol=tol, workers=workers, on_solve=on_solve))
     fine, coarse = curves
     k, residual = fit_k_H(fine.deltas, fine.forces)
     k_coarse, _ = fit_k_H(coarse.deltas, coarse.forces)

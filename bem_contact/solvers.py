@@ -493,4 +493,5 @@ def _solve_force_by_search(h, dx, E_star, W, solver, tol, x0, maxiter, workers, 
     else:
         if raise_on_failure:
             raise ConvergenceError(f"solver {solver!r}: the search for the indentation at force {W:g} N did not converge; use solver='pk'")
+        residual = max(residual, abs(F / W - 1.0))  # reported as not converged
     return _finish(h, dx, E_star, p, delta, total, residual, compl, solver, tol, workers, maxiter, raise_on_failure)
