@@ -57,7 +57,7 @@ SOLVERS: dict[str, SolverInfo] = {
     "pk": SolverInfo("pk", None, 1e-8, 20000, "Polonsky-Keer constrained CG on the FFT operator (any grid)"),
     "al-jacobi": SolverInfo("al-jacobi", 64 * 64, 1e-8, 200000, "augmented Lagrangian, Jacobi relaxation (the paper's method; dense)"),
     "osqp": SolverInfo("osqp", 48 * 48, 1e-8, 200000, "OSQP on the quadratic program (dense)"),
-    "cvxpy": SolverInfo("cvxpy", 32 * 32, 1e-6, 500, "cvxpy / Clarabel on the quadratic program (dense reference)"),
+    "cvxpy": SolverInfo("cvxpy", 32 * 32, 1e-5, 500, "cvxpy / Clarabel on the quadratic program (dense reference)"),
 }
 DEFAULT_SOLVER = "pk"
 MAX_ELEMENTS = 4096 * 4096  # the zero-padded FFT operator of a larger map needs > 1 GB

@@ -33,7 +33,8 @@ def test_all_solvers_agree_on_the_sphere_at_20um():
     reference = results["pk"].force
     for name, result in results.items():
         assert result.converged and result.solver == name
-        assert result.force == pytest.approx(reference, rel=1e-6), name  # acceptance asks 0.5 %
+        # acceptance asks 0.5 %; the interior-point reference cvxpy is held to its own tol (1e-5)
+        assert result.force == pytest.approx(reference, rel=10 * max(result.tol, 1e-7)), name
         assert_complementarity(result)
 
 
@@ -159,7 +160,7 @@ def test_cvxpy_reference_agrees_on_random_maps(problem):
     gap, dx, delta = problem
     pk = solve_contact(gap, dx, E_STAR, indentation=delta, solver="pk")
     ref = solve_contact(gap, dx, E_STAR, indentation=delta, solver="cvxpy")
-    assert ref.force == pytest.approx(pk.force, rel=1e-5)
+    assert ref.force == pytest.approx(pk.force, rel=10 * ref.tol)
     assert_complementarity(ref)
 
 
