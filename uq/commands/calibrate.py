@@ -216,6 +216,8 @@ def summary(result, source: GapSource, E_star: float) -> dict[str, Any]:
 
 
 def _text(data: dict[str, Any], label: str) -> str:
+    import math
+
     to_mm = 1e3**1.5  # N/m^1.5 -> N/mm^1.5
     lines = [
         f"{label}, E* = {data['E_star'] / 1e9:.2f} GPa",
@@ -230,6 +232,7 @@ def _text(data: dict[str, Any], label: str) -> str:
         from scans.io import unit_scale
 
         um, unit = 1e6, unit_scale(data["units_in_file"])
+        decimals = max(0, round(-math.log10(1e-6 / unit)))  # to the micrometre
         lines[:0] = [
             f"scan {data['scan']}: {data['scan_kind']}, {data['scan_points']} points, read in {data['units_in_file']}"
             + (", imprint inverted" if data["imprint"] else ""),
@@ -238,7 +241,7 @@ def _text(data: dict[str, Any], label: str) -> str:
             f"crater: depth {data['crater_depth'] * um:.2f} um, rim {data['rim_height'] * um:.2f} um, "
             f"diameter {data['crater_diameter'] * 1e3:.3f} mm",
             f"sphere axis on the crater's {data['placement']}, through ("
-            + ", ".join(f"{v / unit:.4g}" for v in data["sphere_axis_point"]) + f") {data['units_in_file']} in the scan's frame; "
+            + ", ".join(f"{v / unit:.{decimals}f}" for v in data["sphere_axis_point"]) + f") {data['units_in_file']} in the scan's frame; "
             f"domain {data['side'] * 1e3:.3f} mm; holes: {data['holes'][str(data['grid'])]}",
         ]
         lines += [
