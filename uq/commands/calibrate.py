@@ -241,7 +241,7 @@ def _text(data: dict[str, Any], label: str) -> str:
             f"crater: depth {data['crater_depth'] * um:.2f} um, rim {data['rim_height'] * um:.2f} um, "
             f"diameter {data['crater_diameter'] * 1e3:.3f} mm",
             f"sphere axis on the crater's {data['placement']}, through ("
-            + ", ".join(f"{v / unit:.{decimals}f}" for v in data["sphere_axis_point"]) + f") {data['units_in_file']} in the scan's frame; "
+            + ", ".join(f"{round(v / unit, decimals) + 0.0:.{decimals}f}" for v in data["sphere_axis_point"]) + f") {data['units_in_file']} in the scan's frame; "
             f"domain {data['side'] * 1e3:.3f} mm; holes: {data['holes'][str(data['grid'])]}",
         ]
         lines += [
