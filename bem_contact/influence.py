@@ -21,7 +21,6 @@ zero-padded FFT convolution (any grid, non-periodic); they agree to round-off.
 from __future__ import annotations
 
 import numpy as np
-import scipy.fft
 
 from bem_contact.errors import ContactInputError
 from bem_contact.materials import Material
@@ -123,6 +122,8 @@ class ConvolutionOperator:
         return ConvolutionOperator(self.table[N - n : N + n - 1, M - m : M + m - 1], self.workers)
 
     def _prepare(self) -> None:
+        import scipy.fft  # imported on first use (keeps `ies --help` fast)
+
         n, m = self.shape
         s = (scipy.fft.next_fast_len(2 * n - 1, real=True), scipy.fft.next_fast_len(2 * m - 1, real=True))
         wrapped = np.zeros(s)
@@ -136,6 +137,8 @@ class ConvolutionOperator:
 
     def __call__(self, p: np.ndarray) -> np.ndarray:
         """Apply the operator to a traction field p of shape (n, m); returns the displacement field."""
+        import scipy.fft
+
         if self._kernel_hat is None:
             self._prepare()
         n, m = self.shape

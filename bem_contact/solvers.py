@@ -37,7 +37,6 @@ from typing import Callable
 
 import numpy as np
 
-from bem_contact import _pk_kernels as _k
 from bem_contact.errors import ContactInputError, ConvergenceError
 from bem_contact.influence import ConvolutionOperator, love_kernel
 
@@ -204,6 +203,8 @@ def polonsky_keer(
     Load control (force given): the gradient is shifted by its mean over the contact (delta read off)
     and p is rescaled to the load after each step. Returns (p, u = K p, delta, iterations, residual).
     """
+    from bem_contact import _pk_kernels as _k  # numba, imported on first use (keeps `ies --help` fast)
+
     load_control = force is not None
     kii = op.self_compliance
     if x0 is not None and np.any(x0 > 0):
