@@ -13,11 +13,21 @@ E_STAR = contact_modulus(STEEL, BRASS)
 SIDE = 2.5e-3
 
 
+def assert_signorini(result):
+    """p >= 0, g >= -tol delta and p g = 0 (to tol) on the FFT displacement (the FFT equals the dense matrix)."""
+    g = result.deformed_gap
+    tol = result.tol * result.indentation
+    kii = result._operator.self_compliance
+    assert result.pressure.min() >= 0 and g.min() >= -tol
+    assert np.max(np.abs(np.minimum(result.pressure * kii, g))) <= tol
+
+
 @pytest.mark.parametrize("n", [127, 128])
 def test_force_radius_and_pressure_of_a_paraboloid(n):
     gap, dx = sphere_gap(n, SIDE, R)
     delta = 20e-6
     result = solve_contact(gap, dx, E_STAR, indentation=delta)
+    assert_signorini(result)
     assert result.force == pytest.approx(float(hertz_force(delta, R, E_STAR)), rel=3e-4)
     a = float(hertz_radius(delta, R))
     assert np.sqrt(result.contact_area / np.pi) == pytest.approx(a, rel=2 * dx / a)
@@ -33,6 +43,7 @@ def test_load_control_reads_the_indentation_off_the_solution():
     gap, dx = sphere_gap(128, SIDE, R)
     W = 800.0  # N
     result = solve_contact(gap, dx, E_STAR, force=W)
+    assert_signorini(result)
     assert result.force == pytest.approx(W, rel=1e-12)
     assert result.indentation == pytest.approx(float(hertz_indentation_from_force(W, R, E_STAR)), rel=3e-4)
 
@@ -70,6 +81,7 @@ def test_elliptical_contact_of_a_non_spherical_gap():
     gap = x[:, None] ** 2 / (2 * R1) + x[None, :] ** 2 / (2 * R2)
     delta = 20e-6
     result = solve_contact(gap, side / n, E_STAR, indentation=delta)
+    assert_signorini(result)
     assert result.force == pytest.approx(elliptical_hertz_force(delta, R1, R2, E_STAR), rel=5e-4)
     # sanity of the reference itself: nearly equal radii give the circular force with R = sqrt(R1 R2)
     R1 = 1.001 * R
