@@ -25,6 +25,10 @@ from scans.errors import ScanError
 from scans.surface import FLAT_MARGIN, LevelledSurface, _smooth
 
 
+#: noise (m) beyond which the scan's noise biases k_H by more than about half a percent
+NOISY = 0.1e-6
+
+
 @dataclass(frozen=True)
 class CraterMetrics:
     """Measured crater (all in m): depth below the flat wall (0 for a flat wall), rim height above it,
@@ -60,6 +64,11 @@ def crater_metrics(surface: LevelledSurface) -> CraterMetrics:
     i = int(round((surface.deepest[0] - surface.x0) / pitch))
     area = float((labels == labels[j, i]).sum()) * pitch**2 if labels[j, i] else 0.0
     diameter = 2.0 * math.sqrt(area / math.pi)
+    if surface.noise > NOISY:
+        warnings.append(
+            f"scanner noise {surface.noise * 1e6:.2g} um: the first touch moves onto noise peaks and k_H comes out low "
+            "(paper-like crater: -0.6 % at 0.1 um, -3.4 % at 0.5 um); consider smoothing (--smooth, about one triangle size)"
+        )
     if rim > depth:
         warnings.append(
             f"the pile-up ({rim * 1e6:.3g} um) stands higher than the crater is deep ({depth * 1e6:.3g} um): "

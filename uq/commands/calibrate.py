@@ -53,6 +53,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                       help="sphere in the BEM: ideal (default, as the paper's Fig. 3c) or flattened (cap of --flattening cut off)")
     scan.add_argument("--placement", choices=("centroid", "deepest"), default="centroid",
                       help="sphere axis above the crater's depth-weighted centroid (default) or its deepest point")
+    scan.add_argument("--smooth", type=float, default=0.0, metavar="UM",
+                      help="Gaussian filter (standard deviation, um) of the wall before the BEM, against scanner noise "
+                           "(default 0: the scan as it is)")
     scan.add_argument("--clearance", type=float, default=PAPER_CLEARANCE_MM, metavar="MM",
                       help=f"nominal clearance in mm (default {PAPER_CLEARANCE_MM} = (17 - 15.84) / 2)")
     numerics = parser.add_argument_group("numerics")
@@ -105,10 +108,10 @@ def scanned_wall(args: argparse.Namespace) -> GapSource:
     from scans import (PAPER_CRATER, ScanError, Sphere, clearance_bounds, crater_metrics, example_path,
                        level_scan, read_scan, scan_contact)
 
-    for name in ("flattening", "clearance"):
+    for name in ("flattening", "clearance", "smooth"):
         value = getattr(args, name)
         if not (math.isfinite(value) and value >= 0):
-            raise ScanError(f"--{name} {value} mm must be a finite number >= 0")
+            raise ScanError(f"--{name} {value} must be a finite number >= 0")
     if args.pixel_size is not None and not (math.isfinite(args.pixel_size) and args.pixel_size > 0):
         raise ScanError(f"--pixel-size {args.pixel_size} must be > 0 (in --units)")
     path = args.scan if args.scan is not None else example_path("crater")
@@ -118,7 +121,8 @@ def scanned_wall(args: argparse.Namespace) -> GapSource:
     flattening = args.flattening * 1e-3
     sphere = Sphere(SPHERE_RADIUS, flattening if args.sphere == "flattened" else 0.0)
     side = None if args.side_mm is None else args.side_mm * 1e-3
-    contact = scan_contact(surface, sphere, placement=args.placement, delta_max=args.delta_max_um * 1e-6, side=side)
+    contact = scan_contact(surface, sphere, placement=args.placement, delta_max=args.delta_max_um * 1e-6, side=side,
+                           smoothing=args.smooth * 1e-6)
     clearance_min, clearance_max = clearance_bounds(metrics.depth, flattening, args.clearance * 1e-3)
     facts: dict[str, Any] = {
         "geometry": "scan",
@@ -134,6 +138,7 @@ def scanned_wall(args: argparse.Namespace) -> GapSource:
         "sphere_axis_point": surface.to_scanner(*contact.centre),
         "sphere_axis_direction": surface.axes[2],
         "side": contact.side,
+        "smoothing": contact.smoothing,
         "wall_tilt_deg": surface.tilt_deg(),
         "noise": metrics.noise,
         "flat_fraction": surface.flat_fraction,
@@ -210,7 +215,7 @@ def summary(result, source: GapSource, E_star: float) -> dict[str, Any]:
     if data.get("geometry") == "scan":
         data["units"].update({k: "m" for k in ("crater_depth", "rim_height", "crater_diameter", "clearance_min",
                                                 "clearance_max", "clearance_nominal", "flattening", "noise",
-                                                "sphere_flattening_in_bem", "sphere_axis_point")})
+                                                "sphere_flattening_in_bem", "sphere_axis_point", "smoothing")})
         data["units"].update({"wall_tilt_deg": "deg", "flat_fraction": "1", "sphere_axis_direction": "1 (unit normal)"})
     return data
 
@@ -242,7 +247,8 @@ def _text(data: dict[str, Any], label: str) -> str:
             f"diameter {data['crater_diameter'] * 1e3:.3f} mm",
             f"sphere axis on the crater's {data['placement']}, through ("
             + ", ".join(f"{round(v / unit, decimals) + 0.0:.{decimals}f}" for v in data["sphere_axis_point"]) + f") {data['units_in_file']} in the scan's frame; "
-            f"domain {data['side'] * 1e3:.3f} mm; holes: {data['holes'][str(data['grid'])]}",
+            f"domain {data['side'] * 1e3:.3f} mm; holes: {data['holes'][str(data['grid'])]}"
+            + (f"; wall smoothed over {data['smoothing'] * um:g} um" if data["smoothing"] else ""),
         ]
         lines += [
             f"clearance: {data['clearance_min'] * 1e3:.3f} to {data['clearance_max'] * 1e3:.3f} mm "
