@@ -103,9 +103,7 @@ def fill_holes(height: np.ndarray, dx: float, ring: int = 3) -> tuple[np.ndarray
         jj, ii = np.mgrid[rows, cols]
         base = _quadratic_fit(ii[near], jj[near], window[near], ii, jj)
         residual = np.where(np.isfinite(window), window - base, 0.0)
-        filled[rows, cols] = np.where(hole, base + _laplace_fill(residual, hole, rows.start == 0, cols.start == 0,
-                                                                 rows.stop == height.shape[0], cols.stop == height.shape[1]),
-                                      filled[rows, cols])
+        filled[rows, cols] = np.where(hole, base + _laplace_fill(residual, hole), filled[rows, cols])
     sizes = np.bincount(labels.ravel())[1:]
     largest = 2.0 * np.sqrt(sizes.max() * dx * dx / np.pi)
     return filled, HoleReport(int(n_holes), int(missing.sum()), float(largest))
@@ -122,7 +120,7 @@ def _quadratic_fit(i: np.ndarray, j: np.ndarray, h: np.ndarray, ii: np.ndarray, 
     return sum(c * t(ii, jj) for c, t in zip(coef, terms[:use]))
 
 
-def _laplace_fill(values: np.ndarray, hole: np.ndarray, *_edges: bool) -> np.ndarray:
+def _laplace_fill(values: np.ndarray, hole: np.ndarray) -> np.ndarray:
     """Solve the 5-point Laplace equation on `hole` with `values` elsewhere (zero flux at the window edge)."""
     ny, nx = values.shape
     index = -np.ones(values.shape, dtype=np.int64)

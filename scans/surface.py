@@ -129,14 +129,12 @@ def level_scan(scan: Scan, imprint: bool = False, iterations: int = 3) -> Levell
     if imprint:
         normal = -normal
     axes = _frame(normal)
-    plane = None
     for it in range(iterations + 1):
         local = (vertices - origin) @ axes.T
         if it == 0:
             coef = _trimmed_plane(local)
         else:
             coef = np.linalg.lstsq(_design(local[flat]), local[flat, 2], rcond=None)[0]
-        plane = coef
         tilt = np.array([-coef[1], -coef[2], 1.0])
         tilt /= np.linalg.norm(tilt)
         origin = origin + coef[0] * axes[2]
@@ -152,7 +150,6 @@ def level_scan(scan: Scan, imprint: bool = False, iterations: int = 3) -> Levell
                 f"{scan.source}: no flat region around the crater to level on (crater and rim cover "
                 f"{100 * (1 - flat_fraction):.0f}% of the scan); scan a larger area of the flat wall around the crater"
             )
-    del plane
     return LevelledSurface(
         points=local, faces=faces, origin=origin, axes=axes, pitch=pitch, overview=overview, x0=x0, y0=y0,
         noise=found["noise"], threshold=found["threshold"], feature_radius=found["feature_radius"],
