@@ -7,11 +7,11 @@ import pytest
 
 from uq.cli import main
 
-FAST = ["--grid", "32", "--points", "6"]
+FAST = ["--flat", "--grid", "32", "--points", "6"]
 
 
 def test_json_has_the_promised_keys_in_si_units(capsys):
-    assert main(["calibrate", "--flat", "--json", *FAST]) == 0
+    assert main(["calibrate", "--json", *FAST]) == 0
     data = json.loads(capsys.readouterr().out)
     for key in ("k_H", "k_H_star", "k_H_ratio", "k_H_error", "fit_residual", "grid", "solver"):
         assert key in data
@@ -30,7 +30,7 @@ def test_summary_and_plot(tmp_path, capsys):
 
 
 def test_dense_solver_on_a_small_grid(capsys):
-    assert main(["calibrate", "--json", "--grid", "16", "--points", "3", "--solver", "al-jacobi", "--side-mm", "2.5"]) == 0
+    assert main(["calibrate", "--flat", "--json", "--grid", "16", "--points", "3", "--solver", "al-jacobi", "--side-mm", "2.5"]) == 0
     assert json.loads(capsys.readouterr().out)["solver"] == "al-jacobi"
 
 
