@@ -16,7 +16,7 @@ import pytest
 from scans import PAPER_CRATER, Sphere, example_path, level_scan, read_scan, scan_contact, synthetic_scan
 from scans.examples import EXAMPLES
 
-GRID = 128
+GRID = 256  # the command's default
 DELTAS = np.linspace(2e-6, 40e-6, 20)
 R = 7.92e-3
 BASE = dict(side=4e-3, triangle=30e-6, seed=21)
