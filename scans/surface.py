@@ -43,7 +43,8 @@ class LevelledSurface:
     feature_radius: radius (m) of crater and rim around `centre`, 0 for a flat wall; centre: (x, y) of
     the crater's depth-weighted centroid (m) or the scan's centre for a flat wall; deepest: (x, y) of the
     deepest point (m); flat_fraction: share of the scanned area used to level; imprint: whether the
-    surface was inverted.
+    surface was inverted; spikes: scanner spikes removed (points departing from the plane through their
+    neighbours by more than spike_threshold, m); their triangles become holes, filled on resampling.
     """
 
     points: np.ndarray
@@ -62,6 +63,8 @@ class LevelledSurface:
     flat_fraction: float
     imprint: bool
     source: str
+    spikes: int = 0
+    spike_threshold: float = float("inf")
 
     @property
     def has_crater(self) -> bool:
@@ -104,7 +107,7 @@ def level_scan(scan: Scan, imprint: bool = False, iterations: int = 3) -> Levell
     """Level a scan on its flat wall (Sect. 4.1: heights measured from the nominally flat part of the wall).
 
     1. normal = principal axis of least variance of the points, oriented to the outward side
-       (reversed for an imprint);
+       (reversed for an imprint); scanner spikes are removed after the first plane fit (see `_spikes`);
     2. robust plane fit (trimmed least squares) to find the crater, then an ordinary least-squares plane on
        the flat region outside the crater and its rim (radius x FLAT_MARGIN), repeated `iterations` times,
        each time rotating the frame onto the fitted plane.
@@ -140,6 +143,12 @@ def level_scan(scan: Scan, imprint: bool = False, iterations: int = 3) -> Levell
         origin = origin + coef[0] * axes[2]
         axes = _frame(tilt @ axes)
         local = (vertices - origin) @ axes.T
+        if it == 0:
+            keep, spike_threshold = _spikes(local, faces)
+            spikes = int((~keep).sum())
+            if spikes:
+                vertices, faces = _drop_vertices(vertices, faces, keep, scan.source)
+                local = local[keep]
         overview, x0, y0, pitch = _overview(local, faces)
         found = _features(local, overview, x0, y0, pitch, scan.source, None if it == 0 else found["noise"])
         r2 = (local[:, 0] - found["centre"][0]) ** 2 + (local[:, 1] - found["centre"][1]) ** 2
@@ -154,8 +163,53 @@ def level_scan(scan: Scan, imprint: bool = False, iterations: int = 3) -> Levell
         points=local, faces=faces, origin=origin, axes=axes, pitch=pitch, overview=overview, x0=x0, y0=y0,
         noise=found["noise"], threshold=found["threshold"], feature_radius=found["feature_radius"],
         centre=found["centre"], deepest=found["deepest"], flat_fraction=flat_fraction, imprint=imprint,
-        source=scan.source,
+        source=scan.source, spikes=spikes, spike_threshold=spike_threshold,
     )
+
+
+def _spikes(local: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:
+    """Mask of the points to keep, and the threshold (m) beyond which a point is a scanner spike.
+
+    Each point's height is compared with the least-squares plane through its mesh neighbours (exact for
+    any sloped surface; a smooth crater departs by curvature x edge^2 / 2, about 0.2 um at 30 um
+    triangles). Spikes depart by more than max(8 robust sigmas of that departure, 5 % of the height span)
+    and more than twice as much as any of their neighbours (isolated points; a cluster is left alone).
+    """
+    n = len(local)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    edges = np.unique(np.sort(edges, axis=1), axis=0)
+    i, j = np.concatenate([edges[:, 0], edges[:, 1]]), np.concatenate([edges[:, 1], edges[:, 0]])
+    d = local[j] - local[i]  # neighbour offsets (dx, dy, dh) seen from point i
+    design = np.stack([np.ones(len(i)), d[:, 0], d[:, 1]], axis=1)
+    normal = np.zeros((n, 3, 3))
+    rhs = np.zeros((n, 3))
+    np.add.at(normal, i, design[:, :, None] * design[:, None, :])
+    np.add.at(rhs, i, design * d[:, 2:3])
+    solvable = np.bincount(i, minlength=n) >= 3
+    solvable[solvable] = np.abs(np.linalg.det(normal[solvable])) > 1e-30 * np.abs(normal[solvable]).max(axis=(1, 2)) ** 3
+    departure = np.zeros(n)
+    departure[solvable] = -np.linalg.solve(normal[solvable], rhs[solvable][:, :, None])[:, 0, 0]  # h_i - plane(i)
+    resid = departure[solvable]
+    if resid.size < 10:
+        return np.ones(n, bool), np.inf
+    sigma = 1.4826 * float(np.median(np.abs(resid - np.median(resid))))
+    lo, hi = np.percentile(local[:, 2], [0.5, 99.5])
+    threshold = max(8.0 * sigma, 0.05 * (hi - lo), 1e-12)
+    # a spike stands alone: its neighbours depart far less (they see it as one of ~6 points), whereas on
+    # a sharp but real ridge the neighbours along the ridge depart as much
+    neighbours = np.zeros(n)
+    np.maximum.at(neighbours, i, np.abs(departure[j]))
+    spike = (np.abs(departure) > threshold) & (np.abs(departure) > 2.0 * neighbours)
+    return ~spike, threshold
+
+
+def _drop_vertices(vertices: np.ndarray, faces: np.ndarray, keep: np.ndarray, source: str) -> tuple[np.ndarray, np.ndarray]:
+    """Remove points (and their triangles): what remains is a mesh with holes where they were."""
+    faces = faces[keep[faces].all(axis=1)]
+    if len(faces) == 0:
+        raise ScanError(f"{source}: nothing left after removing scanner spikes")
+    remap = np.cumsum(keep) - 1
+    return vertices[keep], remap[faces]
 
 
 def outside_scan(height: np.ndarray) -> np.ndarray:

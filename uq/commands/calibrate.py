@@ -141,6 +141,7 @@ def scanned_wall(args: argparse.Namespace) -> GapSource:
         "smoothing": contact.smoothing,
         "wall_tilt_deg": surface.tilt_deg(),
         "noise": metrics.noise,
+        "spikes_removed": surface.spikes,
         "flat_fraction": surface.flat_fraction,
         "crater_depth": metrics.depth,
         "rim_height": metrics.rim_height,
@@ -242,7 +243,7 @@ def _text(data: dict[str, Any], label: str) -> str:
             f"scan {data['scan']}: {data['scan_kind']}, {data['scan_points']} points, read in {data['units_in_file']}"
             + (", imprint inverted" if data["imprint"] else ""),
             f"levelled on the flat wall ({100 * data['flat_fraction']:.0f} % of the scan): tilt {data['wall_tilt_deg']:.2f} deg, "
-            f"noise {data['noise'] * um:.3g} um",
+            f"noise {data['noise'] * um:.3g} um, {data['spikes_removed']} spike(s) removed",
             f"crater: depth {data['crater_depth'] * um:.2f} um, rim {data['rim_height'] * um:.2f} um, "
             f"diameter {data['crater_diameter'] * 1e3:.3f} mm",
             f"sphere axis on the crater's {data['placement']}, through ("
