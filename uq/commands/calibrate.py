@@ -70,7 +70,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     numerics.add_argument("--points", type=int, default=20, help="indentations on the curve (default 20)")
     output = parser.add_argument_group("output")
     output.add_argument("--json", action="store_true", help="print one JSON object (SI units, k_H in N/m^1.5)")
-    output.add_argument("--plot", metavar="FILE", help="write the force-indentation plot (Fig. 3c style), e.g. k_H.png")
+    output.add_argument("--plot", metavar="FILE", help="write the force-indentation plot (Fig. 3c style; for a scan beside the levelled crater map, Fig. 3b), e.g. k_H.png")
 
 
 @dataclass(frozen=True)
