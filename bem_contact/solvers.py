@@ -26,7 +26,7 @@ Solvers, by name (see `SOLVERS`):
               p <- max(0, p - (omega / K_ii) g), i.e. a multiplier update with per-element penalty.
   "osqp"      OSQP on the equivalent quadratic program (dense matrix, solution polished).
   "cvxpy"     cvxpy (Clarabel) on the same quadratic program: a reference for small grids.
-Dense solvers take load control by a safeguarded secant search on delta.
+Dense solvers take load control by a search on delta (Hertz-like steps to bracket, then Brent).
 """
 from __future__ import annotations
 
@@ -36,6 +36,7 @@ from functools import cached_property, lru_cache
 from typing import Callable
 
 import numpy as np
+from scipy import optimize
 
 from bem_contact.errors import ContactInputError, ConvergenceError
 from bem_contact.influence import ConvolutionOperator, love_kernel
@@ -474,25 +475,34 @@ def _solve_force_by_search(h, dx, E_star, W, solver, tol, x0, maxiter, workers, 
     # on [levels[k], levels[k+1]] the estimate is (counts[k] delta - cumulative[k]) dx^2 / K_ii
     k = int(np.searchsorted((counts * levels - cumulative) * dx * dx / kii, W)) - 1
     delta = (W * kii / (dx * dx) + cumulative[k]) / counts[k]
+    state = {"x0": x0, "total": 0}
+
+    def solve_at(d: float):
+        p, iterations, residual, compl = _solve_indentation(h, dx, E_star, d, solver, tol, state["x0"], maxiter, workers)
+        state["x0"], state["total"] = p, state["total"] + iterations
+        return p, residual, compl, float(p.sum()) * dx * dx
+
+    # bracket the root from below by Hertz-like steps delta (W/F)^(2/3), then Brent's method; the
+    # indentation is resolved to tol relative, the accuracy of each solve (F may have kinks: new patches)
     low, high = 0.0, math.inf
-    total = 0
     for _ in range(60):
-        p, iterations, residual, compl = _solve_indentation(h, dx, E_star, delta, solver, tol, x0, maxiter, workers)
-        total += iterations
-        F = float(p.sum()) * dx * dx
+        p, residual, compl, F = solve_at(delta)
         if abs(F / W - 1.0) <= tol:
+            return _finish(h, dx, E_star, p, delta, state["total"], residual, compl, solver, tol, workers, maxiter, raise_on_failure)
+        if F > W:
+            high = delta
             break
-        if F < W:
-            low = max(low, delta)
-        else:
-            high = min(high, delta)
-        x0 = p
-        proposal = delta * (W / F) ** (2.0 / 3.0) if F > 0 else 2.0 * delta
-        if not (low < proposal < high):
-            proposal = math.sqrt(low * high) if math.isfinite(high) and low > 0 else 0.5 * (low + high) if math.isfinite(high) else 2.0 * delta
-        delta = proposal
-    else:
+        low = delta
+        delta *= max((W / F) ** (2.0 / 3.0), 1.0 + 1e-3) if F > 0 else 2.0
+    if math.isfinite(high):
+        try:
+            delta = optimize.brentq(lambda d: solve_at(d)[3] - W, low, high, xtol=0.5 * tol * low if low > 0 else 1e-300,
+                                    rtol=max(tol, 4 * np.finfo(float).eps), maxiter=200)
+            p, residual, compl, F = solve_at(delta)
+        except RuntimeError:
+            high = math.inf
+    if not math.isfinite(high):
         if raise_on_failure:
             raise ConvergenceError(f"solver {solver!r}: the search for the indentation at force {W:g} N did not converge; use solver='pk'")
-        residual = max(residual, abs(F / W - 1.0))  # reported as not converged
-    return _finish(h, dx, E_star, p, delta, total, residual, compl, solver, tol, workers, maxiter, raise_on_failure)
+        residual = math.inf  # reported as not converged
+    return _finish(h, dx, E_star, p, delta, state["total"], residual, compl, solver, tol, workers, maxiter, raise_on_failure)
