@@ -246,7 +246,7 @@ def _text(data: dict[str, Any], label: str) -> str:
             f"noise {data['noise'] * um:.3g} um, {data['spikes_removed']} spike(s) removed",
             f"crater: depth {data['crater_depth'] * um:.2f} um, rim {data['rim_height'] * um:.2f} um, "
             f"diameter {data['crater_diameter'] * 1e3:.3f} mm",
-            f"sphere axis on the crater's {data['placement']}, through ("
+            f"sphere axis on the crater's {'deepest point' if data['placement'] == 'deepest' else 'depth-weighted centroid'}, through ("
             + ", ".join(f"{round(v / unit, decimals) + 0.0:.{decimals}f}" for v in data["sphere_axis_point"]) + f") {data['units_in_file']} in the scan's frame; "
             f"domain {data['side'] * 1e3:.3f} mm; holes: {data['holes'][str(data['grid'])]}"
             + (f"; wall smoothed over {data['smoothing'] * um:g} um" if data["smoothing"] else ""),
