@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from sim.rig import F_MEASURED_HZ, seed_rig_model
+from sim.rig import F_MEASURED_HZ, F_PAPER_MODEL_ERROR, seed_rig_model
 from sim.system import SPHERE_MASS, a_base_star
 from uq.cli import main
 
@@ -25,14 +25,31 @@ def test_json_of_the_built_in_rig(capsys):
     assert KEYS <= set(data)
     model = seed_rig_model()
     assert len(data["frequencies_hz"]) == 9
-    assert np.allclose(data["frequencies_hz"][:4], F_MEASURED_HZ, rtol=1e-6)
+    assert np.allclose(data["frequencies_hz"], model.frequencies_hz, rtol=1e-12)
+    assert np.all(np.abs(np.array(data["frequencies_hz"][:4]) / F_MEASURED_HZ - 1) < F_PAPER_MODEL_ERROR)
     assert data["damping_ratios"] == [0.00085, 0.0044, 0.0005, 0.0031] + [0.001] * 5
     assert data["dt"] == pytest.approx(2 * np.pi / (15 * 2 * np.pi * model.frequencies_hz[8]), rel=1e-12)
     assert data["a_base_star"] == pytest.approx(a_base_star(model), rel=1e-12)
     assert data["modal_mass_ratio"] == pytest.approx(SPHERE_MASS * model.phi_wall_left[0] ** 2)
     assert data["phi_tip_over_phi_c"] == pytest.approx(0.96, abs=0.005)
-    assert data["rig"]["updated_parameters"]["E_Pa"] > 0
-    assert max(abs(e) for e in data["rig"]["f_model_error"]) < 1e-6
+    rig = data["rig"]
+    assert 200e9 <= rig["updated_parameters"]["E_Pa"] <= 215e9
+    assert rig["updated_parameters"]["joint_translational_stiffness_N_per_m"] > 0
+    assert rig["f_model_error"] == pytest.approx((np.array(data["frequencies_hz"][:4]) / F_MEASURED_HZ - 1).tolist())
+    assert rig["f9_hz"] == pytest.approx(19.8e3, rel=0.005)
+    assert rig["modal_mass_ratio"] == pytest.approx(data["modal_mass_ratio"])
+
+
+def test_variant_option(capsys):
+    data = run_json(capsys, "--variant", "effective-modulus")
+    assert np.allclose(data["frequencies_hz"][:4], F_MEASURED_HZ, rtol=1e-6)
+    assert "effective-modulus" in data["source"]
+    assert "joint_translational_stiffness_N_per_m" not in data["rig"]["updated_parameters"]
+    assert main(["modes", "--variant", "soft"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unknown rig variant 'soft'" in err
+    assert main(["modes", "--variant", "joint-spring", "--model", "x.toml"]) == 2
+    assert "cannot be used with --model" in capsys.readouterr().err
 
 
 def test_table_is_readable(capsys):

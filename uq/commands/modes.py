@@ -15,6 +15,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
     parser.add_argument("--save", metavar="FILE", help="write the model as a modal-model file (.toml)")
     parser.add_argument("--model", metavar="FILE", help="read a modal-model file instead of the built-in seed rig")
+    parser.add_argument("--variant", default=None, metavar="NAME",
+                        help="updating variant of the built-in rig: joint-spring (default) or effective-modulus")
 
 
 def describe(model, rig=None) -> dict:
@@ -60,8 +62,10 @@ def _table(data: dict) -> str:
     if rig:
         errors = ", ".join(f"{round(100 * e, 4) + 0.0:+.4f} %" for e in rig["f_model_error"])
         p = rig["updated_parameters"]
+        joint = p.get("joint_translational_stiffness_N_per_m")
         lines.append(f"updated: E = {p['E_Pa'] / 1e9:.2f} GPa, neck {1e3 * p['neck_length_m']:.2f} mm long, "
-                     f"{1e3 * p['neck_width_x_m']:.2f} x {1e3 * p['neck_width_y_m']:.2f} mm (x, y)")
+                     f"{1e3 * p['neck_width_x_m']:.2f} x {1e3 * p['neck_width_y_m']:.2f} mm (x, y), joint "
+                     + ("rigid" if joint is None else f"spring {joint:.4g} N/m"))
         lines.append(f"f1..f4 vs Table A.1: {errors}")
         if "f9_hz" in rig:
             lines.append(f"f9 = {rig['f9_hz']:.0f} Hz (paper's 3D model: {rig['f9_paper_hz']:.0f} Hz)")
@@ -69,15 +73,20 @@ def _table(data: dict) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from sim.errors import SimulationInputError
     from sim.modal_file import load_modal_model, save_modal_model
     from uq.output import dumps
 
     if args.model:
+        if args.variant is not None:
+            raise SimulationInputError("--variant selects a built-in rig model; it cannot be used with --model")
         model, rig = load_modal_model(args.model), None
     else:
-        from sim.rig import rig_modes, seed_rig_model
+        from sim.rig import DEFAULT_VARIANT, rig_modes, seed_rig_model, variant_parameters
 
-        model, rig = seed_rig_model(n_modes=9), rig_modes(n_modes=9)
+        variant = args.variant or DEFAULT_VARIANT
+        model = seed_rig_model(n_modes=9, variant=variant)
+        rig = rig_modes(variant_parameters(variant), n_modes=9)
     data = describe(model, rig)
     if args.save:
         data["saved_to"] = str(save_modal_model(model, args.save))
