@@ -176,15 +176,19 @@ def _spikes(local: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:
     and more than twice as much as any of their neighbours (isolated points; a cluster is left alone).
     """
     n = len(local)
-    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    edges = np.unique(np.sort(edges, axis=1), axis=0)
-    i, j = np.concatenate([edges[:, 0], edges[:, 1]]), np.concatenate([edges[:, 1], edges[:, 0]])
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    keys = np.sort(edges[:, 0].astype(np.int64) * n + edges[:, 1])
+    keys = keys[np.concatenate([[True], keys[1:] != keys[:-1]])]  # each edge once
+    a, b = keys // n, keys % n
+    i, j = np.concatenate([a, b]), np.concatenate([b, a])
     d = local[j] - local[i]  # neighbour offsets (dx, dy, dh) seen from point i
     design = np.stack([np.ones(len(i)), d[:, 0], d[:, 1]], axis=1)
-    normal = np.zeros((n, 3, 3))
-    rhs = np.zeros((n, 3))
-    np.add.at(normal, i, design[:, :, None] * design[:, None, :])
-    np.add.at(rhs, i, design * d[:, 2:3])
+    normal = np.empty((n, 3, 3))
+    rhs = np.empty((n, 3))
+    for r in range(3):
+        rhs[:, r] = np.bincount(i, weights=design[:, r] * d[:, 2], minlength=n)
+        for c in range(3):
+            normal[:, r, c] = np.bincount(i, weights=design[:, r] * design[:, c], minlength=n)
     solvable = np.bincount(i, minlength=n) >= 3
     solvable[solvable] = np.abs(np.linalg.det(normal[solvable])) > 1e-30 * np.abs(normal[solvable]).max(axis=(1, 2)) ** 3
     departure = np.zeros(n)
@@ -197,8 +201,11 @@ def _spikes(local: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:
     threshold = max(8.0 * sigma, 0.05 * (hi - lo), 1e-12)
     # a spike stands alone: its neighbours depart far less (they see it as one of ~6 points), whereas on
     # a sharp but real ridge the neighbours along the ridge depart as much
+    order = np.argsort(i, kind="stable")
+    starts = np.searchsorted(i[order], np.arange(n))
+    has = np.bincount(i, minlength=n) > 0
     neighbours = np.zeros(n)
-    np.maximum.at(neighbours, i, np.abs(departure[j]))
+    neighbours[has] = np.maximum.reduceat(np.abs(departure[j[order]]), starts[has])
     spike = (np.abs(departure) > threshold) & (np.abs(departure) > 2.0 * neighbours)
     return ~spike, threshold
 
