@@ -49,9 +49,20 @@ def _describe(model: Any) -> Any:
 
 def task_key(task: Task, model: Any, seed: int, version: str) -> str:
     """Stable key of a task (hex SHA-256 of its parameters, the model settings, seed and code version)."""
-    blob = json.dumps({"params": task.params, "level": task.level, "rep": task.rep, "seed": seed,
-                       "model": _describe(model), "version": version}, sort_keys=True, default=str)
-    return hashlib.sha256(blob.encode()).hexdigest()
+    return _keyer(model, seed, version)(task)
+
+
+def _keyer(model: Any, seed: int, version: str) -> Callable[[Task], str]:
+    """Key function with the study-wide part (model settings, seed, version) hashed once."""
+    common = hashlib.sha256(json.dumps({"seed": seed, "model": _describe(model), "version": version},
+                                       sort_keys=True, default=str).encode())
+
+    def key(task: Task) -> str:
+        digest = common.copy()
+        digest.update(json.dumps([task.params, task.level, task.rep]).encode())
+        return digest.hexdigest()
+
+    return key
 
 
 class ResultStore:
@@ -147,7 +158,8 @@ def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultSt
     if jobs < 1:
         raise StudyError(f"--jobs must be >= 1, got {jobs}")
     version = model.version()
-    keys = {task: task_key(task, model, seed, version) for task in tasks}
+    keyer = _keyer(model, seed, version)
+    keys = {task: keyer(task) for task in tasks}
     unique: dict[str, Task] = {}
     for task, key in keys.items():
         if key not in unique and not store.has(key):

@@ -1,0 +1,109 @@
+"""`ies sobol`, `ies interval` and `ies reproduce` end to end on analytic and noisy models."""
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from uq.cli import main
+
+HERE = Path(__file__).parent
+AB = """
+[parameters.a]
+nominal = 0.5
+min = 0.0
+max = 1.0
+[parameters.b]
+nominal = 0.5
+min = 0.0
+max = 1.0
+"""
+
+
+def rows(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+@pytest.fixture
+def models_on_path(monkeypatch):
+    monkeypatch.syspath_prepend(str(HERE))
+
+
+def test_sobol_command_on_ishigami(tmp_path, capsys):
+    study = tmp_path / "s.toml"
+    study.write_text("[study]\nkind = 'sobol'\nmodel = 'ishigami'\nseed = 5\n[sobol]\nbootstrap = 300\n")
+    assert main(["sobol", str(study), "--n", "1024", "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    res = {r["parameter"]: r for r in rows(tmp_path / "o" / "sobol.csv")}
+    V = 7**2 / 8 + 0.1 * np.pi**4 / 5 + 0.1**2 * np.pi**8 / 18 + 0.5
+    exact_S1 = {"x1": 0.5 * (1 + 0.1 * np.pi**4 / 5) ** 2 / V, "x2": 7**2 / 8 / V, "x3": 0.0}
+    for name, s1 in exact_S1.items():
+        assert abs(float(res[name]["S1"]) - s1) <= max(float(res[name]["S1_conf"]), 5e-3)
+    for suffix in ("png", "pdf"):
+        assert (tmp_path / "o" / f"sobol.{suffix}").stat().st_size > 1000
+    meta = json.loads((tmp_path / "o" / "study.json").read_text())
+    assert meta["study"]["sobol"]["n"] == 64 and meta["summary"]["base_sample"] == 1024
+
+
+def test_noisy_model_noise_share_and_no_false_flags(tmp_path, models_on_path):
+    from uq.study import load_study
+    from uq.execute import run_interval_study, run_sobol_study
+
+    text = "[study]\nkind = '{kind}'\nmodel = '_uq_models:noisy_linear'\nrepetitions = {reps}\nseed = 3\n" + AB
+    path = tmp_path / "i.toml"
+    path.write_text(text.format(kind="interval", reps=8) + "[interval]\ndesigns = ['individual', 'joint']\ninterior = 3\n")
+    res = run_interval_study(load_study(path), out=tmp_path / "i", progress=False)
+    assert all(res.summary["monotone"].values()), res.warnings  # noise does not trip the check
+    band = {r["design"]: r for r in rows(tmp_path / "i" / "bands.csv")}
+    assert float(band["joint"]["lower"]) == pytest.approx(1.0, abs=4 * 0.2 / np.sqrt(8))  # level 1 + 0
+    assert float(band["joint"]["upper"]) == pytest.approx(4.0, abs=4 * 0.2 / np.sqrt(8))  # level 1 + 1 + 2
+    path.write_text(text.format(kind="sobol", reps=4) + "[sobol]\nn = 128\n")
+    res = run_sobol_study(load_study(path), out=tmp_path / "s", progress=False)
+    # Var(ybar) = Var(a + 2 b) + sigma^2 / r = 5/12 + 0.01; noise share = 0.01 / (5/12 + 0.01)
+    share = float(rows(tmp_path / "s" / "variance.csv")[0]["noise_share"])
+    assert share == pytest.approx(0.01 / (5 / 12 + 0.01), rel=0.25)
+
+
+def test_failed_runs_are_reported_not_hidden(tmp_path, models_on_path, capsys):
+    path = tmp_path / "f.toml"
+    path.write_text("[study]\nkind = 'sobol'\nmodel = '_uq_models:failing'\nrepetitions = 2\n" + AB + "[sobol]\nn = 32\n")
+    assert main(["sobol", str(path), "--out", str(tmp_path / "o"), "--quiet", "--no-figures"]) == 0
+    err = capsys.readouterr().err
+    assert "runs failed" in err and "not analysed" in err and "no finite run" in err
+    runs = rows(tmp_path / "o" / "runs.csv")
+    assert any(r["error"].startswith("SimulationDiverged") for r in runs)
+    summary = rows(tmp_path / "o" / "variance.csv")[0]
+    assert summary["message"] and summary["noise_share"] == "nan"
+
+
+def test_interval_command_writes_data_then_figures(tmp_path):
+    path = tmp_path / "i.toml"
+    path.write_text("[study]\nkind = 'interval'\nmodel = 'ishigami'\n[parameters.x1]\nnominal = 0.5\nmin = 0.2\n"
+                    "max = 1.0\n[interval]\ndesigns = ['individual', 'joint']\n")
+    assert main(["interval", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    for name in ("runs.csv", "points.csv", "bands.csv", "study.json", "fig7.png", "fig7.pdf", "fig8.png", "fig8.pdf"):
+        assert (tmp_path / "o" / name).is_file(), name
+    meta = json.loads((tmp_path / "o" / "study.json").read_text())
+    assert meta["study"]["parameters"]["x1"]["max"] == 1.0 and meta["code_version"]
+
+
+def test_reproduce_rejects_bad_calibration(tmp_path, capsys):
+    bad = tmp_path / "calib.json"
+    bad.write_text("{\"k_H_ratio\": 1.5}")
+    assert main(["reproduce", "fig7", "--quick", "--calibration", str(bad), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "has no positive 'k_H'" in err and len(err.strip().splitlines()) == 1
+
+
+def test_calibrated_k_H_becomes_the_upper_bound():
+    from uq.commands.reproduce import study_file, with_calibration
+    from uq.space import K_H_STAR
+    from uq.study import load_study
+
+    study = load_study(study_file("fig8", quick=True))
+    cal = with_calibration(study, 1.48 * K_H_STAR)
+    assert cal.space["k_H"].max == pytest.approx(1.48 * K_H_STAR)
+    assert cal.fix["k_H"] == pytest.approx(1.25 * K_H_STAR)
+    low = with_calibration(study, 1.1 * K_H_STAR)  # below the paper's best estimate: use the midpoint
+    assert low.fix["k_H"] == pytest.approx(1.05 * K_H_STAR)
