@@ -102,3 +102,15 @@ def test_diverging_simulation_exits_3_without_traceback(model_file):
     assert proc.returncode == 3
     assert "diverged" in proc.stderr and "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_no_impactor_waits_15_s_by_default_and_reaches_a_noabs(tmp_path, three_mode_model, capsys):
+    """Sect. 5.1: 15 s wait without the IES; at eta = 1 the response is a_noabs* (Nominal D* = the model's)."""
+    path = str(save_modal_model(three_mode_model, tmp_path / "m.toml"))
+    code = main(["sweep", "--level", "2", "--eta", "1:1:1", "--hold", "0.2", "--reps", "1", "--perturbation", "0",
+                 "--model", path, "--no-impactor", "--json"])
+    assert code == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["protocol"]["wait"] == 15.0
+    assert data["resonant_mean"] == pytest.approx(1.0, rel=5e-3)
+    assert data["regime"] == "linear"

@@ -34,7 +34,8 @@ def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int
     parser.add_argument("--start", default="rest", choices=("rest", "base-velocity"),
                         help="initial conditions of each run: at rest (default) or with the base's peak velocity "
                              "(homogeneous relative ICs under a sine excitation: the sphere drifts into a wall)")
-    parser.add_argument("--wait", type=float, default=3.0, metavar="S", help="wait time per frequency in s (default 3)")
+    parser.add_argument("--wait", type=float, default=None, metavar="S",
+                        help="wait time per frequency in s (default 3, or 15 with --no-impactor, Sect. 5.1)")
     parser.add_argument("--hold", type=float, default=5.0, metavar="S", help="hold time per frequency in s (default 5)")
     parser.add_argument("--reps", type=int, default=default_reps, metavar="N",
                         help=f"runs from rest, each with its own random frequency offsets (default {default_reps})")
@@ -92,7 +93,8 @@ def build_protocol(args: argparse.Namespace):
     from sim.protocol import SteppedSine
 
     start, stop, n = parse_grid(args.eta, "--eta")
-    return SteppedSine(eta_start=start, eta_stop=stop, n_eta=n, sequence=args.sequence, wait=args.wait,
+    wait = args.wait if args.wait is not None else (15.0 if args.no_impactor else 3.0)
+    return SteppedSine(eta_start=start, eta_stop=stop, n_eta=n, sequence=args.sequence, wait=wait,
                        hold=args.hold, perturbation=args.perturbation, repetition=args.repetition,
                        integrator=args.integrator, dt_scale=args.dt_scale, start=args.start)
 
