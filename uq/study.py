@@ -22,6 +22,7 @@ Layout (every table and key is optional except where noted; SI units)::
     levels = [5.3, 6.7, 7.4]     # a_base / a_base* (Sect. 5.3; nominal D*, g*)
     eta = { start = 0.95, stop = 1.01, n = 25 }   # Omega / omega_1*
     repetition = "leg"           # "leg" or "run": what counts as one repetition sample (sim.protocol)
+    start = "base-velocity"      # initial conditions of each run: "rest" or "base-velocity" (sim.protocol)
     wait = 3.0                   # s
     hold = 5.0                   # s
     sequence = "up-down-up"
@@ -58,7 +59,8 @@ DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
     "study": {"name", "kind", "model", "seed", "repetitions", "output"},
     "parameters": None,  # one sub-table per parameter
-    "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "repetition"},
+    "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "repetition", "start",
+                   "dt_scale"},
     "interval": {"designs", "interior", "z", "fix"},
     "sobol": {"n", "bootstrap", "confidence"},
 }
@@ -272,10 +274,10 @@ def _parse_fix(fix: Any, space: ParameterSpace, base_dir: Path) -> dict[str, flo
 def _parse_protocol(exc: Mapping[str, Any]) -> dict[str, Any]:
     """Protocol settings as given (SteppedSine fills in and validates the rest when the model is built)."""
     out: dict[str, Any] = {}
-    for key in ("wait", "hold", "perturbation"):
+    for key in ("wait", "hold", "perturbation", "dt_scale"):
         if key in exc:
             out[key] = float(_number("excitation", key, exc[key]))
-    for key in ("sequence", "integrator", "repetition"):
+    for key in ("sequence", "integrator", "repetition", "start"):
         if key in exc:
             if not isinstance(exc[key], str):
                 raise StudyError(f"[excitation] {key} must be a string, got {exc[key]!r}")

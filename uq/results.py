@@ -1,0 +1,86 @@
+"""Reading a finished interval study back and summarising the paper's trends (Sect. 5.4, Figs. 7, 8).
+
+`effects(folder)` gives, per parameter and excitation level, the change of the repetition-mean resonant
+level from the parameter's min to its max (others nominal), relative to the nominal level, with its
+noise (the standard errors combined) and the nominal regime. `trend_table` formats it; `band_table`
+lists the joint and residual bands. Both read only the study's CSV files.
+"""
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Effect:
+    """Change of the resonant level from a parameter's min to its max at one excitation level.
+
+    delta: value(max) - value(min) (a / a_noabs*); relative: delta / nominal value; noise: the
+    combined standard error of the two values; regime: "APR" or "SMR" at the nominal point.
+    """
+
+    parameter: str
+    level: float
+    delta: float
+    relative: float
+    noise: float
+    regime: str
+    nominal: float
+
+
+def _rows(path: Path) -> list[dict]:
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def effects(folder: str | Path, output: str = "mean") -> list[Effect]:
+    """Effects of the individual variation (designs "individual:NAME") in a study folder."""
+    points = _rows(Path(folder) / "points.csv")
+    nominal = {float(r["level"]): float(r["mean"]) for r in points if r["design"] == "nominal" and r["output"] == output}
+    regime = {float(r["level"]): ("APR" if float(r["mean"]) >= 0.5 else "SMR")
+              for r in points if r["design"] == "nominal" and r["output"] == "apr"}
+    out = []
+    designs = sorted({r["design"] for r in points if r["design"].startswith("individual:")})
+    for design in designs:
+        name = design.split(":", 1)[1]
+        rows = [r for r in points if r["design"] == design and r["output"] == output and r["role"] == "corner"]
+        for level in sorted({float(r["level"]) for r in rows}):
+            at = sorted((r for r in rows if float(r["level"]) == level), key=lambda r: float(r[name]))
+            lo, hi = at[0], at[-1]
+            delta = float(hi["mean"]) - float(lo["mean"])
+            noise = float(np.hypot(float(hi["se"]), float(lo["se"])))
+            out.append(Effect(name, level, delta, delta / nominal[level], noise, regime.get(level, "?"), nominal[level]))
+    return out
+
+
+def trend_table(folder: str | Path, output: str = "mean") -> str:
+    """Text table of `effects`: one row per level, one column per parameter (relative change +- noise)."""
+    eff = effects(folder, output)
+    names = list(dict.fromkeys(e.parameter for e in eff))
+    levels = sorted({e.level for e in eff})
+    head = f"{'level':>6} {'regime':>6} " + " ".join(f"{'d' + n + ' (max-min)/nominal':>26}" for n in names)
+    lines = [head]
+    for lv in levels:
+        row = {e.parameter: e for e in eff if e.level == lv}
+        regime = next(iter(row.values())).regime
+        cells = " ".join(f"{row[n].relative:+8.1%} (noise {row[n].noise / row[n].nominal:5.1%})".rjust(26)
+                         for n in names)
+        lines.append(f"{lv:6.2f} {regime:>6} {cells}")
+    return "\n".join(lines)
+
+
+def band_table(folder: str | Path, output: str = "mean") -> str:
+    """Text table of the box bands (joint, residual) and the nominal value per level."""
+    folder = Path(folder)
+    bands = [r for r in _rows(folder / "bands.csv") if r["output"] == output and not r["design"].startswith("individual")]
+    points = _rows(folder / "points.csv")
+    nominal = {float(r["level"]): float(r["mean"]) for r in points if r["design"] == "nominal" and r["output"] == output}
+    lines = [f"{'design':>9} {'level':>6} {'lower':>8} {'nominal':>8} {'upper':>8} {'flagged':>7}"]
+    for r in bands:
+        lv = float(r["level"])
+        lines.append(f"{r['design']:>9} {lv:6.2f} {float(r['lower']):8.4f} {nominal.get(lv, np.nan):8.4f} "
+                     f"{float(r['upper']):8.4f} {r['flagged']:>7}")
+    return "\n".join(lines)
