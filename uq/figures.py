@@ -131,22 +131,17 @@ def _value_of(label: str) -> float:
 
 
 def _overview(folder: Path, points: list[dict], plt) -> list[Path]:
-    """Fig. 6 style: nominal resonant mean and max vs level; APR where most runs end in the APR regime."""
-    runs = _rows(folder / "runs.csv")
-    meta = json.loads((folder / "study.json").read_text())
-    nominal = {k: v["nominal"] for k, v in meta["study"]["parameters"].items() if not k.startswith("_")}
-    apr = defaultdict(list)
-    for r in runs:
-        if all(np.isclose(float(r[k]), v, rtol=1e-12) for k, v in nominal.items()) and r["apr"] != "nan":
-            apr[float(r["level"])].append(float(r["apr"]))
+    """Fig. 6 style: nominal resonant mean and max vs level, with the regime (APR/SMR) where the
+    repetition-averaged resonant mean is reached (as `sim.protocol.aggregate_runs` classifies it)."""
+    apr = {float(r["level"]): float(r["mean"]) for r in points if r["design"] == "nominal" and r["output"] == "apr"}
     fig, ax = plt.subplots(figsize=(5.5, 4))
     for output, style in (("mean", "o-"), ("max", "s--")):
         curve = _curves(points, "nominal", output).get("nominal")
         if curve is not None:
             ax.plot(*curve, style, label=f"{output} (nominal)")
     top = ax.get_ylim()[1]
-    for level, flags in sorted(apr.items()):
-        ax.annotate("APR" if np.mean(flags) > 0.5 else "SMR", (level, top), ha="center", va="bottom", fontsize=7)
+    for level, flag in sorted(apr.items()):
+        ax.annotate("APR" if flag >= 0.5 else "SMR", (level, top), ha="center", va="bottom", fontsize=7)
     ax.set_xlabel("excitation level  a_base / a_base*")
     ax.set_ylabel("resonant response level  a / a_noabs*")
     ax.set_title("Resonant response level (cf. Fig. 6)", fontsize=10, pad=14)
