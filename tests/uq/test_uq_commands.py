@@ -107,3 +107,24 @@ def test_calibrated_k_H_becomes_the_upper_bound():
     assert cal.fix["k_H"] == pytest.approx(1.25 * K_H_STAR)
     low = with_calibration(study, 1.1 * K_H_STAR)  # below the paper's best estimate: use the midpoint
     assert low.fix["k_H"] == pytest.approx(1.05 * K_H_STAR)
+
+
+def test_reproduce_uses_the_calibrated_k_H(tmp_path, monkeypatch, capsys):
+    """`ies reproduce` end to end on a tiny simulator study: calibrated k_H bound, data, figures, trends."""
+    import uq.commands.reproduce as reproduce
+    from uq.space import K_H_STAR
+
+    tiny = tmp_path / "tiny.toml"
+    tiny.write_text("[study]\nkind = 'interval'\nrepetitions = 1\n[parameters.k_H]\n[excitation]\nlevels = [7.4]\n"
+                    "eta = { start = 0.975, stop = 0.98, n = 2 }\nwait = 0.1\nhold = 0.1\nintegrator = 'ode3'\n"
+                    "[interval]\ninterior = 0\n")
+    monkeypatch.setattr(reproduce, "study_file", lambda figure, quick: tiny)
+    calib = tmp_path / "calib.json"
+    calib.write_text(json.dumps({"k_H": 1.5 * K_H_STAR}))
+    out = tmp_path / "o"
+    assert main(["reproduce", "fig7", "--calibration", str(calib), "--out", str(out), "--quiet", "--jobs", "1"]) == 0
+    text = capsys.readouterr().out
+    assert "= 1.500 k_H*" in text and "dk_H (max-min)/nominal" in text
+    meta = json.loads((out / "fig7" / "study.json").read_text())
+    assert meta["study"]["parameters"]["k_H"]["max"] == pytest.approx(1.5 * K_H_STAR)
+    assert (out / "fig7" / "fig7.pdf").is_file() and (out / "fig7" / "fig6.png").is_file()
