@@ -1,4 +1,6 @@
-"""Independent reference for the exact integrator's tests: scipy solve_ivp (DOP853) on Eqs. 3-7 in the
+"""Helpers of the exact integrator's tests (and a check of the reference itself).
+
+Independent reference: scipy solve_ivp (DOP853) on Eqs. 3-7 in the
 original coordinates y = [s, s', u_a, u_a'], restarted at every contact onset and release (events), so the
 Hertz law's non-smoothness never sits inside a step."""
 from __future__ import annotations
@@ -6,7 +8,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from scipy.integrate import solve_ivp
+from scipy.special import gamma as gamma_fn
+
+from sim.system import Impactor, ModalModel, system_arrays
 
 
 def reference_run(y0, t_end, Omega, a_base, sys, rtol=1e-12, atol_scale=1e-16, t_eval=None):
@@ -69,3 +75,41 @@ def reference_run(y0, t_end, Omega, a_base, sys, rtol=1e-12, atol_scale=1e-16, t
             raise RuntimeError("reference integration did not progress")
         t = t_new
     return y, np.array(onsets), np.array(releases), np.array(speeds)
+
+
+
+
+# A uniform cantilever of 1.8 kg (free length of the seed's beam): mass-normalised tip value 2/sqrt(m) for
+# every mode (alternating sign), participation sqrt(effective-mass fraction * m) (Euler-Bernoulli values).
+_EFFECTIVE_MASS_FRACTION = (0.6131, 0.1883, 0.0647, 0.0331, 0.0200, 0.0134, 0.0096, 0.0072, 0.0056)
+_FREQUENCIES_HZ = (117.4, 886.0, 2494.0, 4712.0, 7540.0, 10300.0, 13300.0, 16500.0, 19800.0)
+_DAMPING = (0.00085, 0.0044, 0.0005, 0.0031, 0.001, 0.001, 0.001, 0.001, 0.001)
+
+
+def cantilever_like_model(n_modes: int = 9, undamped: bool = False) -> ModalModel:
+    """A 9-mode model with the seed rig's frequencies (Table A.1, f9 = 19.8 kHz) and cantilever-like shapes."""
+    mass = 1.8
+    j = np.arange(n_modes)
+    sign = np.where(j % 2 == 0, 1.0, -1.0)
+    phi_c = sign * 2.0 / np.sqrt(mass)
+    damping = np.full(n_modes, 1e-12) if undamped else np.array(_DAMPING[:n_modes])
+    return ModalModel(
+        frequencies_hz=np.array(_FREQUENCIES_HZ[:n_modes]), damping_ratios=damping,
+        phi_wall_left=phi_c, phi_wall_right=phi_c, phi_tip=0.96 * phi_c,
+        participation=np.sqrt(np.array(_EFFECTIVE_MASS_FRACTION[:n_modes]) * mass),
+        source="tests: cantilever-like")
+
+
+def test_reference_reproduces_the_hertz_impact_on_a_rigid_wall():
+    """The reference itself: restitution 1 and the analytic contact time
+    t_c = 2 sqrt(pi) Gamma(7/5) / Gamma(9/10) delta_max / v0 (= 2.9432 delta_max / v0)."""
+    model = ModalModel(frequencies_hz=[100.0], damping_ratios=[0.01], phi_wall_left=[0.0], phi_wall_right=[0.0],
+                       phi_tip=[1.0], participation=[1.0])
+    sys = system_arrays(model, Impactor())
+    v0 = 0.5
+    y0 = np.array([0.0, 0.0, sys.g - 1e-5, v0])
+    y, onsets, releases, speeds = reference_run(y0, 1e-3, 2 * math.pi * 1000.0, 0.0, sys)
+    delta_max = (5 * sys.m_a * v0**2 / (4 * sys.k_H)) ** 0.4
+    t_c = 2 * math.sqrt(math.pi) * gamma_fn(1.4) / gamma_fn(0.9) * delta_max / v0
+    assert releases[0] - onsets[0] == pytest.approx(t_c, rel=1e-9)
+    assert abs(y[3]) == pytest.approx(v0, rel=1e-10)
