@@ -18,8 +18,8 @@ from typing import Any
 from scans.errors import ScanError
 
 _WHERE = {
-    "scans.contact": ["PAPER_CLEARANCE", "PAPER_DELTA_MAX", "PAPER_FLATTENING", "PAPER_RADIUS", "PLACEMENTS",
-                      "ScanContact", "Sphere", "scan_contact"],
+    "scans.contact": ["DEFAULT_DENOISE", "PAPER_CLEARANCE", "PAPER_DELTA_MAX", "PAPER_FLATTENING", "PAPER_RADIUS", "PLACEMENTS",
+                      "ScanContact", "Sphere", "denoise", "scan_contact"],
     "scans.examples": ["EXAMPLES", "example_path", "example_scan", "write_examples"],
     "scans.io": ["SUPPORTED", "UNITS", "Scan", "check_units", "read_scan", "write_scan"],
     "scans.metrics": ["CraterMetrics", "clearance_bounds", "crater_metrics"],

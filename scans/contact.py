@@ -14,6 +14,23 @@ the crater where it made it):
 * "deepest": above the deepest point of the (lightly smoothed) scan.
 For a flat wall (no depression above the noise) both are the centre of the scanned area.
 
+Scanner noise and the indentation reference. The indentation is measured from the sphere's first touch
+(`bem_contact`'s convention). On a raw scan that touch lands on the highest noise peak, so every
+indentation is overstated by a few noise sigmas and k_H comes out low (paper-like crater, 30 um
+triangles: -0.6 % at 0.1 um noise, -3.4 % at 0.5 um, -7 % at 1 um). By default the wall is therefore
+denoised before the gap is built, by a second-order (local-quadratic) Gaussian filter
+
+    h_d = G_s * h - (s^2 / 2) lap(G_s * h)   (continuous form; `denoise` uses its exact discrete kernel),
+
+the equivalent kernel G_s (2 - r^2 / (2 s^2)) of a Gaussian-weighted local quadratic regression: it
+reproduces any quadratic surface exactly (a plain Gaussian raises a crater's bottom by
+(s^2 / 2) lap(h), which cost -0.4 % of k_H at s = 30 um), so a smooth crater keeps its shape and only
+the noise is averaged out. With s = DEFAULT_DENOISE = 90 um (3 triangles of a 30 um scan) k_H of the
+paper-like crater moves by -0.08 % without noise and by at most -0.4 % with 1 um noise (benchmark
+tests/benchmarks/test_scans_calibrate.py); denoise = 0 restores the raw scan (the first touch on the
+noisiest point). A filter wide against the crater's bottom would flatten it: s is checked against the
+crater's radius by the caller (a warning in `ies calibrate`).
+
 The BEM grid is centred there, with the node convention of `bem_contact` (element centres at
 (i - n // 2) dx, axis 0 = x). Its side is chosen so that it holds every point that could touch at the
 largest indentation: the elastic displacement K p is >= 0 everywhere, so the contact at indentation
@@ -40,6 +57,33 @@ PAPER_FLATTENING = 0.02e-3
 #: nominal clearance (Sect. 4.1: (17 - 15.84) / 2 mm)
 PAPER_CLEARANCE = 0.58e-3
 PLACEMENTS = ("centroid", "deepest")
+#: width (standard deviation, m) of the default second-order Gaussian denoising of the wall (module docstring)
+DEFAULT_DENOISE = 90e-6
+
+
+def denoise(height: np.ndarray, width_px: float) -> np.ndarray:
+    """Second-order Gaussian filter of a height map: width_px = s, the Gaussian's standard deviation in pixels.
+
+    The equivalent kernel of a local quadratic regression with Gaussian weights,
+    K = G(x) G(y) (a - b (x^2 + y^2)), continuous limit a = 2, b = 1 / (2 s^2), i.e. G * h - (s^2 / 2) lap(G * h).
+    a and b are solved for the sampled, truncated (4 s) Gaussian so that the discrete kernel has sum 1 and zero
+    second moments: quadratic surfaces pass unchanged to rounding (bias of order s^4 times the fourth
+    derivatives), white noise keeps about 2.5 / (4 pi s^2) of its variance. width_px = 0 returns the map.
+    """
+    if width_px <= 0:
+        return height
+    x = np.arange(-math.ceil(4 * width_px), math.ceil(4 * width_px) + 1, dtype=float)
+    g = np.exp(-0.5 * (x / width_px) ** 2)
+    g /= g.sum()
+    q = x**2 * g
+    m2, m4 = float(g @ x**2), float(g @ x**4)
+    # K = a g(x) g(y) - b (q(x) g(y) + g(x) q(y)): sum K = a - 2 b m2 = 1, sum K x^2 = a m2 - b (m4 + m2^2) = 0
+    a, b = (m4 + m2**2) / (m4 - m2**2), m2 / (m4 - m2**2)
+
+    def separable(k0: np.ndarray, k1: np.ndarray) -> np.ndarray:
+        return ndi.correlate1d(ndi.correlate1d(height, k0, axis=0, mode="nearest"), k1, axis=1, mode="nearest")
+
+    return a * separable(g, g) - b * (separable(q, g) + separable(g, q))
 
 
 @dataclass(frozen=True)
@@ -92,13 +136,16 @@ class ScanContact:
     reach: float
     delta_max: float
     smoothing: float = 0.0
+    denoise: float = 0.0
     holes: dict[int, HoleReport] = field(default_factory=dict, compare=False)
 
     def gap_at(self, n: int) -> tuple[np.ndarray, float]:
         """Initial gap (m, min 0) on the n x n grid of side `self.side`, and the pitch dx (m).
 
         The signature `calibrate_k_H` expects; the hole report for each n is kept in `self.holes`.
-        With `smoothing` > 0 the wall is first filtered by a Gaussian of that standard deviation (m).
+        The wall is first denoised (`denoise`, m; module docstring) and, with `smoothing` > 0, then
+        filtered by a plain Gaussian of that standard deviation (m). min(gap) = 0 is then the first touch
+        on that (denoised) wall: the indentation reference.
         """
         height, dx = self.height_at(n)
         offsets = (np.arange(n) - n // 2) * dx
@@ -106,9 +153,10 @@ class ScanContact:
         return gap - gap.min(), dx
 
     def height_at(self, n: int) -> tuple[np.ndarray, float]:
-        """Levelled (and, if asked, smoothed) wall height (m) on the grid of `gap_at(n)`."""
+        """Levelled, denoised (and, if asked, smoothed) wall height (m) on the grid of `gap_at(n)`."""
         height, dx, holes = self.surface.resample(self.centre, self.side, n)
         self.holes[n] = holes
+        height = denoise(height, self.denoise / dx)
         if self.smoothing > 0:
             height = ndi.gaussian_filter(height, self.smoothing / dx, mode="nearest")
         return height, dx
@@ -123,14 +171,16 @@ def scan_contact(
     side: float | None = None,
     margin: float = 1.15,
     smoothing: float = 0.0,
+    denoise: float = DEFAULT_DENOISE,
 ) -> ScanContact:
     """Place the sphere above the crater and size the BEM domain (see the module docstring).
 
     side: BEM domain side (m); None chooses margin x the diameter of {gap <= delta_max}.
-    smoothing: standard deviation (m) of a Gaussian filter applied to the wall before the BEM; 0 (default)
-    uses the scan as it is. Scanner noise puts the first touch on the highest noise peak and biases k_H
-    low (paper-like crater, 30 um triangles: -0.6 % at 0.1 um noise, -3.4 % at 0.5 um); a filter of about
-    one triangle size removes most of that but rounds the crater (-0.4 % on a noise-free scan). Raises
+    denoise: width (standard deviation, m) of the second-order Gaussian filter against scanner noise
+    (module docstring; default DEFAULT_DENOISE = 90 um); 0 uses the scan as it is, the first touch then
+    sits on the highest noise peak and k_H comes out low (paper-like crater: -3.4 % at 0.5 um noise).
+    smoothing: standard deviation (m) of an extra plain Gaussian filter; 0 (default) applies none. It
+    rounds the crater (-0.4 % on a noise-free scan at 30 um), so it is only kept for comparison. Raises
     ScanError if that region reaches the edge of the scan (the crater is larger than the scanned area)
     or does not fit in the given side.
     """
@@ -138,6 +188,8 @@ def scan_contact(
         raise ScanError(f"unknown sphere placement {placement!r}; use one of {', '.join(PLACEMENTS)}")
     if not (math.isfinite(smoothing) and smoothing >= 0):
         raise ScanError(f"smoothing {smoothing!r} m must be a finite number >= 0")
+    if not (math.isfinite(denoise) and denoise >= 0):
+        raise ScanError(f"denoising width {denoise!r} m must be a finite number >= 0 (default {DEFAULT_DENOISE:g}, 0 = off)")
     if not (math.isfinite(delta_max) and delta_max > 0):
         raise ScanError(f"largest indentation {delta_max!r} m must be > 0 (paper: 40e-6)")
     centre = surface.centre if placement == "centroid" else surface.deepest
@@ -170,4 +222,5 @@ def scan_contact(
             f"the grid side {side * 1e3:.3g} mm is smaller than the region the sphere can touch at "
             f"{delta_max * 1e6:.3g} um indentation ({needed * 1e3:.3g} mm across); use a larger side or the automatic one"
         )
-    return ScanContact(surface, sphere, centre, placement, float(side), reach, float(delta_max), float(smoothing))
+    return ScanContact(surface, sphere, centre, placement, float(side), reach, float(delta_max), float(smoothing),
+                       float(denoise))

@@ -53,6 +53,28 @@ def test_imprint_without_the_flag_is_warned_about(tmp_path, capsys):
     assert len(warnings) == 1 and "use --imprint" in warnings[0]
 
 
+def test_indentation_reference_is_reported_and_the_raw_scan_stays_available(tmp_path, capsys):
+    """Default: the wall denoised over 90 um, said in the text and the JSON; --denoise 0 is the raw scan
+    (the earlier behaviour), warned about when the scan is noisy; a bad --denoise is one line, exit 2."""
+    scan = synthetic_scan(PAPER_CRATER, side=4e-3, triangle=50e-6, noise=0.5e-6, seed=4)
+    path = write_scan(tmp_path / "noisy.ply", scan.vertices, scan.faces)
+    assert main(["calibrate", str(path), *FAST]) == 0
+    out = capsys.readouterr().out
+    assert "indentation delta from the first touch on the wall denoised by a second-order Gaussian filter of 90 um" in out
+    assert "warning:" not in out
+    assert main(["calibrate", str(path), "--denoise", "0", "--json", *FAST]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["denoise"] == 0 and data["indentation_reference"].startswith("first touch on the raw scan")
+    assert any("--denoise 0" in w for w in data["warnings"]) and data["units"]["denoise"] == "m"
+    assert main(["calibrate", "--flat", "--json", *FAST]) == 0
+    assert json.loads(capsys.readouterr().out)["indentation_reference"].startswith("first touch of the ideal sphere")
+    assert main(["calibrate", str(path), "--denoise", "-3", *FAST]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err.count("\n") == 1 and "--denoise -3" in captured.err
+    assert main(["calibrate", str(path), "--denoise", "400", "--json", *FAST]) == 0
+    assert any("wide against the crater" in w for w in json.loads(capsys.readouterr().out)["warnings"])
+
+
 def _bad_scans(tmp_path):
     """name -> (file, extra arguments, words the message must contain)."""
     cases = {"missing file": (tmp_path / "nope.stl", [], "no such file")}
