@@ -73,8 +73,9 @@ def axis_design(space: ParameterSpace, name: str, n_interior: int = 1) -> Design
 
 
 def box_design(space: ParameterSpace, n_interior: int = 4, *, name: str = "joint", seed: int = 0) -> Design:
-    """Joint variation (Fig. 8): the 2^k corners of the varied parameters, the centre and
-    `n_interior - 1` further interior points from a scrambled Sobol' sequence (seeded)."""
+    """Joint variation (Fig. 8): the 2^k corners of the varied parameters, the centre,
+    `n_interior - 1` further interior points from a scrambled Sobol' sequence (seeded) and, when
+    n_interior >= 1, the nominal point unless it is a corner."""
     varied = space.varied
     if not varied:
         raise StudyError("no parameter is varied; widen at least one interval")
@@ -97,6 +98,9 @@ def box_design(space: ParameterSpace, n_interior: int = 4, *, name: str = "joint
     for i, t in enumerate(interior):
         vals = space.point(t)
         points.append(DesignPoint(vals, "interior", f"interior{i}"))
+    nominal = DesignPoint(space.nominal(), "interior", "nominal")
+    if n_interior >= 1 and all(nominal.key() != p.key() for p in points):
+        points.append(nominal)  # inside the closed box too: monotonicity puts it within the corner band
     return Design(name, "box", tuple(points))
 
 
