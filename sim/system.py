@@ -22,6 +22,8 @@ Conventions shared by every integrator in `sim`
   the magnitude |c_1| of the fundamental Fourier coefficient of q_tip = phi_tip^T s
   (c_1 = (2/T) int_period q_tip exp(-i Omega t) dt, in m) and the number of contact onsets
   (open -> closed transitions at either wall) in that period.
+  ``record`` is None, or a float64 array of shape (n_periods * M + 1, len(y)) that receives the state
+  at M equally spaced instants per period (first row: the initial state).
 * Normalisations (Sects. 5, 5.3) always use the *nominal* (starred) parameters, so that results
   with varied D, g, k_H stay on the paper's axes:
   a_noabs* = phi_tip,1 (phi_1^T M b) a_base / (2 D*),  a_base* = 2 D* g* / (phi_c,1 phi_1^T M b).

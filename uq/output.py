@@ -48,8 +48,11 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
         raise StudyError(f"cannot write {target}: folder {directory} does not exist; create it or choose another path")
     fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=target.suffix, dir=directory)
     os.close(fd)
+    umask = os.umask(0)
+    os.umask(umask)
     try:
         yield Path(tmp)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; results are ordinary files
         os.replace(tmp, target)
     except BaseException:
         if os.path.exists(tmp):
