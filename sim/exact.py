@@ -482,7 +482,8 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
                     h = max(s - s * 0.9 * err ** -0.4, 0.05 * s)
                     continue
             elif tau < step + s_rel and tau < t_stop - t:
-                step = max(tau - 0.9 * s_rel, 0.5 * tau)
+                # approach so that the release step left over is s_rel (never longer than the step control allows)
+                step = min(step, max(tau - 0.9 * s_rel, 0.5 * tau))
                 last = False
         kind = _ONSET if first else _REGULAR
         err = _dp_step(Y, t, step, kind, K, tmp, Ynew, n, modes, par)
@@ -549,7 +550,7 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
 # ----------------------------------------------------------------------------------------------------------
 @njit(cache=True)
 def _to_state(Y, t, y_out, n, modes, par):
-    """Write [s, s', u_a, u_a'] at phase time t from the deviation state Y (inverse of `_from_state`)."""
+    """Write [s, s', u_a, u_a'] at phase time t from the deviation state Y (inverse of the split in `_advance`)."""
     Om = par[_OM]
     ct = math.cos(Om * t)
     st = math.sin(Om * t)
