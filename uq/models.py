@@ -93,8 +93,16 @@ class IESModel:
             raise StudyError(f"[excitation]: {exc}") from None
 
     def check(self) -> None:
-        """Build the protocol and the rig model once so that bad settings fail before any task runs."""
-        self._stepped_sine()
+        """Build the protocol, the integrator and the rig model once so that bad settings fail before any
+        task runs (and before anything is written)."""
+        from sim.errors import SimulationInputError
+        from sim.integrators import get_integrator
+
+        protocol = self._stepped_sine()
+        try:
+            get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
+        except SimulationInputError as exc:
+            raise StudyError(f"[excitation]: {exc}") from None
         _rig_model(self.n_modes)
 
     def with_rig(self) -> "IESModel":

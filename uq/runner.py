@@ -88,17 +88,24 @@ class ResultStore:
         return json.loads(self._path(key).read_text())
 
 
-def prepare_output(folder: str | Path, *, resume: bool) -> Path:
-    """Create the output folder and check it can be written; refuse to overwrite finished results."""
+def check_writable(folder: str | Path) -> Path:
+    """Create `folder` (and parents) and prove a file can be written in it, else a one-line StudyError."""
     folder = Path(folder)
     try:
-        (folder / "tasks").mkdir(parents=True, exist_ok=True)
-        probe = folder / "tasks" / f".probe-{os.getpid()}"
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / f".probe-{os.getpid()}"
         probe.write_text("")
         probe.unlink()
     except OSError as exc:
         reason = exc.strerror or type(exc).__name__
         raise StudyError(f"cannot write to output folder {folder} ({reason}); choose another --out") from None
+    return folder
+
+
+def prepare_output(folder: str | Path, *, resume: bool) -> Path:
+    """Create the output folder and check it can be written; refuse to overwrite finished results."""
+    folder = Path(folder)
+    check_writable(folder / "tasks")
     if not resume and ResultStore(folder).count():
         raise StudyError(f"output folder {folder} already holds task results; pass --resume to continue that study "
                          "or choose another --out")

@@ -128,3 +128,11 @@ def test_reproduce_uses_the_calibrated_k_H(tmp_path, monkeypatch, capsys):
     meta = json.loads((out / "fig7" / "study.json").read_text())
     assert meta["study"]["parameters"]["k_H"]["max"] == pytest.approx(1.5 * K_H_STAR)
     assert (out / "fig7" / "fig7.pdf").is_file() and (out / "fig7" / "fig6.png").is_file()
+
+
+def test_reproduce_bad_integrator_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "o"
+    assert main(["reproduce", "all", "--quick", "--integrator", "rk99", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "unknown integrator 'rk99'" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()

@@ -32,6 +32,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     calib.add_argument("--calibration", type=Path, metavar="FILE",
                        help="use this `ies calibrate --json` output instead of running the calibration")
     calib.add_argument("--no-calibration", action="store_true", help="keep Table 2's k_H bounds")
+    parser.add_argument("--integrator", metavar="NAME",
+                        help="override the study files' integrator (ode3 = the paper's scheme, exact = free flight)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -89,14 +91,20 @@ def run(args: argparse.Namespace) -> int:
     from uq.errors import StudyError
     from uq.execute import run_interval_study
     from uq.figures import interval_figures
-    from uq.runner import prepare_output
+    from uq.runner import check_writable
     from uq.space import K_H_STAR, calibrated_k_H
     from uq.study import load_study
 
     figures = ("fig7", "fig8") if args.figure == "all" else (args.figure,)
     studies = [load_study(study_file(f, args.quick)) for f in figures]
+    if args.integrator:
+        from dataclasses import replace
+
+        studies = [replace(s, protocol={**s.protocol, "integrator": args.integrator}) for s in studies]
+    for s in studies:
+        s.make_model().check()  # bad settings (e.g. an unknown integrator) fail here, before anything is written
     out = args.out
-    prepare_output(out, resume=True)  # checks the folder can be written; results live in subfolders
+    check_writable(out)
     calibration = None
     if args.calibration is not None:
         calibration = {"k_H": calibrated_k_H(args.calibration), "source": str(args.calibration)}
