@@ -34,7 +34,7 @@ def models_on_path(monkeypatch):
 def test_sobol_command_on_ishigami(tmp_path, capsys):
     study = tmp_path / "s.toml"
     study.write_text("[study]\nkind = 'sobol'\nmodel = 'ishigami'\nseed = 5\n[sobol]\nbootstrap = 300\n")
-    assert main(["sobol", str(study), "--n", "1024", "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert main(["sobol", str(study), "--n", "512", "--out", str(tmp_path / "o"), "--quiet", "--jobs", "1"]) == 0
     res = {r["parameter"]: r for r in rows(tmp_path / "o" / "sobol.csv")}
     V = 7**2 / 8 + 0.1 * np.pi**4 / 5 + 0.1**2 * np.pi**8 / 18 + 0.5
     exact_S1 = {"x1": 0.5 * (1 + 0.1 * np.pi**4 / 5) ** 2 / V, "x2": 7**2 / 8 / V, "x3": 0.0}
@@ -43,7 +43,7 @@ def test_sobol_command_on_ishigami(tmp_path, capsys):
     for suffix in ("png", "pdf"):
         assert (tmp_path / "o" / f"sobol.{suffix}").stat().st_size > 1000
     meta = json.loads((tmp_path / "o" / "study.json").read_text())
-    assert meta["study"]["sobol"]["n"] == 64 and meta["summary"]["base_sample"] == 1024
+    assert meta["study"]["sobol"]["n"] == 64 and meta["summary"]["base_sample"] == 512
 
 
 def test_noisy_model_noise_share_and_no_false_flags(tmp_path, models_on_path):
@@ -68,7 +68,7 @@ def test_noisy_model_noise_share_and_no_false_flags(tmp_path, models_on_path):
 def test_failed_runs_are_reported_not_hidden(tmp_path, models_on_path, capsys):
     path = tmp_path / "f.toml"
     path.write_text("[study]\nkind = 'sobol'\nmodel = '_uq_models:failing'\nrepetitions = 2\n" + AB + "[sobol]\nn = 32\n")
-    assert main(["sobol", str(path), "--out", str(tmp_path / "o"), "--quiet", "--no-figures"]) == 0
+    assert main(["sobol", str(path), "--out", str(tmp_path / "o"), "--quiet", "--jobs", "1", "--no-figures"]) == 0
     err = capsys.readouterr().err
     assert "runs failed" in err and "not analysed" in err and "no finite run" in err
     runs = rows(tmp_path / "o" / "runs.csv")
@@ -81,7 +81,7 @@ def test_interval_command_writes_data_then_figures(tmp_path):
     path = tmp_path / "i.toml"
     path.write_text("[study]\nkind = 'interval'\nmodel = 'ishigami'\n[parameters.x1]\nnominal = 0.5\nmin = 0.2\n"
                     "max = 1.0\n[interval]\ndesigns = ['individual', 'joint']\n")
-    assert main(["interval", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert main(["interval", str(path), "--out", str(tmp_path / "o"), "--quiet", "--jobs", "1"]) == 0
     for name in ("runs.csv", "points.csv", "bands.csv", "study.json", "fig7.png", "fig7.pdf", "fig8.png", "fig8.pdf"):
         assert (tmp_path / "o" / name).is_file(), name
     meta = json.loads((tmp_path / "o" / "study.json").read_text())

@@ -47,7 +47,7 @@ def data_of(folder):
 def serial(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("serial")
     out = tmp / "out"
-    assert main(["interval", str(tiny_study(tmp)), "--out", str(out), "--quiet", "--no-figures"]) == 0
+    assert main(["interval", str(tiny_study(tmp)), "--out", str(out), "--quiet", "--jobs", "1", "--no-figures"]) == 0
     return out
 
 
@@ -63,14 +63,14 @@ def test_dask_local_cluster_gives_identical_numbers(serial, tmp_path):
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         out = tmp_path / "out"
         assert main(["interval", str(tiny_study(tmp_path)), "--out", str(out), "--scheduler",
-                     cluster.scheduler_address, "--quiet", "--no-figures"]) == 0
+                     cluster.scheduler_address, "--quiet", "--jobs", "1", "--no-figures"]) == 0
     assert data_of(out) == data_of(serial)
 
 
 def test_unreachable_scheduler_is_one_line(tmp_path, capsys):
     pytest.importorskip("distributed")
     code = main(["interval", str(tiny_study(tmp_path)), "--out", str(tmp_path / "o"), "--scheduler",
-                 "tcp://127.0.0.1:9", "--quiet"])
+                 "tcp://127.0.0.1:9", "--quiet", "--jobs", "1"])
     err = capsys.readouterr().err
     assert code == 2 and "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in err
     assert len(err.strip().splitlines()) == 1
@@ -79,7 +79,7 @@ def test_unreachable_scheduler_is_one_line(tmp_path, capsys):
 def test_sigkill_then_resume_runs_only_unfinished_tasks(serial, tmp_path):
     study = tiny_study(tmp_path)
     out = tmp_path / "out"
-    proc = subprocess.Popen([sys.executable, "-m", "uq", "interval", str(study), "--out", str(out), "--quiet",
+    proc = subprocess.Popen([sys.executable, "-m", "uq", "interval", str(study), "--out", str(out), "--quiet", "--jobs", "1",
                              "--no-figures"], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     tasks = out / "tasks"
     total = 2 * 2 * 8  # reps x levels x points (nominal, D: min/nominal/max, g, k_H: mid and max, corners, ...)
@@ -96,7 +96,7 @@ def test_sigkill_then_resume_runs_only_unfinished_tasks(serial, tmp_path):
     assert not (out / "bands.csv").exists()
     for path in tasks.glob("*.json"):  # every finished task file is complete (atomic rename)
         assert json.loads(path.read_text())["outputs"]
-    assert main(["interval", str(study), "--out", str(out), "--resume", "--quiet", "--no-figures"]) == 0
+    assert main(["interval", str(study), "--out", str(out), "--resume", "--quiet", "--jobs", "1", "--no-figures"]) == 0
     summary = json.loads((out / "study.json").read_text())["summary"]
     assert summary["reused"] == len(finished) and summary["ran"] == summary["tasks"] - len(finished)
     assert all(p.stat().st_mtime_ns == finished[p.name] for p in tasks.glob("*.json") if p.name in finished)
@@ -106,6 +106,6 @@ def test_sigkill_then_resume_runs_only_unfinished_tasks(serial, tmp_path):
 
 
 def test_resume_with_everything_done_runs_nothing(serial, tmp_path, capsys):
-    assert main(["interval", str(tiny_study(tmp_path)), "--out", str(serial), "--resume", "--quiet",
+    assert main(["interval", str(tiny_study(tmp_path)), "--out", str(serial), "--resume", "--quiet", "--jobs", "1",
                  "--no-figures"]) == 0
     assert "(0 run now" in capsys.readouterr().out

@@ -75,7 +75,7 @@ def test_resolved_study_lists_every_setting(tmp_path):
 def test_bad_study_is_one_line_exit_2(tmp_path, capsys, extra, message):
     path = write(tmp_path, extra)
     out = tmp_path / "out"
-    code = main(["interval", str(path), "--out", str(out), "--quiet"])
+    code = main(["interval", str(path), "--out", str(out), "--quiet", "--jobs", "1"])
     err = capsys.readouterr().err
     assert code == 2
     assert message in err, err
@@ -93,22 +93,22 @@ def test_unwritable_output_folder(tmp_path, capsys):
     path = write(tmp_path, "[study]\nkind = 'interval'\nmodel = 'ishigami'\n")
     blocker = tmp_path / "file"
     blocker.write_text("not a folder")
-    assert main(["interval", str(path), "--out", str(blocker / "sub"), "--quiet"]) == 2
+    assert main(["interval", str(path), "--out", str(blocker / "sub"), "--quiet", "--jobs", "1"]) == 2
     err = capsys.readouterr().err
     assert "cannot write to output folder" in err and len(err.strip().splitlines()) == 1
     if os.geteuid() != 0:  # root can write anywhere
         locked = tmp_path / "locked"
         locked.mkdir(mode=0o500)
-        assert main(["interval", str(path), "--out", str(locked / "x"), "--quiet"]) == 2
+        assert main(["interval", str(path), "--out", str(locked / "x"), "--quiet", "--jobs", "1"]) == 2
 
 
 def test_existing_results_are_not_overwritten_without_resume(tmp_path, capsys):
     path = write(tmp_path, "[study]\nkind = 'interval'\nmodel = 'ishigami'\n")
     out = tmp_path / "out"
-    assert main(["interval", str(path), "--out", str(out), "--quiet", "--no-figures"]) == 0
+    assert main(["interval", str(path), "--out", str(out), "--quiet", "--jobs", "1", "--no-figures"]) == 0
     before = sorted((out / "tasks").iterdir())
     capsys.readouterr()
-    assert main(["interval", str(path), "--out", str(out), "--quiet"]) == 2
+    assert main(["interval", str(path), "--out", str(out), "--quiet", "--jobs", "1"]) == 2
     assert "--resume" in capsys.readouterr().err
     assert sorted((out / "tasks").iterdir()) == before
 

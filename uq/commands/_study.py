@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -9,7 +10,8 @@ from pathlib import Path
 def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     """--out, --jobs, --scheduler, --resume, --no-figures, --quiet."""
     parser.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: the study's [study] output)")
-    parser.add_argument("--jobs", type=int, default=1, metavar="N", help="local worker processes (default 1)")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, metavar="N",
+                        help="local worker processes (default: the number of CPU cores; 1 runs in this process)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="run on a Dask cluster, e.g. tcp://host:8786 (needs dask.distributed)")
     parser.add_argument("--resume", action="store_true",

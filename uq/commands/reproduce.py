@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -25,7 +26,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="reduced protocol (fewer levels, frequencies, repetitions, shorter holds); same trends")
     parser.add_argument("--out", type=Path, default=Path("ies-out/reproduce"), metavar="DIR",
                         help="output folder (default ies-out/reproduce)")
-    parser.add_argument("--jobs", type=int, default=2, metavar="N", help="local worker processes (default 2)")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, metavar="N",
+                        help="local worker processes (default: the number of CPU cores)")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://host:8786")
     parser.add_argument("--resume", action="store_true", help="continue an interrupted reproduction in --out")
     calib = parser.add_mutually_exclusive_group()
