@@ -121,6 +121,10 @@ def sobol_indices(space: ParameterSpace, X: np.ndarray, Y: np.ndarray, *, num_re
     if variance <= 0:
         return SobolResult(problem["names"], nan, nan, nan, nan, variance, noise_variance, np.nan,
                            int((~finite).sum()), confidence, "the output does not vary over the sample", notes)
+    if noise_variance >= 0.5 * variance:
+        notes.append(f"repetition noise makes up {noise_variance / variance:.0%} of the variance (a share >= 100 % "
+                     "means no parameter effect is resolved above the noise): the indices mostly describe noise; "
+                     "raise the repetitions or the hold time")
     res = sobol_analyzer.analyze(problem, ybar, calc_second_order=False, num_resamples=num_resamples,
                                  conf_level=confidence, print_to_console=False, seed=seed)
     return SobolResult(problem["names"], np.asarray(res["S1"]), np.asarray(res["S1_conf"]), np.asarray(res["ST"]),

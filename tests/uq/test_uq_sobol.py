@@ -48,6 +48,9 @@ def test_repetition_noise_share_is_estimated(space):
     res = sobol_indices(space, X, Y, num_resamples=100)
     expected = (sigma**2 / r) / (ishigami_analytic_variance() + sigma**2 / r)
     assert res.noise_share == pytest.approx(expected, rel=0.1)
+    assert not res.notes  # noise well below half the variance: no warning
+    pure_noise = sobol_indices(space, X, sigma * rng.standard_normal((X.shape[0], r)), num_resamples=10)
+    assert pure_noise.noise_share == pytest.approx(1.0, rel=0.1) and "repetition noise makes up" in pure_noise.notes[0]
 
 
 def ishigami_analytic_variance():
