@@ -140,6 +140,10 @@ def kkt_measures(p: np.ndarray, g: np.ndarray, self_compliance: float, delta: fl
     return residual, complementarity
 
 
+# Indentations below 1e-12 grid pitches are round-off of the geometry, not contact (they also underflow).
+MIN_RELATIVE_INDENTATION = 1e-12
+
+
 def _validate(gap: np.ndarray, dx: float, E_star: float, indentation, force, solver: str, x0) -> tuple[np.ndarray, str]:
     h = np.asarray(gap, dtype=float)
     if h.ndim != 2 or h.size == 0:
@@ -158,6 +162,11 @@ def _validate(gap: np.ndarray, dx: float, E_star: float, indentation, force, sol
     for name, value, unit in (("indentation", indentation, "m"), ("force", force, "N")):
         if value is not None and not (math.isfinite(value) and value > 0):
             raise ContactInputError(f"{name} = {value!r} {unit} must be a finite number > 0")
+    if indentation is not None and indentation < MIN_RELATIVE_INDENTATION * dx:
+        raise ContactInputError(
+            f"indentation = {indentation!r} m is below the model's length resolution ({MIN_RELATIVE_INDENTATION:g} dx = "
+            f"{MIN_RELATIVE_INDENTATION * dx:.3g} m); give a physical indentation"
+        )
     if solver == "auto":
         solver = DEFAULT_SOLVER
     if solver not in SOLVERS:
