@@ -133,7 +133,7 @@ def _as_2d(values: np.ndarray | Sequence) -> np.ndarray:
 
 
 def band(design: Design, values: np.ndarray, noise: np.ndarray | None = None, *, z: float = 2.0,
-         output_labels: Sequence[str] | None = None) -> Band:
+         output_labels: Sequence[str] | None = None, pool: bool = True) -> Band:
     """Band of `values` (n_points x n_outputs, rows in `design.points` order) with the monotonicity check.
 
     `noise` (same shape) is the standard error of each value (repetition noise of a chaotic response;
@@ -141,6 +141,9 @@ def band(design: Design, values: np.ndarray, noise: np.ndarray | None = None, *,
     z * sqrt(se_a^2 + se_b^2). Box designs: an interior value outside the corner envelope is a
     violation. Axis designs: the sequence along the axis must be monotone (all steps >= -tol or all
     <= +tol). Non-finite values are refused (catch failed runs before).
+    pool: use the RMS standard error of all the design's points (per output column) for every point: a
+    chaotic response scatters alike at nearby parameters, and the standard error of 2-5 repetitions of
+    one point is itself too uncertain to judge by.
     """
     y = _as_2d(values)
     if y.shape[0] != len(design.points):
@@ -151,6 +154,8 @@ def band(design: Design, values: np.ndarray, noise: np.ndarray | None = None, *,
     if se.shape != y.shape:
         raise StudyError(f"noise has shape {se.shape} but values have shape {y.shape}")
     se = np.nan_to_num(se, nan=0.0)
+    if pool:
+        se = np.broadcast_to(np.sqrt(np.mean(se**2, axis=0)), se.shape)
     corner = np.array([p.role == "corner" for p in design.points])
     labels = output_labels or [str(j) for j in range(y.shape[1])]
     corner_lo, corner_hi = y[corner].min(axis=0), y[corner].max(axis=0)

@@ -80,3 +80,13 @@ def test_nan_values_are_refused():
     design = axis_design(unit_space(1), "x0", n_interior=0)
     with pytest.raises(StudyError, match="NaN"):
         band(design, np.array([1.0, np.nan, 2.0]))
+
+
+def test_noise_is_pooled_over_the_design_points():
+    # one point's own standard error is 0 (two equal repetitions by chance); the design's pooled noise counts
+    space = ParameterSpace((Parameter("x0", 0.1, 0.1, 1.0),))
+    design = axis_design(space, "x0", n_interior=1)
+    values = np.array([[1.0], [1.05], [0.99]])
+    noise = np.array([[0.04], [0.0], [0.04]])
+    assert band(design, values, noise, pool=True).monotone
+    assert not band(design, values, noise, pool=False).monotone
