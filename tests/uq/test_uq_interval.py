@@ -85,8 +85,8 @@ def test_nan_values_are_refused():
 def test_noise_is_pooled_over_the_design_points():
     # one point's own standard error is 0 (two equal repetitions by chance); the design's pooled noise counts
     space = ParameterSpace((Parameter("x0", 0.1, 0.1, 1.0),))
-    design = axis_design(space, "x0", n_interior=1)
-    values = np.array([[1.0], [1.05], [0.99]])
-    noise = np.array([[0.04], [0.0], [0.04]])
+    design = axis_design(space, "x0", n_interior=2)
+    values = np.array([[1.0], [1.0], [1.05], [0.99]])
+    noise = np.array([[0.06], [0.0], [0.0], [0.0]])  # RMS 0.03: steps of 0.05-0.06 are within 2 sqrt(2) 0.03
     assert band(design, values, noise, pool=True).monotone
     assert not band(design, values, noise, pool=False).monotone
