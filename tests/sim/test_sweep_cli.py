@@ -29,6 +29,7 @@ def test_sweep_json_out_and_plot(tmp_path, model_file, capsys):
     assert data["eta"] == pytest.approx([0.98, 0.99, 1.0])
     assert data["resonant_mean"] == pytest.approx(max(data["mean"]))
     assert data["n_samples"] == 2 and data["protocol"]["integrator"] == "ode3"
+    assert data["protocol"]["start"] == "base-velocity"  # the default initial conditions (sim.protocol)
     table = np.genfromtxt(out / "sweep.csv", delimiter=",", names=True, dtype=None, encoding=None)
     np.testing.assert_allclose(table["mean"], data["mean"], rtol=1e-12)
     assert json.loads((out / "sweep.json").read_text())["resonant_max"] == pytest.approx(data["resonant_max"])
