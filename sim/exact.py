@@ -51,7 +51,7 @@ from sim.system import SystemArrays
 #: Free-flight grid steps per excitation period (certification cells; no effect on accuracy).
 GRID_PER_PERIOD = 48
 #: Default tolerance of the contact integration, relative to the clearance g (error per step, in m / g).
-CONTACT_RTOL = 1e-8
+CONTACT_RTOL = 1e-7
 #: Onset/release location tolerance on the closing function, relative to g.
 GAP_TOLERANCE = 1e-12
 #: Contact onsets need an approach speed above this (m/s) unless the indentation already exceeds the tolerance.

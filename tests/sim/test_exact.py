@@ -140,8 +140,8 @@ def test_observed_order_of_the_contact_step():
 def test_energy_conserved_over_1000_impacts():
     """No damping (D = 1e-15), no excitation: modal + sphere (+ contact) energy within 1e-6 over >= 1000 impacts.
 
-    The drift is the contact integration's error and scales with rtol (about 4e-7 per impact at the
-    default 1e-8, ~2e-9 at 1e-11): the criterion needs rtol = 1e-12."""
+    The drift is the contact integration's error and scales with rtol (about 4e-7 per impact at
+    rtol 1e-8, ~2e-9 at 1e-11; more at the default 1e-7): the criterion needs rtol = 1e-12."""
     model = cantilever_like_model(undamped=True)
     model = ModalModel(frequencies_hz=model.frequencies_hz, damping_ratios=np.full(N9, 1e-15),
                        phi_wall_left=model.phi_wall_left, phi_wall_right=model.phi_wall_right,
