@@ -23,7 +23,10 @@ from sim.system import ModalModel, Nominal
 #: cv = std/mean of the per-period amplitudes above which the response counts as strongly modulated.
 #: Chosen from simulations of the rig model at a_base/a_base* = 7.4 (Fig. 4; down-sweep, 3 runs): inside the
 #: APR branch (eta = 0.976-0.980) cv = 0.02-0.05, in the SMR (eta = 0.984-1.006) cv = 0.24-0.55; points at
-#: the edge of the APR branch fall in between (0.09-0.14) and may switch label between runs.
+#: the edge of the APR branch fall in between (0.09-0.14) and may switch label between runs. Rechecked on the
+#: updated rig model (`ies sweep --level 7.4 --reps 5 --integrator exact`, up, base-velocity start): APR
+#: eta = 0.974-0.980 cv = 0.03-0.08, SMR eta = 0.982-1.02 cv = 0.43-0.53, the branch's lower edge
+#: (eta = 0.968-0.972) 0.12-0.15.
 REGIME_CV_THRESHOLD = 0.1
 APR, SMR, LINEAR = "APR", "SMR", "linear"
 
