@@ -28,7 +28,7 @@ def test_sweep_json_out_and_plot(tmp_path, model_file, capsys):
         assert key in data
     assert data["eta"] == pytest.approx([0.98, 0.99, 1.0])
     assert data["resonant_mean"] == pytest.approx(max(data["mean"]))
-    assert data["n_samples"] == 2 and data["protocol"]["integrator"] == "ode3"
+    assert data["n_samples"] == 2 and data["protocol"]["integrator"] == "exact"
     assert data["protocol"]["start"] == "base-velocity"  # the default initial conditions (sim.protocol)
     table = np.genfromtxt(out / "sweep.csv", delimiter=",", names=True, dtype=None, encoding=None)
     np.testing.assert_allclose(table["mean"], data["mean"], rtol=1e-12)
@@ -66,7 +66,7 @@ def test_overview_json_and_out(tmp_path, model_file, capsys):
     (["--eta", "0.96:1.02:0"], "empty"),
     (["--eta", "0.96-1.02"], "START:STOP:N"),
     (["--hold", "0.001"], "shorter than one excitation period"),
-    (["--dt-scale", "10"], "too large for ode3 stability"),
+    (["--integrator", "ode3", "--dt-scale", "10"], "too large for ode3 stability"),
     (["--integrator", "rk4"], "unknown integrator"),
 ])
 def test_bad_input_is_one_line_exit_2(tmp_path, model_file, capsys, args, message):
@@ -101,7 +101,7 @@ def test_diverging_simulation_exits_3_without_traceback(model_file):
     proc = subprocess.run([sys.executable, "-m", "uq", "sweep", "--level", "1e6", *FAST, "--model", model_file],
                           capture_output=True, text=True)
     assert proc.returncode == 3
-    assert "diverged" in proc.stderr and "Traceback" not in proc.stderr
+    assert "numerical failure" in proc.stderr and "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
 
 
