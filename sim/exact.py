@@ -46,7 +46,7 @@ import numpy as np
 from numba import njit
 
 from sim.errors import SimulationDiverged, SimulationInputError
-from sim.system import SystemArrays
+from sim.system import SystemArrays, check_run_step
 
 #: Free-flight grid steps per excitation period (certification cells; no effect on accuracy).
 GRID_PER_PERIOD = 48
@@ -799,35 +799,12 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     Raises SimulationInputError for bad arguments, SimulationDiverged for a non-finite state, an
     indentation beyond the clearance or a stalled contact search.
     """
-    n = sys.omega.size
-    if not isinstance(y, np.ndarray) or y.dtype != np.float64 or y.shape != (2 * n + 2,) or not y.flags.c_contiguous:
-        raise SimulationInputError(f"state y must be a contiguous float64 array of length {2 * n + 2} (2 n_modes + 2)")
-    n_periods = int(n_periods)
-    if n_periods < 1:
-        raise SimulationInputError(f"n_periods must be at least 1, got {n_periods}")
-    Omega = float(Omega)
-    a_base = float(a_base)
-    if not math.isfinite(Omega) or Omega <= 0:
-        raise SimulationInputError(f"excitation frequency Omega must be positive (rad/s), got {Omega!r}")
-    if not math.isfinite(a_base) or a_base < 0:
-        raise SimulationInputError(f"base amplitude a_base must be >= 0 (m), got {a_base!r}")
+    n_periods, Omega, a_base, record_arr, samples = check_run_step(y, n_periods, Omega, a_base, sys, record)
     rtol = float(rtol)
     if not math.isfinite(rtol) or not 0.0 < rtol < 1e-2:
         raise SimulationInputError(f"rtol must lie in (0, 0.01), got {rtol!r}")
-    if not np.all(np.isfinite(y)):
-        raise SimulationInputError("state y contains non-finite values")
     if not (sys.m_a > 0 and sys.k_H >= 0 and sys.g > 0):
         raise SimulationInputError("sphere mass and clearance g must be positive and k_H >= 0 (0: no impactor)")
-    samples = 1
-    record_arr = np.empty((0, 2 * n + 2))
-    if record is not None:
-        rows = record.shape[0] - 1 if record.ndim == 2 else -1
-        if (record.dtype != np.float64 or record.ndim != 2 or record.shape[1] != 2 * n + 2 or rows < n_periods
-                or rows % n_periods or not record.flags.c_contiguous):
-            raise SimulationInputError(
-                f"record must be a contiguous float64 array of shape (n_periods * M + 1, {2 * n + 2})")
-        record_arr = record
-        samples = rows // n_periods
     N = max(int(grid_per_period), samples)
     N = -(-N // samples) * samples
     omega_max = float(np.max(sys.omega))

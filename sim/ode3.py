@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from sim.errors import SimulationDiverged, SimulationInputError
-from sim.system import SystemArrays
+from sim.system import SystemArrays, check_run_step
 
 #: Sect. 3.2: the highest retained mode's period is sampled with 15 time levels.
 STEPS_PER_HIGHEST_PERIOD = 15
@@ -196,35 +196,10 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     Raises SimulationInputError for bad arguments or an unstable step, SimulationDiverged if the state
     becomes non-finite or an indentation exceeds the clearance (the contact was stepped over).
     """
-    n = sys.omega.size
-    if not isinstance(y, np.ndarray) or y.dtype != np.float64 or y.shape != (2 * n + 2,) or not y.flags.c_contiguous:
-        raise SimulationInputError(f"state y must be a contiguous float64 array of length {2 * n + 2} (2 n_modes + 2)")
-    n_periods = int(n_periods)
-    if n_periods < 1:
-        raise SimulationInputError(f"n_periods must be at least 1, got {n_periods}")
-    Omega = float(Omega)
-    a_base = float(a_base)
-    if not math.isfinite(Omega) or Omega <= 0:
-        raise SimulationInputError(f"excitation frequency Omega must be positive (rad/s), got {Omega!r}")
-    if not math.isfinite(a_base) or a_base < 0:
-        raise SimulationInputError(f"base amplitude a_base must be >= 0 (m), got {a_base!r}")
+    n_periods, Omega, a_base, record_arr, samples = check_run_step(y, n_periods, Omega, a_base, sys, record)
     dt_scale = float(dt_scale)
     if not math.isfinite(dt_scale) or dt_scale <= 0:
         raise SimulationInputError(f"dt_scale must be positive, got {dt_scale!r}")
-    if not np.all(np.isfinite(y)):
-        raise SimulationInputError("state y contains non-finite values")
-
-    if record is None:
-        record_arr = np.empty((0, 2 * n + 2))
-        samples = 1
-    else:
-        rows = record.shape[0] - 1 if record.ndim == 2 else -1
-        if (record.dtype != np.float64 or record.ndim != 2 or record.shape[1] != 2 * n + 2 or rows < n_periods
-                or rows % n_periods or not record.flags.c_contiguous):
-            raise SimulationInputError(
-                f"record must be a contiguous float64 array of shape (n_periods * M + 1, {2 * n + 2})")
-        record_arr = record
-        samples = rows // n_periods
 
     dt_max = paper_time_step(float(np.max(sys.omega)), dt_scale)
     N = steps_per_period(Omega, dt_max, samples)

@@ -189,3 +189,32 @@ def contact_forces(s: np.ndarray, u_a: float, sys: SystemArrays) -> tuple[float,
     f_l = sys.k_H * delta_l**1.5 if delta_l > 0 else 0.0
     f_r = -sys.k_H * (-delta_r) ** 1.5 if delta_r < 0 else 0.0
     return f_l, f_r
+
+
+def check_run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: SystemArrays,
+                   record: np.ndarray | None) -> tuple[int, float, float, np.ndarray, int]:
+    """Validate the integrator contract's arguments (shared by every integrator).
+
+    Returns (n_periods, Omega (rad/s), a_base (m), record array (0 rows when not recording),
+    samples per period M). Raises SimulationInputError with one line for anything malformed.
+    """
+    n = sys.omega.size
+    if not isinstance(y, np.ndarray) or y.dtype != np.float64 or y.shape != (2 * n + 2,) or not y.flags.c_contiguous:
+        raise SimulationInputError(f"state y must be a contiguous float64 array of length {2 * n + 2} (2 n_modes + 2)")
+    n_periods = int(n_periods)
+    if n_periods < 1:
+        raise SimulationInputError(f"n_periods must be at least 1, got {n_periods}")
+    Omega, a_base = float(Omega), float(a_base)
+    if not np.isfinite(Omega) or Omega <= 0:
+        raise SimulationInputError(f"excitation frequency Omega must be positive (rad/s), got {Omega!r}")
+    if not np.isfinite(a_base) or a_base < 0:
+        raise SimulationInputError(f"base amplitude a_base must be >= 0 (m), got {a_base!r}")
+    if not np.all(np.isfinite(y)):
+        raise SimulationInputError("state y contains non-finite values")
+    if record is None:
+        return n_periods, Omega, a_base, np.empty((0, 2 * n + 2)), 1
+    rows = record.shape[0] - 1 if record.ndim == 2 else -1
+    if (record.dtype != np.float64 or record.ndim != 2 or record.shape[1] != 2 * n + 2 or rows < n_periods
+            or rows % n_periods or not record.flags.c_contiguous):
+        raise SimulationInputError(f"record must be a contiguous float64 array of shape (n_periods * M + 1, {2 * n + 2})")
+    return n_periods, Omega, a_base, record, rows // n_periods
