@@ -71,3 +71,20 @@ def save_figure(fig: Any, path: str | os.PathLike) -> None:
     target = Path(path)
     with atomic_path(target) as tmp:
         fig.savefig(tmp, format=target.suffix.lstrip(".") or "png", dpi=150, bbox_inches="tight")
+
+
+@contextmanager
+def plot_to(path: str | os.PathLike, figsize: tuple[float, float] = (6.0, 4.0)) -> Iterator[tuple[Any, Any]]:
+    """Yield (figure, axes) of a new matplotlib figure (Agg backend); on success it is saved atomically to
+    `path` (format from the suffix), and it is always closed."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=figsize)
+    try:
+        yield fig, ax
+        save_figure(fig, path)
+    finally:
+        plt.close(fig)

@@ -45,30 +45,20 @@ def parse_levels(text: str) -> list[float]:
 
 def plot_overview(levels, results, path: str, title: str) -> None:
     """Fig. 6: resonant mean (solid) and max (dashed) level vs excitation level, regime labels on top."""
-    import matplotlib
+    from uq.output import plot_to
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-
-    from uq.output import save_figure
-
-    fig, ax = plt.subplots(figsize=(6.5, 4.0))
-    res_mean = np.array([r.resonant_mean for r in results])
-    res_max = np.array([r.resonant_max for r in results])
-    ax.plot(levels, res_max, "s--", color="tab:red", label="max")
-    ax.plot(levels, res_mean, "o-", color="tab:blue", label="mean")
-    for level, r in zip(levels, results):
-        ax.annotate(r.regime, (level, 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom",
-                    fontsize=7, rotation=90)
-    ax.set_xlabel(r"$a_{base} / a^*_{base}$")
-    ax.set_ylabel(r"resonant level $a / a^{noabs*}$")
-    ax.set_ylim(bottom=0)
-    ax.set_title(title, pad=28)
-    ax.legend()
-    ax.grid(alpha=0.3)
-    save_figure(fig, path)
-    plt.close(fig)
+    with plot_to(path, figsize=(6.5, 4.0)) as (fig, ax):
+        ax.plot(levels, [r.resonant_max for r in results], "s--", color="tab:red", label="max")
+        ax.plot(levels, [r.resonant_mean for r in results], "o-", color="tab:blue", label="mean")
+        for level, r in zip(levels, results):
+            ax.annotate(r.regime, (level, 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom",
+                        fontsize=7, rotation=90)
+        ax.set_xlabel(r"$a_{base} / a^*_{base}$")
+        ax.set_ylabel(r"resonant level $a / a^{noabs*}$")
+        ax.set_ylim(bottom=0)
+        ax.set_title(title, pad=28)
+        ax.legend()
+        ax.grid(alpha=0.3)
 
 
 def run(args: argparse.Namespace) -> int:

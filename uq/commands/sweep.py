@@ -137,26 +137,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def plot_sweep(result, path: str, title: str) -> None:
     """Fig. 5: mean (solid) and max (dashed) amplitude vs eta with the repetition spread as bands."""
-    import matplotlib
+    from uq.output import plot_to
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from uq.output import save_figure
-
-    fig, ax = plt.subplots(figsize=(6.0, 4.0))
-    ax.fill_between(result.eta, result.max_lo, result.max_hi, color="tab:red", alpha=0.2, lw=0)
-    ax.plot(result.eta, result.max, "--", color="tab:red", label="max")
-    ax.fill_between(result.eta, result.mean_lo, result.mean_hi, color="tab:blue", alpha=0.25, lw=0)
-    ax.plot(result.eta, result.mean, "-", color="tab:blue", label="mean")
-    ax.set_xlabel(r"$\eta = \Omega/\omega^*$")
-    ax.set_ylabel(r"$a / a^{noabs*}$")
-    ax.set_title(title)
-    ax.set_ylim(bottom=0)
-    ax.legend()
-    ax.grid(alpha=0.3)
-    save_figure(fig, path)
-    plt.close(fig)
+    with plot_to(path, figsize=(6.0, 4.0)) as (fig, ax):
+        ax.fill_between(result.eta, result.max_lo, result.max_hi, color="tab:red", alpha=0.2, lw=0)
+        ax.plot(result.eta, result.max, "--", color="tab:red", label="max")
+        ax.fill_between(result.eta, result.mean_lo, result.mean_hi, color="tab:blue", alpha=0.25, lw=0)
+        ax.plot(result.eta, result.mean, "-", color="tab:blue", label="mean")
+        ax.set_xlabel(r"$\eta = \Omega/\omega^*$")
+        ax.set_ylabel(r"$a / a^{noabs*}$")
+        ax.set_title(title)
+        ax.set_ylim(bottom=0)
+        ax.legend()
+        ax.grid(alpha=0.3)
 
 
 def run(args: argparse.Namespace) -> int:
