@@ -19,16 +19,18 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
+from sim.system import CLEARANCE_NOMINAL, D1_NOMINAL, K_H_NOMINAL
 from uq.errors import StudyError
 
-# Table 2 of the seed paper (SI units). k_H in N/m^1.5: 1 N/mm^1.5 = 1e3^1.5 N/m^1.5.
+# Table 2 of the seed paper (SI units); the nominal values are the simulator's (sim.system).
+# k_H in N/m^1.5: 1 N/mm^1.5 = 1e3^1.5 N/m^1.5.
 N_PER_MM15 = 1e3**1.5
-K_H_STAR = 282e3 * N_PER_MM15  # Eq. 8, nominal sphere on a flat wall
+K_H_STAR = K_H_NOMINAL  # Eq. 8, nominal sphere on a flat wall (282e3 N/mm^1.5)
 K_H_BEST_ESTIMATE_FACTOR = 1.25  # Sect. 4.1
 K_H_BEST_ESTIMATE = K_H_BEST_ESTIMATE_FACTOR * K_H_STAR
 TABLE2 = {
-    "D": dict(nominal=0.00085, min=0.00075, max=0.00090, unit="-", label="modal damping ratio D_1"),
-    "g": dict(nominal=0.580e-3, min=0.580e-3, max=0.612e-3, unit="m", label="clearance g"),
+    "D": dict(nominal=D1_NOMINAL, min=0.00075, max=0.00090, unit="-", label="modal damping ratio D_1"),
+    "g": dict(nominal=CLEARANCE_NOMINAL, min=CLEARANCE_NOMINAL, max=0.612e-3, unit="m", label="clearance g"),
     "k_H": dict(nominal=K_H_STAR, min=K_H_STAR, max=428e3 * N_PER_MM15, unit="N/m^1.5",
                 label="Hertzian spring constant k_H"),
 }
