@@ -20,7 +20,7 @@ import numpy as np
 from uq.errors import StudyError
 from uq.interval import Band, Design, DesignPoint, axis_design, band, box_design
 from uq.output import dumps, write_text
-from uq.runner import ResultStore, Task, prepare_output, run_tasks
+from uq.runner import ResultStore, Task, check_scheduler, prepare_output, run_tasks
 from uq.study import Study
 
 
@@ -88,9 +88,11 @@ def _runs_rows(results: dict, points: Sequence[dict], study: Study, outputs: Seq
     return rows
 
 
-def _start(study: Study, out: Path | None, resume: bool) -> tuple[Any, Path, StudyResult]:
+def _start(study: Study, out: Path | None, resume: bool, scheduler: str | None) -> tuple[Any, Path, StudyResult]:
     model = study.make_model()
     model.check()
+    if scheduler is not None:
+        check_scheduler(scheduler)
     if hasattr(model, "with_rig"):
         model = model.with_rig()
     folder = prepare_output(out or study.output, resume=resume)
@@ -125,7 +127,7 @@ def interval_designs(study: Study) -> list[Design]:
 def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, scheduler: str | None = None,
                        resume: bool = False, progress: bool = True, client: Any = None) -> StudyResult:
     """Interval study (Figs. 7 and 8): bands of the repetition-mean resonant levels per excitation level."""
-    model, folder, result = _start(study, out, resume)
+    model, folder, result = _start(study, out, resume, scheduler)
     designs = interval_designs(study)
     nominal = DesignPoint(study.space.nominal(), "nominal", "nominal")
     unique: dict[tuple, dict] = {nominal.key(): dict(nominal.values)}
@@ -210,7 +212,7 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     with the share of their variance that is repetition noise."""
     from uq.sobol import sobol_indices, sobol_sample
 
-    model, folder, result = _start(study, out, resume)
+    model, folder, result = _start(study, out, resume, scheduler)
     n = n or study.sobol_n
     X = sobol_sample(study.space, n, seed=study.seed)
     points = [study.space.from_values(x) for x in X]

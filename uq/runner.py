@@ -139,6 +139,11 @@ def _run_one(model: Callable, key: str, task: Task, seed: int) -> tuple[str, dic
     return key, evaluate(model, task, seed)
 
 
+def check_scheduler(address: str) -> None:
+    """Refuse an unreachable Dask scheduler before anything is written (one-line StudyError)."""
+    _connect(address).close()
+
+
 def _connect(address: str):
     """A distributed.Client for `address`, or a one-line StudyError when it cannot be reached."""
     try:
