@@ -34,9 +34,15 @@ wall/tip displacement), started at the located onset; the release is located by 
 length of the last step (|c| < GAP_TOLERANCE * g). Chattering is handled because every release is
 followed by the same certified free-flight search.
 
-Measure (Sect. 5): c_1 = (2/T) int_T q_tip e^{-i Omega t} dt is exact: the particular part contributes
-phi_tip^T S per whole period, each free-flight piece of the homogeneous part is integrated in closed
-form, and during contacts the integral is a further component of the Dormand-Prince state (5th order).
+Measure (Sect. 5): c_1 = (2/T) int_T q_tip e^{-i Omega t} dt is exact. The particular part contributes
+phi_tip^T S per whole period; for the deviation x_j, multiplying its equation by e^{-i Omega t} and
+integrating by parts over the period (e^{-i Omega T} = 1) gives, with Delta_j = omega_j^2 - Omega^2 + 2 i sigma_j Omega,
+
+    Delta_j int_T x_j e^{-i Omega t} dt = -[x_j'] - (i Omega + 2 sigma_j) [x_j] - phi_l,j F_l - phi_r,j F_r,
+
+[.] the change over the period and F_w = int_T f_w e^{-i Omega t} dt the Fourier integral of the contact force,
+two further components of the Dormand-Prince state during contacts (5th order). Free flight needs no
+quadrature at all.
 """
 from __future__ import annotations
 
@@ -58,8 +64,8 @@ GAP_TOLERANCE = 1e-12
 MIN_APPROACH_SPEED = 1e-9
 
 # rows of the per-mode constant table
-_SIG, _WD, _W2, _PL, _PR, _PT, _APL, _APR, _SRE, _SIM, _SCX, _SCV = range(12)
-_N_ROWS = 12
+_SIG, _WD, _W2, _PL, _PR, _RHR, _RHI, _APL, _APR, _SRE, _SIM, _SCX, _SCV = range(13)
+_N_ROWS = 13
 # entries of the scalar parameter vector
 (_OM, _ABASE, _MA, _KH, _G, _WLR, _WLI, _WRR, _WRI, _PRE, _PIM, _TOL, _VMIN, _HG, _ML0, _MR0, _SCZ, _SCZD,
  _HMAX) = range(19)
@@ -95,72 +101,36 @@ def _transition(tau, sig, wd, w2):
     return e * (co + sig / wd * si), e * si / wd, -e * w2 / wd * si, e * (co - sig / wd * si)
 
 
-@njit(cache=True, inline="always")
-def _exp_integral(a, b, tau):
-    """E = int_0^tau exp(mu u) du = (exp(mu tau) - 1) / mu for mu = a + i b, without cancellation."""
-    ea = math.exp(a * tau)
-    re = math.expm1(a * tau) * math.cos(b * tau) - 2.0 * math.sin(0.5 * b * tau) ** 2
-    im = ea * math.sin(b * tau)
-    den = a * a + b * b
-    return (re * a + im * b) / den, (im * a - re * b) / den
+@njit(cache=True)
+def _flight_transitions(tau, modes, tr):
+    """tr[:, j] = transition (a, b, c, d) of mode j over a free flight of length tau."""
+    for j in range(modes.shape[1]):
+        tr[0, j], tr[1, j], tr[2, j], tr[3, j] = _transition(tau, modes[_SIG, j], modes[_WD, j], modes[_W2, j])
 
 
 @njit(cache=True)
-def _flight_coefficients(tau, Omega, modes, tr, fa, fb):
-    """Closed-form free flight over tau for every mode.
-
-    tr[:, j] = transition (a, b, c, d); the Fourier integral of phi_tip,j x_j over the piece is
-    int_0^tau phi_tip,j x_j(u) e^{-i Omega u} du = fa_j x_j0 + fb_j v_j0 (fa, fb complex as [re, im] rows).
-    """
-    n = modes.shape[1]
-    for j in range(n):
-        sig = modes[_SIG, j]
-        wd = modes[_WD, j]
-        a, b, c, d = _transition(tau, sig, wd, modes[_W2, j])
-        tr[0, j] = a
-        tr[1, j] = b
-        tr[2, j] = c
-        tr[3, j] = d
-        e1r, e1i = _exp_integral(-sig, wd - Omega, tau)
-        e2r, e2i = _exp_integral(-sig, -(wd + Omega), tau)
-        r = sig / wd
-        # alpha = 1/2 [(1 - i r) E1 + (1 + i r) E2],  beta = 1/2 [(-i / wd) E1 + (i / wd) E2]
-        ar = 0.5 * (e1r + r * e1i + e2r - r * e2i)
-        ai = 0.5 * (e1i - r * e1r + e2i + r * e2r)
-        br = 0.5 * (e1i - e2i) / wd
-        bi = 0.5 * (-e1r + e2r) / wd
-        pt = modes[_PT, j]
-        fa[0, j] = pt * ar
-        fa[1, j] = pt * ai
-        fb[0, j] = pt * br
-        fb[1, j] = pt * bi
-
-
-@njit(cache=True)
-def _apply_flight(Y, Ynew, tau, cos_t, sin_t, tr, fa, fb, n):
-    """Ynew = free flight of Y over tau starting at phase time t (cos_t, sin_t = cos, sin(Omega t))."""
-    fr = 0.0
-    fi = 0.0
+def _apply_flight(Y, Ynew, tau, tr, n):
+    """Ynew = free flight of Y over tau (the force integrals F_w do not change)."""
     for j in range(n):
         x = Y[j]
         v = Y[n + j]
         Ynew[j] = tr[0, j] * x + tr[1, j] * v
         Ynew[n + j] = tr[2, j] * x + tr[3, j] * v
-        fr += fa[0, j] * x + fb[0, j] * v
-        fi += fa[1, j] * x + fb[1, j] * v
     Ynew[2 * n] = Y[2 * n] + tau * Y[2 * n + 1]
-    Ynew[2 * n + 1] = Y[2 * n + 1]
-    # rotate by e^{-i Omega t}
-    Ynew[2 * n + 2] = Y[2 * n + 2] + fr * cos_t + fi * sin_t
-    Ynew[2 * n + 3] = Y[2 * n + 3] + fi * cos_t - fr * sin_t
+    for i in range(2 * n + 1, Y.size):
+        Ynew[i] = Y[i]
 
 
 @njit(cache=True, inline="always")
 def _closing(Y, t, n, modes, par):
     """(c_l, c_l', c_r, c_r') at phase time t: contact at a wall when its c > 0 (Eqs. 4-6)."""
+    return _closing_at(Y, math.cos(par[_OM] * t), math.sin(par[_OM] * t), n, modes, par)
+
+
+@njit(cache=True, inline="always")
+def _closing_at(Y, ct, st, n, modes, par):
+    """`_closing` with cos, sin(Omega t) given."""
     Om = par[_OM]
-    ct = math.cos(Om * t)
-    st = math.sin(Om * t)
     sl = par[_WLR] * ct - par[_WLI] * st
     sld = -Om * (par[_WLR] * st + par[_WLI] * ct)
     sr = par[_WRR] * ct - par[_WRI] * st
@@ -207,8 +177,8 @@ def _curvature_bounds(Y, n, modes, par):
 def _search(Y, t0, tau_end, n, modes, par, scratch, counters):
     """First contact onset in (t0, t0 + tau_end] of the free flight from Y, by conservative Newton steps.
 
-    Returns (tau, wall): wall 0 (left) or 1 (right) with the onset at t0 + tau, -1 if the interval is
-    certified contact-free, -2 if the search stalled.
+    Returns (tau, wall): wall 0 (left) or 1 (right) with the onset at t0 + tau and the state there in
+    scratch[:2 n + 2], -1 if the interval is certified contact-free, -2 if the search stalled.
     """
     Ml, Mr = _curvature_bounds(Y, n, modes, par)
     tol = par[_TOL]
@@ -216,6 +186,7 @@ def _search(Y, t0, tau_end, n, modes, par, scratch, counters):
     tau = 0.0
     for _ in range(_MAX_SEARCH):
         if tau == 0.0:
+            scratch[:2 * n + 2] = Y[:2 * n + 2]
             cl, cld, cr, crd = _closing(Y, t0, n, modes, par)
         else:
             for j in range(n):
@@ -252,17 +223,15 @@ _REGULAR, _ONSET, _RELEASE, _GRAZE = 0, 1, 2, 3
 
 @njit(cache=True, inline="always", fastmath=_FAST)
 def _rhs(ct, st, Y, out, n, modes, par):
-    """Eqs. 3-7 in the deviation coordinates at cos, sin(Omega t) = ct, st, plus the Fourier integrand."""
+    """Eqs. 3-7 in the deviation coordinates at cos, sin(Omega t) = ct, st, plus the integrands of F_l, F_r."""
     g = par[_G]
     z = Y[2 * n]
     dl = par[_WLR] * ct - par[_WLI] * st - z - g
     dr = par[_WRR] * ct - par[_WRI] * st - z + g
-    q = 0.0
     for j in range(n):
         x = Y[j]
         dl += modes[_PL, j] * x
         dr += modes[_PR, j] * x
-        q += modes[_PT, j] * x
     kH = par[_KH]
     fl = kH * dl * math.sqrt(dl) if dl > 0.0 else 0.0
     fr = -kH * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
@@ -272,8 +241,10 @@ def _rhs(ct, st, Y, out, n, modes, par):
         out[n + j] = -2.0 * modes[_SIG, j] * v - modes[_W2, j] * Y[j] - modes[_PL, j] * fl - modes[_PR, j] * fr
     out[2 * n] = Y[2 * n + 1]
     out[2 * n + 1] = (fl + fr) / par[_MA]
-    out[2 * n + 2] = q * ct
-    out[2 * n + 3] = -q * st
+    out[2 * n + 2] = fl * ct
+    out[2 * n + 3] = -fl * st
+    out[2 * n + 4] = fr * ct
+    out[2 * n + 5] = -fr * st
 
 
 @njit(cache=True, inline="always")
@@ -567,11 +538,11 @@ def _to_state(Y, t, y_out, n, modes, par):
 
 
 @njit(cache=True)
-def _advance(y, n_periods, N, modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_g, record, stride, amplitudes,
+def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, stride, amplitudes,
              impacts, counters, fixed_step):
     """Advance y (phase 0) over n_periods excitation periods; returns (status, period of failure)."""
     n = modes.shape[1]
-    m = 2 * n + 4
+    m = 2 * n + 6
     Om = par[_OM]
     T = 2.0 * math.pi / Om
     hg = par[_HG]
@@ -580,9 +551,8 @@ def _advance(y, n_periods, N, modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_
     tmp = np.zeros(m)
     K = np.zeros((7, m))
     tr = np.empty((4, n))
-    fa = np.empty((2, n))
-    fb = np.empty((2, n))
     A = np.empty(n)
+    X0 = np.empty(2 * n)  # modal deviation state at the start of the period
     memo = np.zeros(2)
     # phase 0: s = x + Re(S), s' = v - Omega Im(S), u_a = z - a_base
     for j in range(n):
@@ -602,8 +572,8 @@ def _advance(y, n_periods, N, modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_
     h_contact = 0.0
     t = 0.0
     for p in range(n_periods):
-        Y[2 * n + 2] = 0.0
-        Y[2 * n + 3] = 0.0
+        Y[2 * n + 2:] = 0.0
+        X0[:] = Y[:2 * n]
         onsets = 0
         k = 0  # grid index of the current point (free flight on the grid) or of the last grid point passed
         A_valid = False
@@ -635,10 +605,8 @@ def _advance(y, n_periods, N, modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_
                 tau, wall = _search(Y, t, tau_end, n, modes, par, tmp, counters)
                 if wall == -2:
                     return _STALLED_SEARCH, p
-                _flight_coefficients(tau, Om, modes, tr, fa, fb)
-                _apply_flight(Y, Ynew, tau, math.cos(Om * t), math.sin(Om * t), tr, fa, fb, n)
-                Y[:] = Ynew
                 if wall >= 0:
+                    Y[:2 * n + 2] = tmp[:2 * n + 2]
                     t = t + tau
                     in_contact = True
                     at_onset = True
@@ -646,6 +614,9 @@ def _advance(y, n_periods, N, modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_
                     counters[_C_CONTACT] += 1
                     h_contact = _initial_contact_step(Y, t, n, modes, par)
                     continue
+                _flight_transitions(tau, modes, tr)
+                _apply_flight(Y, Ynew, tau, tr, n)
+                Y[:] = Ynew
                 k += 1
                 t = k * hg
                 A_valid = False
@@ -658,10 +629,9 @@ def _advance(y, n_periods, N, modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_
                         A[j] = math.sqrt(x * x + q * q)
                     A_valid = True
                 counters[_C_GRID] += 1
-                _apply_flight(Y, Ynew, hg, rot_g[0, k], rot_g[1, k], tr_g, fa_g, fb_g, n)
-                t1 = (k + 1) * hg
-                c0l, c0ld, c0r, c0rd = _closing(Y, t, n, modes, par)
-                c1l, c1ld, c1r, c1rd = _closing(Ynew, t1, n, modes, par)
+                _apply_flight(Y, Ynew, hg, tr_g, n)
+                c0l, c0ld, c0r, c0rd = _closing_at(Y, rot_g[0, k], rot_g[1, k], n, modes, par)
+                c1l, c1ld, c1r, c1rd = _closing_at(Ynew, rot_g[0, k + 1], rot_g[1, k + 1], n, modes, par)
                 Bl = par[_ML0] * hg * hg / 8.0
                 Br = par[_MR0] * hg * hg / 8.0
                 Ml = par[_ML0]
@@ -679,9 +649,7 @@ def _advance(y, n_periods, N, modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_
                     if wall == -2:
                         return _STALLED_SEARCH, p
                     if wall >= 0:
-                        _flight_coefficients(tau, Om, modes, tr, fa, fb)
-                        _apply_flight(Y, Ynew, tau, rot_g[0, k], rot_g[1, k], tr, fa, fb, n)
-                        Y[:] = Ynew
+                        Y[:2 * n + 2] = tmp[:2 * n + 2]
                         t = t + tau
                         in_contact = True
                         at_onset = True
@@ -701,9 +669,15 @@ def _advance(y, n_periods, N, modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_
                 _to_state(Y, t, record[p * rows + k // stride], n, modes, par)
             if k >= N:
                 break
-        # c_1 = phi_tip^T S + (2/T) int_T phi_tip^T x e^{-i Omega t} dt
-        cre = par[_PRE] + 2.0 / T * Y[2 * n + 2]
-        cim = par[_PIM] + 2.0 / T * Y[2 * n + 3]
+        # c_1 = phi_tip^T S + (2/T) sum_j phi_tip,j int_T x_j e^{-i Omega t} dt, the integral from the module docstring
+        cre = par[_PRE]
+        cim = par[_PIM]
+        for j in range(n):
+            dx = Y[j] - X0[j]
+            nre = -(Y[n + j] - X0[n + j]) - 2.0 * modes[_SIG, j] * dx - modes[_PL, j] * Y[2 * n + 2] - modes[_PR, j] * Y[2 * n + 4]
+            nim = -Om * dx - modes[_PL, j] * Y[2 * n + 3] - modes[_PR, j] * Y[2 * n + 5]
+            cre += 2.0 / T * (modes[_RHR, j] * nre - modes[_RHI, j] * nim)
+            cim += 2.0 / T * (modes[_RHR, j] * nim + modes[_RHI, j] * nre)
         amplitudes[p] = math.sqrt(cre * cre + cim * cim)
         impacts[p] = onsets
         t = 0.0
@@ -751,7 +725,9 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
     wpos = np.where(wpos > 0, wpos, 1e-300)
     modes = np.empty((_N_ROWS, n))
     modes[_SIG], modes[_WD], modes[_W2] = sig, wd, omega**2
-    modes[_PL], modes[_PR], modes[_PT] = sys.phi_l, sys.phi_r, sys.phi_tip
+    modes[_PL], modes[_PR] = sys.phi_l, sys.phi_r
+    rho = sys.phi_tip / (omega**2 - Omega**2 + 2j * sig * Omega)  # phi_tip,j / Delta_j
+    modes[_RHR], modes[_RHI] = rho.real, rho.imag
     modes[_APL], modes[_APR] = np.abs(sys.phi_l), np.abs(sys.phi_r)
     modes[_SRE], modes[_SIM] = S.real, S.imag
     # inverse error scales: x_j error -> displacement phi_j x_j (m); velocity error e_v -> amplitude e_v / omega_j
@@ -770,14 +746,12 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
     par[_SCZD] = 1.0 / (atol * omega[0])
     par[_HMAX] = h_max
     tr_g = np.empty((4, n))
-    fa_g = np.empty((2, n))
-    fb_g = np.empty((2, n))
-    _flight_coefficients(hg, Omega, modes, tr_g, fa_g, fb_g)
+    _flight_transitions(hg, modes, tr_g)
     dec_g = np.exp(-sig * hg)
     kappa_g = np.minimum(omega**2 * hg * hg / 8.0, 2.0)
     phase = Omega * hg * np.arange(N + 1)
     rot_g = np.vstack([np.cos(phase), np.sin(phase)])
-    return modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_g
+    return modes, par, tr_g, dec_g, kappa_g, rot_g
 
 
 def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: SystemArrays,
@@ -809,11 +783,11 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     N = -(-N // samples) * samples
     omega_max = float(np.max(sys.omega))
     h_max = 0.5 / omega_max  # keeps DOPRI5 far inside its stability region on the highest mode
-    modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_g = _prepare(Omega, a_base, sys, N, rtol, h_max)
+    modes, par, tr_g, dec_g, kappa_g, rot_g = _prepare(Omega, a_base, sys, N, rtol, h_max)
     amplitudes = np.empty(n_periods)
     impacts = np.zeros(n_periods, dtype=np.int64)
     counters = np.zeros(_N_COUNT, dtype=np.int64)
-    status, period = _advance(y, n_periods, N, modes, par, tr_g, fa_g, fb_g, dec_g, kappa_g, rot_g, record_arr,
+    status, period = _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record_arr,
                               N // samples, amplitudes, impacts, counters, float(fixed_contact_step))
     if stats is not None:
         names = ("grid_steps", "searches", "search_evaluations", "contact_steps", "rejected_steps",
