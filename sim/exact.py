@@ -362,7 +362,7 @@ def _locate_release(Y, t, s, s_max, kind, wall_left, K, tmp, Ynew, n, modes, par
             lo = s
         else:
             hi = s
-        if abs(c_s) <= tol or hi - lo <= 4e-16 * (t + hi):
+        if abs(c_s) <= tol or (hi < np.inf and hi - lo <= 4e-16 * (t + hi)):
             break
         if cd_s < 0.0:
             s = s - c_s / cd_s
