@@ -278,8 +278,9 @@ def _rotate(ct, st, angle):
 
 
 @njit(cache=True, fastmath=_FAST)
-def _dp_step(Y, t, s, kind, K, tmp, Ynew, n, modes, par):
-    """One Dormand-Prince 5(4) step from (t, Y) over the time map of `_warp` (kind, length s in time).
+def _dp_step(Y, ct0, st0, s, kind, K, tmp, Ynew, n, modes, par):
+    """One Dormand-Prince 5(4) step from (t, Y), cos, sin(Omega t) = ct0, st0, over the time map of `_warp`
+    (kind, length s in time). The phase is carried by rotations (`_rotate`): no cos/sin per step.
 
     K holds the raw right-hand sides F: K[0] = F(t, Y) on entry, K[6] = F(t + s, Ynew) on exit (FSAL);
     dY/du = phi'(u) F(t_a + phi(u), Y). Returns the scaled error estimate (accept if <= 1): max over the
@@ -287,8 +288,6 @@ def _dp_step(Y, t, s, kind, K, tmp, Ynew, n, modes, par):
     """
     m = Y.size
     Om = par[_OM]
-    ct0 = math.cos(Om * t)
-    st0 = math.sin(Om * t)
     _, d1 = _warp(kind, 0.0, s)
     p2, d2 = _warp(kind, _C2, s)
     p3, d3 = _warp(kind, _C3, s)
@@ -333,7 +332,7 @@ def _dp_step(Y, t, s, kind, K, tmp, Ynew, n, modes, par):
 
 
 @njit(cache=True)
-def _locate_release(Y, t, s, s_max, kind, wall_left, K, tmp, Ynew, n, modes, par, counters):
+def _locate_release(Y, t, ct0, st0, s, s_max, kind, wall_left, K, tmp, Ynew, n, modes, par, counters):
     """Length s of a step of `kind` from (t, Y) that ends at the release c = 0 of the active wall.
 
     Newton iteration on the step length from the guess s, bracketed as soon as a step ends open; never
@@ -351,9 +350,10 @@ def _locate_release(Y, t, s, s_max, kind, wall_left, K, tmp, Ynew, n, modes, par
         elif s <= lo:
             s = 2.0 * lo
         s = min(s, s_max)
-        err = _dp_step(Y, t, s, kind, K, tmp, Ynew, n, modes, par)
+        err = _dp_step(Y, ct0, st0, s, kind, K, tmp, Ynew, n, modes, par)
         counters[_C_REL] += 1
-        a1, a2, a3, a4 = _closing(Ynew, t + s, n, modes, par)
+        ct1, st1 = _rotate(ct0, st0, par[_OM] * s)
+        a1, a2, a3, a4 = _closing_at(Ynew, ct1, st1, n, modes, par)
         c_s = a1 if wall_left else a3
         cd_s = a2 if wall_left else a4
         if c_s > 0.0:
@@ -372,7 +372,7 @@ def _locate_release(Y, t, s, s_max, kind, wall_left, K, tmp, Ynew, n, modes, par
         if hi == np.inf:
             return s, err, False
         s = hi
-        err = _dp_step(Y, t, s, kind, K, tmp, Ynew, n, modes, par)
+        err = _dp_step(Y, ct0, st0, s, kind, K, tmp, Ynew, n, modes, par)
     return s, err, True
 
 
@@ -406,8 +406,10 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
     by the 5th-order solution), so their length is predicted from that law instead of by trial.
     """
     Om = par[_OM]
-    _rhs(math.cos(Om * t), math.sin(Om * t), Y, K[0], n, modes, par)
-    cl, cld, cr, crd = _closing(Y, t, n, modes, par)
+    ct = math.cos(Om * t)  # the phase at t, carried along by rotations
+    st = math.sin(Om * t)
+    _rhs(ct, st, Y, K[0], n, modes, par)
+    cl, cld, cr, crd = _closing_at(Y, ct, st, n, modes, par)
     wall_left = cl > cr  # the wall in contact (or about to be)
     open_l = cl <= 0.0
     open_r = cr <= 0.0
@@ -428,8 +430,6 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
             step = t_stop - t
         if adaptive and not first and c_act > 0.0:
             # c'' of the active wall from the accelerations in K[0] (harmonic part: -Omega^2 times its value)
-            ct = math.cos(Om * t)
-            st = math.sin(Om * t)
             if wall_left:
                 cdd = -Om * Om * (par[_WLR] * ct - par[_WLI] * st) - K[0, 2 * n + 1]
                 for j in range(n):
@@ -442,8 +442,8 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
             v_rel = max(abs(cd_act + cdd * tau), 1e-6)
             s_rel = (0.5 / (memo[1] * v_rel**1.5)) ** 0.4 if memo[1] > 0.0 else step
             if tau <= 1.2 * s_rel and tau <= 1.25 * step and tau < t_stop - t:
-                s, err, found = _locate_release(Y, t, tau, min(2.0 * step, t_stop - t), _RELEASE, wall_left, K, tmp,
-                                                Ynew, n, modes, par, counters)
+                s, err, found = _locate_release(Y, t, ct, st, tau, min(2.0 * step, t_stop - t), _RELEASE, wall_left, K,
+                                                tmp, Ynew, n, modes, par, counters)
                 if found:
                     memo[1] = max(err, 1e-3) / (v_rel**1.5 * s**2.5)
                     if err <= 1.0:
@@ -460,7 +460,7 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
                 step = min(step, max(tau - 0.9 * s_rel, 0.5 * tau))
                 last = False
         kind = _ONSET if first else _REGULAR
-        err = _dp_step(Y, t, step, kind, K, tmp, Ynew, n, modes, par)
+        err = _dp_step(Y, ct, st, step, kind, K, tmp, Ynew, n, modes, par)
         if not math.isfinite(err):
             return t, h, False, _NONFINITE, extra
         if adaptive and err > 1.0:
@@ -473,14 +473,15 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
             continue
         if adaptive and first:
             memo[0] = max(err, 1e-3) / (v_onset**1.5 * step**2.5)
-        ncl, ncld, ncr, ncrd = _closing(Ynew, t + step, n, modes, par)
+        ct1, st1 = _rotate(ct, st, Om * step)
+        ncl, ncld, ncr, ncrd = _closing_at(Ynew, ct1, st1, n, modes, par)
         if ncl <= 0.0 and ncr <= 0.0:
             # release inside (t, t + step]: a step with the release time map ending exactly there
             kind = _GRAZE if first else _RELEASE
             c_end = ncl if wall_left else ncr
             cd_end = ncld if wall_left else ncrd
             guess = step - c_end / cd_end if cd_end < 0.0 else 0.5 * step
-            s, err, found = _locate_release(Y, t, guess, min(2.0 * step, t_stop - t), kind, wall_left, K, tmp,
+            s, err, found = _locate_release(Y, t, ct, st, guess, min(2.0 * step, t_stop - t), kind, wall_left, K, tmp,
                                             Ynew, n, modes, par, counters)
             if adaptive and err > 1.0 and s > 1e-3 * step:
                 # too long for the tolerance: first a shorter (onset or regular) step towards the release
@@ -492,7 +493,7 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
                 # the release-map step still ends (barely, |c| ~ rounding) closed while the regular step ended
                 # open: c hovers at 0 (sphere riding on the wall); release at the regular step's end
                 s = step
-                _dp_step(Y, t, s, _ONSET if first else _REGULAR, K, tmp, Ynew, n, modes, par)
+                _dp_step(Y, ct, st, s, _ONSET if first else _REGULAR, K, tmp, Ynew, n, modes, par)
             for i in range(Y.size):
                 Y[i] = Ynew[i]
             return t + s, h, True, _OK, extra
@@ -512,6 +513,9 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
         for i in range(Y.size):
             K[0, i] = K[6, i]
         t = t + step
+        norm = 1.5 - 0.5 * (ct1 * ct1 + st1 * st1)  # keeps cos^2 + sin^2 = 1 to rounding along the rotations
+        ct = ct1 * norm
+        st = st1 * norm
         if adaptive and not last:
             h = step * min(5.0, max(0.2, 0.9 * max(err, 1e-10) ** -0.2))
         if last:
