@@ -2,8 +2,9 @@
 
 `effects(folder)` gives, per parameter and excitation level, the change of the repetition-mean resonant
 level from the parameter's min to its max (others nominal), relative to the nominal level, with its
-noise (the standard errors combined) and the nominal regime. `trend_table` formats it; `band_table`
-lists the joint and residual bands. Both read only the study's CSV files.
+noise (the standard errors combined) and the nominal regime. `trend_table` formats it; `influence` ranks
+the parameters by their mean effect over the almost periodic levels (the band widths of Fig. 7);
+`band_table` lists the joint and residual bands. All read only the study's CSV files.
 """
 from __future__ import annotations
 
@@ -70,6 +71,42 @@ def trend_table(folder: str | Path, output: str = "mean") -> str:
                          for n in names)
         lines.append(f"{lv:6.2f} {regime:>6} {cells}")
     return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class Influence:
+    """A parameter's mean |relative change| (and mean relative noise) over the levels it is averaged on."""
+
+    parameter: str
+    mean_change: float
+    mean_noise: float
+    levels: tuple[float, ...]
+
+
+def influence(folder: str | Path, output: str = "mean", regime: str = "APR") -> list[Influence]:
+    """Parameters ranked by their influence, largest first: the mean over the excitation levels whose nominal
+    point is in `regime` of |value(max) - value(min)| / nominal (Fig. 7's band width relative to the curve).
+
+    Fig. 7 of the paper spans the almost periodic range from the optimum upwards; the strongly modulated
+    level hardly depends on the parameters (Sect. 5.4), so it is left out by default ("any" keeps all levels).
+    """
+    eff = [e for e in effects(folder, output) if regime == "any" or e.regime == regime]
+    out = []
+    for name in dict.fromkeys(e.parameter for e in eff):
+        mine = [e for e in eff if e.parameter == name]
+        out.append(Influence(name, float(np.mean([abs(e.relative) for e in mine])),
+                             float(np.mean([e.noise / e.nominal for e in mine])), tuple(e.level for e in mine)))
+    return sorted(out, key=lambda i: -i.mean_change)
+
+
+def influence_line(folder: str | Path, output: str = "mean") -> str:
+    """One line: the ranking of `influence`, e.g. "k_H 23.1 % > g 16.9 % > D 14.4 % (mean |change| ...)"."""
+    ranked = influence(folder, output)
+    if not ranked:
+        return "no almost periodic level: influence not ranked"
+    levels = ", ".join(f"{lv:g}" for lv in ranked[0].levels)
+    return ("largest influence first, mean |change| over the almost periodic levels " + levels + ": "
+            + " > ".join(f"{i.parameter} {i.mean_change:.1%} (noise {i.mean_noise:.1%})" for i in ranked))
 
 
 def band_table(folder: str | Path, output: str = "mean") -> str:

@@ -131,11 +131,12 @@ def run(args: argparse.Namespace) -> int:
         for key, ok in s["monotone"].items():
             if not ok:
                 print(f"{figure}: monotonicity check failed for {key} (band widened; see study.json)")
-        from uq.results import band_table, trend_table
+        from uq.results import band_table, influence_line, trend_table
 
         if any(d == "individual" for d in study.designs):
             print(f"{figure}: change of the mean resonant level from each parameter's min to its max:")
             print(trend_table(folder))
+            print(f"{figure}: {influence_line(folder)}")
         else:
             print(f"{figure}: bands of the mean resonant level (a / a_noabs*):")
             print(band_table(folder))
