@@ -57,6 +57,8 @@ class IESModel:
 
     protocol: keyword arguments of `sim.protocol.SteppedSine` (eta grid, sequence, wait, hold, ...);
     n_modes: modes of the built-in rig model (9 as in the paper);
+    modal_file: a modal-model file (`sim.modal_file`, e.g. from `ies modes --save`) used instead of the built-in
+    rig; its SHA-256 is part of every task's key;
     rig: the modal model itself, built once by the controlling process (`with_rig`) and shipped to the
     workers: the eigen-solution's last bits depend on the BLAS thread count, which differs between the
     main process and joblib/Dask workers, and a chaotic response amplifies such bits.
@@ -65,6 +67,7 @@ class IESModel:
     protocol: Mapping[str, Any] = field(default_factory=dict)
     n_modes: int = 9
     name: str = "ies"
+    modal_file: str | None = None
     rig: Any = field(default=None, compare=False, repr=False)
 
 
@@ -103,22 +106,37 @@ class IESModel:
             get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
         except SimulationInputError as exc:
             raise StudyError(f"[excitation]: {exc}") from None
-        _rig_model(self.n_modes)
+        self._rig()
+
+    def _rig(self):
+        if self.modal_file is None:
+            return _rig_model(self.n_modes)
+        from sim.errors import SimulationInputError
+        from sim.modal_file import load_modal_model
+
+        try:
+            return load_modal_model(self.modal_file)
+        except SimulationInputError as exc:
+            raise StudyError(f"[study] modal_model: {exc}") from None
 
     def with_rig(self) -> "IESModel":
         """This model carrying the rig's modal model (built here, used unchanged by every worker)."""
-        return self if self.rig is not None else replace(self, rig=_rig_model(self.n_modes))
+        return self if self.rig is not None else replace(self, rig=self._rig())
 
     def describe(self) -> dict:
-        """Settings that define a task's computation (part of its cache key; the rig is covered by version)."""
-        return {"class": type(self).__name__, "protocol": dict(self.protocol), "n_modes": self.n_modes}
+        """Settings that define a task's computation (part of its cache key; the built-in rig is covered by
+        version, a modal file by its content)."""
+        out = {"class": type(self).__name__, "protocol": dict(self.protocol), "n_modes": self.n_modes}
+        if self.modal_file is not None:
+            out["modal_model_sha256"] = hashlib.sha256(Path(self.modal_file).read_bytes()).hexdigest()
+        return out
 
     def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, Any]:
         """One run: its own resonant levels (outputs) and the per-point measures (trace) for aggregation."""
         from sim.protocol import aggregate_runs, run_sweep
         from sim.system import Impactor
 
-        rig = self.rig if self.rig is not None else _rig_model(self.n_modes)
+        rig = self.rig if self.rig is not None else self._rig()
         model = rig.with_damping(params["D"])
         impactor = Impactor(clearance=params["g"], k_H=params["k_H"])
         run = run_sweep(model, impactor, level, self._stepped_sine(), seed=seed, rep=rep)
@@ -250,10 +268,12 @@ class FunctionModel:
         return {"value": float(self._function()(dict(params), level, rep, seed))}
 
 
-def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, parameters: tuple[str, ...] = ()) -> Any:
-    """The model named by a study's ``model`` key ("ies", "ishigami" or "module:function")."""
+def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, parameters: tuple[str, ...] = (),
+               modal_model: str | Path | None = None) -> Any:
+    """The model named by a study's ``model`` key ("ies", "ishigami" or "module:function"); modal_model: a
+    modal-model file replacing the built-in rig of "ies"."""
     if spec == "ies":
-        return IESModel(dict(protocol or {}))
+        return IESModel(dict(protocol or {}), modal_file=None if modal_model is None else str(modal_model))
     if spec == "ishigami":
         return IshigamiModel()
     if ":" in spec:

@@ -6,6 +6,8 @@ Layout (every table and key is optional except where noted; SI units)::
     name = "fig7"
     kind = "interval"            # "interval" or "sobol" (required)
     model = "ies"                # "ies" (the simulator), "ishigami", or "package.module:function"
+    modal_model = "rig.toml"     # optional, model "ies": a modal-model file (`ies modes --save`), relative to
+                                 # this file, instead of the built-in rig
     seed = 1                     # random stream of the repetitions (Sect. 5.1: perturbed frequencies)
     repetitions = 5
     output = "results/fig7"      # default output folder (`--out` overrides), relative to the cwd
@@ -57,7 +59,7 @@ from uq.space import Parameter, ParameterSpace, resolve_k_H
 KINDS = ("interval", "sobol")
 DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
-    "study": {"name", "kind", "model", "seed", "repetitions", "output"},
+    "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output"},
     "parameters": None,  # one sub-table per parameter
     "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "repetition", "start",
                    "dt_scale"},
@@ -88,14 +90,17 @@ class Study:
     bootstrap: int = 200
     confidence: float = 0.95
     source: str = ""
+    modal_model: Path | None = None
 
     def make_model(self) -> Any:
-        return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names))
+        return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
+                          modal_model=self.modal_model)
 
     def to_dict(self) -> dict:
         """The resolved study as plain data (written to the results' metadata)."""
         return {
-            "name": self.name, "kind": self.kind, "model": self.model, "seed": self.seed,
+            "name": self.name, "kind": self.kind, "model": self.model,
+            "modal_model": None if self.modal_model is None else str(self.modal_model), "seed": self.seed,
             "repetitions": self.repetitions, "output": str(self.output), "source": self.source,
             "levels": list(self.levels), "protocol": dict(self.protocol), "parameters": self.space.to_dict(),
             "interval": {"designs": list(self.designs), "interior": self.interior, "z": self.z, "fix": dict(self.fix)},
@@ -157,6 +162,13 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError(f"[study] seed must be >= 0, got {seed}")
     reps = int(_number("study", "repetitions", head.get("repetitions", 1), integer=True))
     output = Path(head.get("output", f"results/{name}"))
+    modal_model = head.get("modal_model")
+    if modal_model is not None:
+        if model_spec != "ies":
+            raise StudyError("[study] modal_model only applies to model = \"ies\" (the simulator)")
+        if not isinstance(modal_model, str) or not modal_model:
+            raise StudyError(f"[study] modal_model must be the path of a modal-model file (`ies modes --save`), got {modal_model!r}")
+        modal_model = base_dir / modal_model
 
     space = _parse_parameters(data.get("parameters"), model_spec, base_dir)
 
@@ -196,8 +208,10 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError("no parameter is varied; give at least one [parameters.NAME] with min < max")
 
     study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
-                  sobol_n, bootstrap, confidence, source)
-    study.make_model()  # unknown model -> one line now
+                  sobol_n, bootstrap, confidence, source, modal_model)
+    model = study.make_model()  # unknown model -> one line now
+    if modal_model is not None:
+        model.check()  # an unreadable modal file -> one line now
     return study
 
 

@@ -71,6 +71,9 @@ def test_resolved_study_lists_every_setting(tmp_path):
     (MINIMAL.replace("levels = [6.7]", "levels = [0.0]"), "levels must be positive"),
     ("[study]\nkind = 'interval'\nmodel = 'nosuchmodule:f'\n[parameters.a]\nnominal=1\nmin=0\nmax=2\n", "cannot be imported"),
     ("[study\nkind=", "not valid TOML"),
+    (MINIMAL.replace("kind", "modal_model = 'none.toml'\nkind"), "modal file"),
+    (MINIMAL.replace("kind", "modal_model = 3\nkind"), "modal_model must be the path"),
+    ("[study]\nkind = 'interval'\nmodel = 'ishigami'\nmodal_model = 'm.toml'\n", "only applies to model"),
 ])
 def test_bad_study_is_one_line_exit_2(tmp_path, capsys, extra, message):
     path = write(tmp_path, extra)
@@ -117,3 +120,33 @@ def test_wrong_kind_for_command(tmp_path, capsys):
     path = write(tmp_path, "[study]\nkind = 'sobol'\nmodel = 'ishigami'\n")
     assert main(["interval", str(path), "--out", str(tmp_path / "o")]) == 2
     assert "run it with `ies sobol`" in capsys.readouterr().err
+
+
+def test_a_modal_model_file_replaces_the_built_in_rig(tmp_path):
+    """The built-in rig saved as a modal file (`ies modes --save`) gives the same numbers; the file's content,
+    not its path, is part of the task key, so an edited file is recomputed."""
+    from sim.modal_file import save_modal_model
+    from sim.rig import seed_rig_model
+
+    save_modal_model(seed_rig_model(n_modes=9), tmp_path / "rig.toml")
+    tiny = ("[study]\nkind = 'interval'\n{}[parameters.k_H]\n[excitation]\nlevels = [7.4]\n"
+            "eta = {{ start = 0.975, stop = 0.98, n = 2 }}\nwait = 0.05\nhold = 0.1\n[interval]\ninterior = 0\n")
+    builtin = load_study(write(tmp_path, tiny.format(""), "builtin.toml"))
+    own = load_study(write(tmp_path, tiny.format("modal_model = 'rig.toml'\n"), "own.toml"))
+    assert own.modal_model == tmp_path / "rig.toml" and own.to_dict()["modal_model"] == str(tmp_path / "rig.toml")
+    a, b = builtin.make_model().with_rig(), own.make_model().with_rig()
+    params = {"D": 0.00085, "g": 0.58e-3, "k_H": K_H_STAR}
+    ra, rb = a(params, 7.4, 0, 1), b(params, 7.4, 0, 1)
+    assert (ra["mean"], ra["max"]) == (rb["mean"], rb["max"])
+    key = b.describe()["modal_model_sha256"]
+    (tmp_path / "rig.toml").write_text((tmp_path / "rig.toml").read_text().replace("0.00085", "0.0009", 1))
+    assert own.make_model().describe()["modal_model_sha256"] != key
+
+
+def test_reproduce_with_a_bad_modal_model_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "o"
+    (tmp_path / "bad.toml").write_text("format = 'something else'\n")
+    assert main(["reproduce", "fig7", "--quick", "--model", str(tmp_path / "bad.toml"), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "modal_model" in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert not out.exists()

@@ -34,6 +34,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     calib.add_argument("--calibration", type=Path, metavar="FILE",
                        help="use this `ies calibrate --json` output instead of running the calibration")
     calib.add_argument("--no-calibration", action="store_true", help="keep Table 2's k_H bounds")
+    parser.add_argument("--model", type=Path, metavar="FILE",
+                        help="run the studies on this modal-model file (`ies modes --save`) instead of the built-in rig")
     parser.add_argument("--integrator", metavar="NAME",
                         help="override the study files' integrator (ode3 = the paper's scheme, exact = free flight)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -99,10 +101,12 @@ def run(args: argparse.Namespace) -> int:
 
     figures = ("fig7", "fig8") if args.figure == "all" else (args.figure,)
     studies = [load_study(study_file(f, args.quick)) for f in figures]
-    if args.integrator:
-        from dataclasses import replace
+    from dataclasses import replace
 
+    if args.integrator:
         studies = [replace(s, protocol={**s.protocol, "integrator": args.integrator}) for s in studies]
+    if args.model is not None:
+        studies = [replace(s, modal_model=args.model) for s in studies]
     for s in studies:
         s.make_model().check()  # bad settings (e.g. an unknown integrator) fail here, before anything is written
     out = args.out
