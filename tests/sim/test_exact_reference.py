@@ -15,10 +15,11 @@ from scipy.special import gamma as gamma_fn
 from sim.system import Impactor, ModalModel, system_arrays
 
 
-def reference_run(y0, t_end, Omega, a_base, sys, rtol=1e-12, atol_scale=1e-16, t_eval=None):
+def reference_run(y0, t_end, Omega, a_base, sys, rtol=1e-12, atol_scale=1e-16, pieces=None):
     """Integrate from t=0 (phase 0) to t_end; returns (y(t_end), onset times, release times, rebound speeds).
 
     rebound speeds: the relative speed phi_w^T s' - u_a' (sign of opening) at each release.
+    pieces: a list that receives (t_start, t_stop, dense solution) of every piece between events.
     """
     n = sys.omega.size
     w2 = sys.omega**2
@@ -58,9 +59,11 @@ def reference_run(y0, t_end, Omega, a_base, sys, rtol=1e-12, atol_scale=1e-16, t
         ev_l.direction = -1.0 if closed[0] else 1.0
         ev_r.direction = 1.0 if closed[1] else -1.0
         sol = solve_ivp(rhs, (t, t_end), y, method="DOP853", rtol=rtol, atol=atol, events=(ev_l, ev_r),
-                        first_step=1e-9)
+                        first_step=1e-9, dense_output=pieces is not None)
         y = sol.y[:, -1].copy()
         t_new = sol.t[-1]
+        if pieces is not None:
+            pieces.append((t, t_new, sol.sol))
         if sol.status == 1:
             for w in range(2):
                 if sol.t_events[w].size:
