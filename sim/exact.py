@@ -583,6 +583,8 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
         A_valid = False
         t = 0.0 if not in_contact else t
         while True:
+            wall = -1  # set to 0/1 when a search locates an onset (state in tmp, at t + tau)
+            tau = 0.0
             if in_contact:
                 ks = (int(t / (stride * hg)) + 1) * stride
                 t_stop = T if ks >= N else ks * hg
@@ -609,21 +611,13 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
                 tau, wall = _search(Y, t, tau_end, n, modes, par, tmp, counters)
                 if wall == -2:
                     return _STALLED_SEARCH, p
-                if wall >= 0:
-                    Y[:2 * n + 2] = tmp[:2 * n + 2]
-                    t = t + tau
-                    in_contact = True
-                    at_onset = True
-                    onsets += 1
-                    counters[_C_CONTACT] += 1
-                    h_contact = _initial_contact_step(Y, t, n, modes, par)
-                    continue
-                _flight_transitions(tau, modes, tr)
-                _apply_flight(Y, Ynew, tau, tr, n)
-                Y[:] = Ynew
-                k += 1
-                t = k * hg
-                A_valid = False
+                if wall < 0:
+                    _flight_transitions(tau, modes, tr)
+                    _apply_flight(Y, Ynew, tau, tr, n)
+                    Y[:] = Ynew
+                    k += 1
+                    t = k * hg
+                    A_valid = False
             else:
                 # one grid step k -> k + 1 in closed form, accepted if certified contact-free
                 if not A_valid:
@@ -652,21 +646,23 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
                     tau, wall = _search(Y, t, hg, n, modes, par, tmp, counters)
                     if wall == -2:
                         return _STALLED_SEARCH, p
-                    if wall >= 0:
-                        Y[:2 * n + 2] = tmp[:2 * n + 2]
-                        t = t + tau
-                        in_contact = True
-                        at_onset = True
-                        onsets += 1
-                        counters[_C_CONTACT] += 1
-                        h_contact = _initial_contact_step(Y, t, n, modes, par)
-                        A_valid = False
-                        continue
-                Y[:] = Ynew
-                for j in range(n):
-                    A[j] *= dec_g[j]
-                k += 1
-                t = k * hg
+                if wall < 0:
+                    Y[:] = Ynew
+                    for j in range(n):
+                        A[j] *= dec_g[j]
+                    k += 1
+                    t = k * hg
+            if wall >= 0:
+                # a located onset (`_search` left the state there in tmp): the contact starts
+                Y[:2 * n + 2] = tmp[:2 * n + 2]
+                t = t + tau
+                in_contact = True
+                at_onset = True
+                onsets += 1
+                counters[_C_CONTACT] += 1
+                h_contact = _initial_contact_step(Y, t, n, modes, par)
+                A_valid = False
+                continue
             if onsets > _MAX_ONSETS_PER_PERIOD:
                 return _STALLED, p
             if recording and k % stride == 0:
