@@ -82,14 +82,21 @@ def check_stability(sys: SystemArrays, h: float) -> None:
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
-def _deriv(y, cos_t, n, w2, c, phi_l, phi_r, f_modal, f_sphere, m_a, k_H, g, out):
-    """Right-hand side of Eqs. 3-7 in relative coordinates (see module docstring)."""
+def _indentations(y, n, phi_l, phi_r, g):
+    """(delta_l, delta_r) of Eqs. 4-6: contact at the left wall when delta_l > 0, at the right when delta_r < 0."""
     u = y[2 * n]
     dl = -u - g
     dr = -u + g
     for j in range(n):
         dl += phi_l[j] * y[j]
         dr += phi_r[j] * y[j]
+    return dl, dr
+
+
+@njit(cache=True, inline="always", fastmath=_FAST)
+def _deriv(y, cos_t, n, w2, c, phi_l, phi_r, f_modal, f_sphere, m_a, k_H, g, out):
+    """Right-hand side of Eqs. 3-7 in relative coordinates (see module docstring)."""
+    dl, dr = _indentations(y, n, phi_l, phi_r, g)
     fl = k_H * dl * math.sqrt(dl) if dl > 0.0 else 0.0
     fr = -k_H * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
     for j in range(n):
@@ -119,12 +126,7 @@ def _advance(y, n_periods, N, h, Omega, a_base, omega, D, phi_l, phi_r, phi_tip,
     if recording:
         record[0, :] = y
     # contact state at the start (continuous with the end of the previous call)
-    u = y[2 * n]
-    dl = -u - g
-    dr = -u + g
-    for j in range(n):
-        dl += phi_l[j] * y[j]
-        dr += phi_r[j] * y[j]
+    dl, dr = _indentations(y, n, phi_l, phi_r, g)
     has_contact = k_H > 0.0  # k_H = 0: the host structure alone, no contacts to count
     closed_l = dl > 0.0 and has_contact
     closed_r = dr < 0.0 and has_contact
@@ -146,14 +148,10 @@ def _advance(y, n_periods, N, h, Omega, a_base, omega, D, phi_l, phi_r, phi_tip,
             for i in range(ny):
                 y[i] += b1 * k1[i] + b2 * k2[i] + b3 * k3[i]
             # measures at the new step point t_{k+1}
-            u = y[2 * n]
+            dl, dr = _indentations(y, n, phi_l, phi_r, g)
             q = 0.0
-            dl = -u - g
-            dr = -u + g
             for j in range(n):
                 q += phi_tip[j] * y[j]
-                dl += phi_l[j] * y[j]
-                dr += phi_r[j] * y[j]
             kk = k + 1
             if kk < N:
                 re += q * cos0[kk]
