@@ -14,6 +14,7 @@ import json
 import os
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 NAME = "reproduce"
@@ -76,8 +77,6 @@ def run_calibration(out: Path) -> dict | None:
 
 def with_calibration(study, k_H_cal: float):
     """The study with k_H's upper bound at the calibrated value (and the best estimate kept below it)."""
-    from dataclasses import replace
-
     from uq.space import K_H_STAR, ParameterSpace
 
     space = study.space
@@ -101,8 +100,6 @@ def run(args: argparse.Namespace) -> int:
 
     figures = ("fig7", "fig8") if args.figure == "all" else (args.figure,)
     studies = [load_study(study_file(f, args.quick)) for f in figures]
-    from dataclasses import replace
-
     if args.integrator:
         studies = [replace(s, protocol={**s.protocol, "integrator": args.integrator}) for s in studies]
     if args.model is not None:
