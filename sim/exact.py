@@ -52,6 +52,10 @@ import numpy as np
 from numba import njit
 
 from sim.errors import SimulationDiverged, SimulationInputError
+from sim.flight import (_ABASE, _APL, _APR, _G, _HG, _HMAX, _KH, _MA, _ML0, _MR0, _N_PAR, _N_ROWS, _OM, _PIM, _PL, _PR,
+                        _PRE, _RHI, _RHR, _SCV, _SCX, _SCZ, _SCZD, _SIG, _SIM, _SRE, _TOL, _VMIN, _W2, _WD, _WLI,
+                        _WLR, _WRI, _WRR, _apply_flight, _closing, _closing_at, _flight_transitions, _rotate,
+                        _transition)
 from sim.system import SystemArrays, check_run_step
 
 #: Free-flight grid steps per excitation period (certification cells; no effect on accuracy).
@@ -63,13 +67,6 @@ GAP_TOLERANCE = 1e-12
 #: Contact onsets need an approach speed above this (m/s) unless the indentation already exceeds the tolerance.
 MIN_APPROACH_SPEED = 1e-9
 
-# rows of the per-mode constant table
-_SIG, _WD, _W2, _PL, _PR, _RHR, _RHI, _APL, _APR, _SRE, _SIM, _SCX, _SCV = range(13)
-_N_ROWS = 13
-# entries of the scalar parameter vector
-(_OM, _ABASE, _MA, _KH, _G, _WLR, _WLI, _WRR, _WRI, _PRE, _PIM, _TOL, _VMIN, _HG, _ML0, _MR0, _SCZ, _SCZD,
- _HMAX) = range(19)
-_N_PAR = 19
 # counters
 _C_GRID, _C_SEARCH, _C_EVAL, _C_ACC, _C_REJ, _C_REL, _C_CONTACT = range(7)
 _N_COUNT = 7
@@ -87,65 +84,6 @@ _A51, _A52, _A53, _A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
 _A61, _A62, _A63, _A64, _A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
 _B1, _B3, _B4, _B5, _B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
 _E1, _E3, _E4, _E5, _E6, _E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
-
-
-# ----------------------------------------------------------------------------------------------------------
-# free flight in closed form
-# ----------------------------------------------------------------------------------------------------------
-@njit(cache=True, inline="always")
-def _transition(tau, sig, wd, w2):
-    """Damped-oscillator transition over tau: (x, v)(tau) = [[a, b], [c, d]] (x0, v0)."""
-    e = math.exp(-sig * tau)
-    co = math.cos(wd * tau)
-    si = math.sin(wd * tau)
-    return e * (co + sig / wd * si), e * si / wd, -e * w2 / wd * si, e * (co - sig / wd * si)
-
-
-@njit(cache=True)
-def _flight_transitions(tau, modes, tr):
-    """tr[:, j] = transition (a, b, c, d) of mode j over a free flight of length tau."""
-    for j in range(modes.shape[1]):
-        tr[0, j], tr[1, j], tr[2, j], tr[3, j] = _transition(tau, modes[_SIG, j], modes[_WD, j], modes[_W2, j])
-
-
-@njit(cache=True)
-def _apply_flight(Y, Ynew, tau, tr, n):
-    """Ynew = free flight of Y over tau (the force integrals F_w do not change)."""
-    for j in range(n):
-        x = Y[j]
-        v = Y[n + j]
-        Ynew[j] = tr[0, j] * x + tr[1, j] * v
-        Ynew[n + j] = tr[2, j] * x + tr[3, j] * v
-    Ynew[2 * n] = Y[2 * n] + tau * Y[2 * n + 1]
-    for i in range(2 * n + 1, Y.size):
-        Ynew[i] = Y[i]
-
-
-@njit(cache=True, inline="always")
-def _closing(Y, t, n, modes, par):
-    """(c_l, c_l', c_r, c_r') at phase time t: contact at a wall when its c > 0 (Eqs. 4-6)."""
-    return _closing_at(Y, math.cos(par[_OM] * t), math.sin(par[_OM] * t), n, modes, par)
-
-
-@njit(cache=True, inline="always")
-def _closing_at(Y, ct, st, n, modes, par):
-    """`_closing` with cos, sin(Omega t) given."""
-    Om = par[_OM]
-    sl = par[_WLR] * ct - par[_WLI] * st
-    sld = -Om * (par[_WLR] * st + par[_WLI] * ct)
-    sr = par[_WRR] * ct - par[_WRI] * st
-    srd = -Om * (par[_WRR] * st + par[_WRI] * ct)
-    for j in range(n):
-        x = Y[j]
-        v = Y[n + j]
-        sl += modes[_PL, j] * x
-        sld += modes[_PL, j] * v
-        sr += modes[_PR, j] * x
-        srd += modes[_PR, j] * v
-    z = Y[2 * n]
-    zd = Y[2 * n + 1]
-    g = par[_G]
-    return sl - z - g, sld - zd, -(sr - z) - g, -(srd - zd)
 
 
 @njit(cache=True, inline="always")
@@ -262,19 +200,6 @@ def _warp(kind, u, s):
     if kind == _RELEASE:
         return s * u * (2.0 - u), 2.0 * s * (1.0 - u)
     return s * u * u * (3.0 - 2.0 * u), 6.0 * s * u * (1.0 - u)
-
-
-@njit(cache=True, inline="always")
-def _rotate(ct, st, angle):
-    """cos, sin(theta + angle) from cos, sin(theta); Taylor series for the small angles of a contact step."""
-    if abs(angle) < 0.02:
-        a2 = angle * angle
-        ca = 1.0 - a2 / 2.0 * (1.0 - a2 / 12.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0)))
-        sa = angle * (1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0 * (1.0 - a2 / 72.0))))
-    else:
-        ca = math.cos(angle)
-        sa = math.sin(angle)
-    return ct * ca - st * sa, st * ca + ct * sa
 
 
 @njit(cache=True, fastmath=_FAST)
