@@ -51,6 +51,7 @@ import math
 import numpy as np
 from numba import njit
 
+from sim import collocation
 from sim.errors import SimulationDiverged, SimulationInputError
 from sim.flight import (_ABASE, _APL, _APR, _G, _HG, _HMAX, _KH, _MA, _ML0, _MR0, _N_PAR, _N_ROWS, _OM, _PIM, _PL, _PR,
                         _PRE, _RHI, _RHR, _SCV, _SCX, _SCZ, _SCZD, _SIG, _SIM, _SRE, _TOL, _VMIN, _W2, _WD, _WLI,
@@ -61,15 +62,15 @@ from sim.system import SystemArrays, check_run_step
 #: Free-flight grid steps per excitation period (certification cells; no effect on accuracy).
 GRID_PER_PERIOD = 48
 #: Default tolerance of the contact integration, relative to the clearance g (error per step, in m / g).
-CONTACT_RTOL = 1e-7
+CONTACT_RTOL = 1e-10
 #: Onset/release location tolerance on the closing function, relative to g.
 GAP_TOLERANCE = 1e-12
 #: Contact onsets need an approach speed above this (m/s) unless the indentation already exceeds the tolerance.
 MIN_APPROACH_SPEED = 1e-9
 
 # counters
-_C_GRID, _C_SEARCH, _C_EVAL, _C_ACC, _C_REJ, _C_REL, _C_CONTACT = range(7)
-_N_COUNT = 7
+_C_GRID, _C_SEARCH, _C_EVAL, _C_ACC, _C_REJ, _C_REL, _C_CONTACT, _C_COLLOC, _C_FALLBACK = range(9)
+_N_COUNT = 9
 # status codes
 _OK, _NONFINITE, _OVERLAP, _STALLED, _STALLED_SEARCH = 0, 1, 2, 3, 4
 _MAX_SEARCH = 200_000
@@ -468,8 +469,11 @@ def _to_state(Y, t, y_out, n, modes, par):
 
 @njit(cache=True)
 def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, stride, amplitudes,
-             impacts, counters, fixed_step):
-    """Advance y (phase 0) over n_periods excitation periods; returns (status, period of failure)."""
+             impacts, counters, fixed_step, use_collocation, colloc):
+    """Advance y (phase 0) over n_periods excitation periods; returns (status, period of failure).
+
+    Contacts start with `collocation.contact` (arguments in the tuple colloc) if use_collocation, and go on
+    with the Dormand-Prince `_contact` wherever that falls back."""
     n = modes.shape[1]
     m = 2 * n + 6
     Om = par[_OM]
@@ -498,6 +502,7 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
     no_contact = par[_KH] == 0.0  # host structure alone (k_H = 0): linear, exact everywhere
     in_contact = (cl > 0.0 or cr > 0.0) and not no_contact
     at_onset = False
+    onset_wall = 0
     h_contact = 0.0
     t = 0.0
     for p in range(n_periods):
@@ -513,10 +518,25 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
             if in_contact:
                 ks = (int(t / (stride * hg)) + 1) * stride
                 t_stop = T if ks >= N else ks * hg
-                if h_contact <= 0.0:
-                    h_contact = 0.01 / math.sqrt(modes[_W2, n - 1])
-                t, h_contact, released, status, extra = _contact(Y, t, t_stop, h_contact, at_onset, K, tmp, Ynew, n,
-                                                                 modes, par, counters, fixed_step, memo)
+                released = False
+                status = _OK
+                extra = 0
+                if at_onset and use_collocation:
+                    tabs, built, off, u, b, xq, bq, M_onset, M_regular, tail, h_ref, memo_c, ws, Aw, S, G, phase = colloc
+                    outcome, t_new, steps = collocation.contact(Y, t, t_stop, onset_wall, tabs, built, off, u, b, xq,
+                                                                bq, M_onset, M_regular, tail, h_ref, n, modes, par,
+                                                                memo_c, ws, Aw, S, G, phase)
+                    counters[_C_COLLOC] += steps
+                    released = outcome == collocation.RELEASED
+                    t = t_new
+                    if not released:
+                        counters[_C_FALLBACK] += 1
+                        at_onset = steps == 0
+                if not released:
+                    if h_contact <= 0.0:
+                        h_contact = 0.01 / math.sqrt(modes[_W2, n - 1])
+                    t, h_contact, released, status, extra = _contact(Y, t, t_stop, h_contact, at_onset, K, tmp, Ynew,
+                                                                     n, modes, par, counters, fixed_step, memo)
                 at_onset = False
                 onsets += extra
                 if status != _OK:
@@ -583,6 +603,7 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
                 t = t + tau
                 in_contact = True
                 at_onset = True
+                onset_wall = wall
                 onsets += 1
                 counters[_C_CONTACT] += 1
                 h_contact = _initial_contact_step(Y, t, n, modes, par)
@@ -681,7 +702,8 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
 
 def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: SystemArrays,
              record: np.ndarray | None = None, *, rtol: float = CONTACT_RTOL, grid_per_period: int = GRID_PER_PERIOD,
-             fixed_contact_step: float = 0.0, stats: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+             fixed_contact_step: float = 0.0, contacts: str = "collocation",
+             stats: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Advance y in place over `n_periods` whole excitation periods, exact between contacts (issue 5).
 
     Integrator contract of `sim.system` (same as `sim.ode3.run_step`): y = [s, s', u_a, u_a'] at
@@ -693,7 +715,10 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     instants per period (row 0 = initial state), exactly at those instants.
     rtol: contact-integration tolerance relative to g (per step, in m of wall/tip displacement).
     grid_per_period: free-flight certification cells per period (rounded up to a multiple of M).
-    fixed_contact_step: > 0 replaces the error control in contacts by this fixed step in s (order studies).
+    fixed_contact_step: > 0 replaces the error control in contacts by this fixed step in s (order studies;
+    Dormand-Prince only).
+    contacts: "collocation" (default: `sim.collocation`, Dormand-Prince where it falls back) or "dopri5"
+    (every contact by the Dormand-Prince 5(4) pair with error control at rtol).
     stats: optional dict that receives the kernel's counters (grid steps, searches, contact steps, ...).
     Raises SimulationInputError for bad arguments, SimulationDiverged for a non-finite state, an
     indentation beyond the clearance or a stalled contact search.
@@ -702,6 +727,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     rtol = float(rtol)
     if not math.isfinite(rtol) or not 0.0 < rtol < 1e-2:
         raise SimulationInputError(f"rtol must lie in (0, 0.01), got {rtol!r}")
+    if contacts not in ("collocation", "dopri5"):
+        raise SimulationInputError(f"contacts must be 'collocation' or 'dopri5', got {contacts!r}")
     if not (sys.m_a > 0 and sys.k_H >= 0 and sys.g > 0):
         raise SimulationInputError("sphere mass and clearance g must be positive and k_H >= 0 (0: no impactor)")
     N = max(int(grid_per_period), samples)
@@ -712,11 +739,14 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     amplitudes = np.empty(n_periods)
     impacts = np.zeros(n_periods, dtype=np.int64)
     counters = np.zeros(_N_COUNT, dtype=np.int64)
+    use_collocation = contacts == "collocation" and fixed_contact_step <= 0.0
+    colloc = collocation.arguments(sys, modes)
     status, period = _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record_arr,
-                              N // samples, amplitudes, impacts, counters, float(fixed_contact_step))
+                              N // samples, amplitudes, impacts, counters, float(fixed_contact_step), use_collocation,
+                              colloc)
     if stats is not None:
         names = ("grid_steps", "searches", "search_evaluations", "contact_steps", "rejected_steps",
-                 "release_iterations", "contacts")
+                 "release_iterations", "contacts", "collocation_steps", "collocation_fallbacks")
         for name, value in zip(names, counters):
             stats[name] = stats.get(name, 0) + int(value)
     if status != _OK:

@@ -167,8 +167,10 @@ def test_observed_order_of_the_contact_step():
 def test_energy_conserved_over_1000_impacts():
     """No damping (D = 1e-15), no excitation: modal + sphere (+ contact) energy within 1e-6 over >= 1000 impacts.
 
-    The drift is the contact integration's error and scales with rtol (about 4e-7 per impact at
-    rtol 1e-8, ~2e-9 at 1e-11; more at the default 1e-7): the criterion needs rtol = 1e-12."""
+    Collocated contacts conserve it to ~1e-10 per impact; the drift comes from the contacts that fall back
+    to the Dormand-Prince pair (about 10 % in this ringing, undamped case; 2 % in the rig's sweeps) and
+    scales with rtol: 6.5e-6 at 1e-7, 4e-7 at the default 1e-10, 3e-8 at 1e-11 (measured). The test runs at
+    1e-11 so that the criterion holds with margin on any platform."""
     model = cantilever_like_model(undamped=True)
     model = ModalModel(frequencies_hz=model.frequencies_hz, damping_ratios=np.full(N9, 1e-15),
                        phi_wall_left=model.phi_wall_left, phi_wall_right=model.phi_wall_right,
@@ -187,7 +189,7 @@ def test_energy_conserved_over_1000_impacts():
     e0 = energy(y)
     impacts = 0
     while impacts < 1000:
-        _, imp = exact.run_step(y, 20, 2 * math.pi * 100.0, 0.0, sys, rtol=1e-12)
+        _, imp = exact.run_step(y, 20, 2 * math.pi * 100.0, 0.0, sys, rtol=1e-11)
         impacts += int(imp.sum())
     drift = abs(energy(y) - e0) / e0
     print(f"\n{impacts} impacts: relative energy change {drift:.2e}")
@@ -199,7 +201,7 @@ def test_release_is_located_when_the_first_guess_ends_short():
     impact) whenever its first trial step ended still closed; it must converge onto c = 0 from either side."""
     sys = system_arrays(cantilever_like_model(), Impactor())
     Omega = 2 * math.pi * 1000.0
-    modes, par, *_ = exact._prepare(Omega, 0.0, sys, 48, exact.CONTACT_RTOL, 0.5 / sys.omega.max())
+    modes, par, *_ = exact._prepare(Omega, 0.0, sys, 48, 1e-7, 0.5 / sys.omega.max())
     n = N9
     Y = np.zeros(2 * n + 6)
     Y[2 * n] = -sys.g - 1e-7  # 0.1 um into the left wall ...

@@ -1,0 +1,763 @@
+"""Contacts by exponential Gauss collocation (issue 5): a whole Hertz impact in two or three steps.
+
+During a contact with wall w only the scalar contact force F(t) = k_H c_w(t)^1.5 is nonlinear; the modes
+and the sphere respond to it linearly (Eqs. 3-7). Over a step of length h from t_a (state Y_a) we write
+the closing function exactly as (Duhamel)
+
+    c_w(t_a + tau) = c_hom(tau) - int_0^tau K_w(tau - sigma) F(sigma) dsigma,
+    K_w(t) = sum_j phi_w,j^2 exp(-sigma_j t) sin(omega_dj t) / omega_dj + t / m_a,
+
+c_hom being the free flight from Y_a (closed form, `sim.exact`). F is represented by its values at s Gauss
+nodes of a time map t = t_a + h w(u), u in [0, 1] (the maps of `sim.exact._warp`: u^2 at an onset,
+u (2 - u) before a release, so that F ~ (time to the end)^1.5 becomes a smooth function of u), and the
+s nodal equations F_i = k_H c_w(t_i)^1.5 are solved by Newton's method. Everything linear is exact:
+the s x s weights of the convolution, the modal and sphere responses to each nodal force, and the
+transitions are tables that depend only on the system, the time map and h. h is taken from a geometric
+ladder (LADDER_PER_OCTAVE per octave) so the tables are built once per system and reused (`Tables`).
+
+A contact is an onset step (h ~ half the Hertz contact time), regular steps if the contact lasts longer,
+and a release step whose *end* is the release: its length is a ladder value and its *start* t_e - d lies
+inside the previous step, where the state is the Taylor series of the previous step's solution (exact
+for its force polynomial) evaluated at d. The s nodal forces and d are solved together by Newton's
+method with c_w = 0 at the step's end. Contacts this cannot treat (too short, too long, crossing the end
+of a period or a record instant, a failed Newton iteration) fall back to the Dormand-Prince contact.
+
+Accuracy: the force is interpolated by a polynomial of degree s - 1 in u, so a step has the order of
+its interpolation (about s + 1 for the modal response, 2 s for the force impulse, Gauss quadrature);
+with s = 10 a whole impact has a rebound error near 1e-9 (tests/sim/test_exact.py).
+"""
+from __future__ import annotations
+
+import math
+from collections import OrderedDict
+
+import numpy as np
+from numba import njit
+from numpy.polynomial import legendre, polynomial
+
+from sim.flight import (_G, _KH, _MA, _OM, _PL, _PR, _SIG, _W2, _WD, _WLI, _WLR, _WRI, _WRR, _closing_at, _rotate,
+                        _transition)
+
+#: Gauss nodes per collocation step.
+NODES = 10
+#: Order of the Taylor series that carries the state back into the previous step. It goes back by at most a
+#: quarter of that step, and steps are at most one period of the highest mode: truncation below 1e-11 of
+#: that mode's amplitude ((pi / 2)^16 / 16!).
+SERIES_ORDER = 16
+#: Step lengths: h_k = (2 pi / omega_max) 2^((k - LADDER_CENTRE) / LADDER_PER_OCTAVE).
+LADDER_PER_OCTAVE = 8
+LADDER_SIZE = 80
+LADDER_CENTRE = 48
+#: Newton's method stops when the last correction was below this, relative to the indentations (the
+#: iterate is then converged to ~1e-12: quadratic convergence).
+_NEWTON_TOL = 1e-6
+#: Gauss-Legendre points of the quadratures that build the tables.
+TABLE_QUADRATURE = 32
+
+# time maps (as in sim.exact._warp)
+ONSET, REGULAR, RELEASE = 0, 1, 2
+
+
+# ----------------------------------------------------------------------------------------------------------
+# tables: layout and construction
+# ----------------------------------------------------------------------------------------------------------
+def _offsets(s: int, n: int) -> np.ndarray:
+    """Offsets of P, Q ((s+1) x n), W ((s+1) x s), BX, BV (s x n), BZ, BZD (s), TR (4 x n), TAU (s+1),
+    WQ (s) in a table, and the table's size (int64 array, indexed by _P ... _SIZE)."""
+    r = s + 1
+    sizes = (r * n, r * n, r * s, s * n, s * n, s, s, 4 * n, r, s)
+    return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+
+
+class Nodes:
+    """Universal data of the s-node collocation: nodes, weights, and the maps from nodal forces to the
+    Taylor coefficients (in the backward time sigma / h) of the force at the end of a step."""
+
+    def __init__(self, s: int = NODES, order: int = SERIES_ORDER):
+        x, w = legendre.leggauss(s)
+        self.u = 0.5 * (x + 1.0)
+        self.b = 0.5 * w
+        xq, wq = legendre.leggauss(TABLE_QUADRATURE)
+        self.xq = 0.5 * (xq + 1.0)
+        self.bq = 0.5 * wq
+        # Taylor coefficients at u = 1 of the Lagrange basis, in eps = 1 - u: C[m, k]
+        C = np.zeros((order, s))
+        for k in range(s):
+            others = np.delete(self.u, k)
+            lk = polynomial.polyfromroots(others) / np.prod(self.u[k] - others)
+            # l_k(1 - eps) as a polynomial in eps
+            coeffs = np.zeros(s)
+            one_minus = np.array([1.0, -1.0])
+            power = np.array([1.0])
+            for c in lk:
+                coeffs[:power.size] += c * power
+                power = polynomial.polymul(power, one_minus)
+            C[:s, k] = coeffs[:s] if order >= s else coeffs[:order]
+        self.regular = C  # sigma / h = eps
+        # onset map: u = sqrt(1 - x), eps = 1 - sqrt(1 - x), x = sigma / h
+        eps = np.zeros(order)
+        binom = 1.0
+        for q in range(1, order):
+            binom *= (0.5 - (q - 1)) / q
+            eps[q] = -binom * (-1.0) ** q
+        onset = np.zeros((order, s))
+        power = np.zeros(order)
+        power[0] = 1.0
+        for m in range(s):
+            onset += np.outer(power, C[m])
+            power = np.convolve(power, eps)[:order]
+        self.onset = onset
+        # the two highest Legendre coefficients of the force polynomial from its nodal values (Gauss quadrature)
+        z = 2.0 * self.u - 1.0
+        self.tail = np.array([(2 * m + 1) * self.b * legendre.legval(z, np.eye(s)[m]) for m in (s - 2, s - 1)])
+
+
+@njit(cache=True, inline="always")
+def _map(kind, u):
+    """(w(u), w'(u)) of the step's time map t = t_a + h w(u)."""
+    if kind == ONSET:
+        return u * u, 2.0 * u
+    if kind == RELEASE:
+        return u * (2.0 - u), 2.0 * (1.0 - u)
+    return u, 1.0
+
+
+@njit(cache=True, inline="always")
+def _lagrange(u, v, k):
+    """l_k(v) on the nodes u."""
+    out = 1.0
+    for m in range(u.size):
+        if m != k:
+            out *= (v - u[m]) / (u[k] - u[m])
+    return out
+
+
+# table offsets: P, Q, W, BX, BV, BZ, BZD, TR, TAU, WQ, size
+_P, _Q, _W, _BX, _BV, _BZ, _BZD, _TR, _TAU, _WQ, _SIZE = range(11)
+
+
+@njit(cache=True)
+def _build(tab, off, kind, h, wall, u, b, xq, bq, n, modes, par):
+    """Fill one table (layout of `_offsets`) for a step of length h with the time map `kind` at wall 0/1.
+
+    P, Q: c_hom at node i (row s: the step's end) = sum_j P_ij x_j + Q_ij v_j + (harmonic and sphere terms).
+    W: c_w at node i drops by sum_k W_ik F_k. BX, BV, BZ, BZD: end-state response to the nodal force F_k.
+    TR: mode transitions over h. TAU: node times. WQ: quadrature weights of int F dt over the step.
+    """
+    s = u.size
+    r = s + 1
+    sgn = 1.0 if wall == 0 else -1.0
+    row = _PL if wall == 0 else _PR
+    ma = par[_MA]
+    tab[:] = 0.0
+    for i in range(r):
+        ui = u[i] if i < s else 1.0
+        wi, _ = _map(kind, ui)
+        tau = h * wi
+        tab[off[_TAU] + i] = tau
+        for j in range(n):
+            a, bb, c, d = _transition(tau, modes[_SIG, j], modes[_WD, j], modes[_W2, j])
+            tab[off[_P] + i * n + j] = sgn * modes[row, j] * a
+            tab[off[_Q] + i * n + j] = sgn * modes[row, j] * bb
+        # W[i, k] = int_0^ui K(tau - h w(v)) l_k(v) h w'(v) dv
+        for q in range(xq.size):
+            v = ui * xq[q]
+            wv, dv = _map(kind, v)
+            lag = tau - h * wv
+            K = lag / ma
+            for j in range(n):
+                K += modes[row, j] ** 2 * math.exp(-modes[_SIG, j] * lag) * math.sin(modes[_WD, j] * lag) / modes[_WD, j]
+            weight = ui * bq[q] * K * h * dv
+            for k in range(s):
+                tab[off[_W] + i * s + k] += weight * _lagrange(u, v, k)
+    for q in range(xq.size):
+        v = xq[q]
+        wv, dv = _map(kind, v)
+        lag = h - h * wv
+        for k in range(s):
+            lw = bq[q] * _lagrange(u, v, k) * h * dv
+            tab[off[_BZ] + k] += sgn * lag * lw / ma
+            tab[off[_BZD] + k] += sgn * lw / ma
+            for j in range(n):
+                e = math.exp(-modes[_SIG, j] * lag)
+                si = math.sin(modes[_WD, j] * lag)
+                co = math.cos(modes[_WD, j] * lag)
+                tab[off[_BX] + k * n + j] -= sgn * modes[row, j] * e * si / modes[_WD, j] * lw
+                tab[off[_BV] + k * n + j] -= sgn * modes[row, j] * e * (co - modes[_SIG, j] / modes[_WD, j] * si) * lw
+    for j in range(n):
+        a, bb, c, d = _transition(h, modes[_SIG, j], modes[_WD, j], modes[_W2, j])
+        tab[off[_TR] + j] = a
+        tab[off[_TR] + n + j] = bb
+        tab[off[_TR] + 2 * n + j] = c
+        tab[off[_TR] + 3 * n + j] = d
+    for k in range(s):
+        _, dk = _map(kind, u[k])
+        tab[off[_WQ] + k] = b[k] * h * dk
+
+
+# ----------------------------------------------------------------------------------------------------------
+# one step: the free closing function at the nodes, Newton on the nodal indentations, the end state
+# ----------------------------------------------------------------------------------------------------------
+@njit(cache=True)
+def _solve_in_place(A, x, m):
+    """x <- A^-1 x for the leading m x m block of A (Gaussian elimination, partial pivoting; A destroyed)."""
+    for c in range(m):
+        p = c
+        best = abs(A[c, c])
+        for r in range(c + 1, m):
+            if abs(A[r, c]) > best:
+                best = abs(A[r, c])
+                p = r
+        if best == 0.0:
+            return False
+        if p != c:
+            for k in range(m):
+                tmp = A[c, k]
+                A[c, k] = A[p, k]
+                A[p, k] = tmp
+            tmp = x[c]
+            x[c] = x[p]
+            x[p] = tmp
+        inv = 1.0 / A[c, c]
+        xc = x[c]
+        for r in range(c + 1, m):
+            f = A[r, c] * inv
+            for k in range(c + 1, m):
+                A[r, k] -= f * A[c, k]
+            x[r] -= f * xc
+    for c in range(m - 1, -1, -1):
+        acc = x[c]
+        for k in range(c + 1, m):
+            acc -= A[c, k] * x[k]
+        x[c] = acc / A[c, c]
+    return True
+
+
+@njit(cache=True)
+def _free_closing(tab, off, Y, ct, st, wall, n, s, par, out, Yd, dout):
+    """out[i] = c_w at node i (i = s: the step's end) of the free flight from Y at phase (ct, st).
+
+    With Yd (dY/dt at the step's start, size > 0) also dout[i] = d out[i] / d t_start."""
+    sgn = 1.0 if wall == 0 else -1.0
+    Wr = par[_WLR] if wall == 0 else par[_WRR]
+    Wi = par[_WLI] if wall == 0 else par[_WRI]
+    Om = par[_OM]
+    g = par[_G]
+    deriv = Yd.size > 0
+    for i in range(s + 1):
+        tau = tab[off[_TAU] + i]
+        acc = 0.0
+        dacc = 0.0
+        for j in range(n):
+            acc += tab[off[_P] + i * n + j] * Y[j] + tab[off[_Q] + i * n + j] * Y[n + j]
+            if deriv:
+                dacc += tab[off[_P] + i * n + j] * Yd[j] + tab[off[_Q] + i * n + j] * Yd[n + j]
+        c, si = _rotate(ct, st, Om * tau)
+        out[i] = acc + sgn * (Wr * c - Wi * si - Y[2 * n] - tau * Y[2 * n + 1]) - g
+        if deriv:
+            dout[i] = dacc + sgn * (-Om * (Wr * si + Wi * c) - Yd[2 * n] - tau * Yd[2 * n + 1])
+
+
+@njit(cache=True, inline="always")
+def _forces(delta, F, D, kH, s):
+    """Hertz law at the nodes: F = k_H delta^1.5, D = dF/d delta."""
+    for k in range(s):
+        d = delta[k]
+        if d > 0.0:
+            r = math.sqrt(d)
+            F[k] = kH * d * r
+            D[k] = 1.5 * kH * r
+        else:
+            F[k] = 0.0
+            D[k] = 0.0
+
+
+@njit(cache=True)
+def _newton(tab, off, chom, delta, F, D, A, rhs, s, kH):
+    """Solve delta_i = chom_i - sum_k W_ik F(delta_k) for the nodal indentations (delta holds the guess).
+
+    Returns the number of iterations, or -1 if Newton's method did not converge."""
+    oW = off[_W]
+    for it in range(40):
+        _forces(delta, F, D, kH, s)
+        scale = 0.0
+        for i in range(s):
+            acc = delta[i] - chom[i]
+            for k in range(s):
+                acc += tab[oW + i * s + k] * F[k]
+                A[i, k] = tab[oW + i * s + k] * D[k]
+            A[i, i] += 1.0
+            rhs[i] = acc
+            scale = max(scale, abs(chom[i]))
+        if not _solve_in_place(A, rhs, s):
+            return -1
+        change = 0.0
+        for i in range(s):
+            delta[i] -= rhs[i]
+            change = max(change, abs(rhs[i]))
+        if not change <= 1e3 * scale:
+            return -1
+        if change <= _NEWTON_TOL * scale:
+            _forces(delta, F, D, kH, s)
+            return it + 1
+    return -1
+
+
+@njit(cache=True)
+def _end_state(tab, off, Y, Yout, F, ct, st, wall, n, s, par):
+    """Yout = the state at the step's end: transitions, responses to the nodal forces, and the Fourier
+    integral of the contact force over the step (Gauss quadrature)."""
+    oTR = off[_TR]
+    for j in range(n):
+        x = Y[j]
+        v = Y[n + j]
+        xe = tab[oTR + j] * x + tab[oTR + n + j] * v
+        ve = tab[oTR + 2 * n + j] * x + tab[oTR + 3 * n + j] * v
+        for k in range(s):
+            xe += tab[off[_BX] + k * n + j] * F[k]
+            ve += tab[off[_BV] + k * n + j] * F[k]
+        Yout[j] = xe
+        Yout[n + j] = ve
+    h = tab[off[_TAU] + s]
+    ze = Y[2 * n] + h * Y[2 * n + 1]
+    zde = Y[2 * n + 1]
+    re = 0.0
+    im = 0.0
+    for k in range(s):
+        ze += tab[off[_BZ] + k] * F[k]
+        zde += tab[off[_BZD] + k] * F[k]
+        c, si = _rotate(ct, st, par[_OM] * tab[off[_TAU] + k])
+        wf = tab[off[_WQ] + k] * F[k]
+        re += wf * c
+        im -= wf * si
+    Yout[2 * n] = ze
+    Yout[2 * n + 1] = zde
+    for i in range(2 * n + 2, Yout.size):
+        Yout[i] = Y[i]
+    sgn = 1.0 if wall == 0 else -1.0
+    row = 2 * n + 2 if wall == 0 else 2 * n + 4
+    Yout[row] += sgn * re
+    Yout[row + 1] += sgn * im
+
+
+# ----------------------------------------------------------------------------------------------------------
+# the state inside the previous step: Taylor series in the backward time sigma
+# ----------------------------------------------------------------------------------------------------------
+@njit(cache=True)
+def _series(Yend, F, M, h, wall, n, modes, par, S, Fs):
+    """S[q]: Taylor coefficients of the state [x, v, z, z'] at t_e - sigma, Fs[q] those of the force, for
+    the solution of the step that ended at t_e (length h, force polynomial with nodal values F; M maps
+    them to the force's coefficients in sigma / h, `Nodes.regular` or `Nodes.onset`)."""
+    p = S.shape[0]
+    s = F.size
+    sgn = 1.0 if wall == 0 else -1.0
+    row = _PL if wall == 0 else _PR
+    scale = 1.0
+    for q in range(p):
+        acc = 0.0
+        for k in range(s):
+            acc += M[q, k] * F[k]
+        Fs[q] = acc * scale
+        scale /= h
+    for i in range(2 * n + 2):
+        S[0, i] = Yend[i]
+    for q in range(p - 1):
+        for j in range(n):
+            S[q + 1, j] = -S[q, n + j] / (q + 1)
+            S[q + 1, n + j] = (2.0 * modes[_SIG, j] * S[q, n + j] + modes[_W2, j] * S[q, j]
+                               + sgn * modes[row, j] * Fs[q]) / (q + 1)
+        S[q + 1, 2 * n] = -S[q, 2 * n + 1] / (q + 1)
+        S[q + 1, 2 * n + 1] = -sgn * Fs[q] / par[_MA] / (q + 1)
+
+
+@njit(cache=True)
+def _series_at(S, sigma, Y, Yd, m):
+    """Y = state at t_e - sigma, Yd = its time derivative (first m components)."""
+    p = S.shape[0]
+    for i in range(m):
+        acc = S[p - 1, i]
+        dacc = (p - 1) * S[p - 1, i]
+        for q in range(p - 2, -1, -1):
+            acc = acc * sigma + S[q, i]
+            if q > 0:
+                dacc = dacc * sigma + q * S[q, i]
+        Y[i] = acc
+        Yd[i] = -dacc
+
+
+@njit(cache=True)
+def _closing_series(tab, off, S, wall, n, s, G):
+    """G[q, i]: Taylor coefficients in sigma of the modal and sphere part of c_hom at node i of a step that
+    starts at t_e - sigma (state series S from `_series`); the harmonic part is added by the caller."""
+    sgn = 1.0 if wall == 0 else -1.0
+    for q in range(S.shape[0]):
+        for i in range(s + 1):
+            acc = 0.0
+            for j in range(n):
+                acc += tab[off[_P] + i * n + j] * S[q, j] + tab[off[_Q] + i * n + j] * S[q, n + j]
+            G[q, i] = acc - sgn * (S[q, 2 * n] + tab[off[_TAU] + i] * S[q, 2 * n + 1])
+
+
+@njit(cache=True)
+def _overlap_fourier(Fs, sigma, ct_e, st_e, Om):
+    """int over [t_e - sigma, t_e] of F(t) exp(-i Omega t) dt from the force's series (Omega sigma << 1)."""
+    jr = 0.0
+    ji = 0.0
+    for q in range(Fs.size):
+        fact = 1.0
+        for m in range(5):
+            term = Fs[q] * fact * sigma ** (q + m + 1) / (q + m + 1)
+            # (i Omega)^m / m!
+            if m % 4 == 0:
+                jr += term
+            elif m % 4 == 1:
+                ji += term
+            elif m % 4 == 2:
+                jr -= term
+            else:
+                ji -= term
+            fact *= Om / (m + 1)
+    return ct_e * jr + st_e * ji, ct_e * ji - st_e * jr
+
+
+# ----------------------------------------------------------------------------------------------------------
+# a whole contact
+# ----------------------------------------------------------------------------------------------------------
+#: Hertz impact on a rigid wall: contact time = _HERTZ_TIME delta_max / v0 (2 sqrt(pi) Gamma(7/5) / Gamma(9/10)).
+_HERTZ_TIME = 2.9432
+#: The onset step covers this fraction of the predicted contact time; a release step is taken when the
+#: predicted rest is at most _RELEASE_REACH times the last step, otherwise a regular step of rest / 1.6.
+#: With these the first step never reaches beyond 40 % of the contact and each step stays well away from
+#: the other end's singularity: three steps and rebound errors near 1e-10 (two steps: 1e-7, measured).
+_ONSET_FRACTION = 0.3
+_RELEASE_REACH = 1.0
+#: A step is accepted only if the predicted rest of the contact after it is at least _CLEARANCE times its
+#: length (closer to the release, the force is not a smooth function of the step's time: errors 1e-6).
+_CLEARANCE = 0.45
+#: A step whose force polynomial has its two highest Legendre coefficients above this fraction of the force
+#: is not resolved (1e-5 ... 4e-4 in ordinary steps): the Dormand-Prince contact takes over.
+_RESOLUTION_TOL = 1e-3
+#: Halvings of rejected steps allowed in one contact before the Dormand-Prince contact takes over.
+_MAX_HALVINGS = 4
+#: Longest collocation step, in periods of the highest mode.
+_MAX_STEP_PERIODS = 1.0
+# outcome of `contact`
+RELEASED, FALLBACK = 0, 1
+# rows of the workspace `ws`
+_CHOM, _DCHOM, _DELTA, _F, _D, _RHS, _YNEW, _YS, _YD, _FS = range(10)
+_WS_ROWS = 10
+# 6-point Gauss-Legendre on [0, 1] for `_time_to_release`
+_GL6_X = np.array([0.033765242898423975, 0.16939530676686776, 0.3806904069584015, 0.6193095930415985,
+                   0.8306046932331322, 0.966234757101576])
+_GL6_W = np.array([0.08566224618958517, 0.1803807865240693, 0.23395696728634552, 0.23395696728634552,
+                   0.1803807865240693, 0.08566224618958517])
+
+
+@njit(cache=True)
+def _time_to_release(c, cd, ma, kH):
+    """Time left in a contact at indentation c > 0 and rate cd, for a Hertz impact of the sphere on a
+    rigid wall with the same energy (a first guess for the release step)."""
+    E = 0.5 * ma * cd * cd + 0.4 * kH * c ** 2.5
+    dmax = (2.5 * E / kH) ** 0.4
+    ve = math.sqrt(2.0 * E / ma)
+    xi = min(c / dmax, 1.0)
+    # J(xi) = int_0^xi (1 - eta^2.5)^-0.5 d eta = int_sqrt(1-xi)^1 2 / sqrt(q(1 - w^2)) dw, q(e) = (1 - e^2.5) / (1 - e)
+    a = math.sqrt(1.0 - xi)
+    J = 0.0
+    for k in range(6):
+        w = a + (1.0 - a) * _GL6_X[k]
+        e = 1.0 - w * w
+        q = (1.0 - e ** 2.5) / (1.0 - e) if e < 1.0 else 2.5
+        J += _GL6_W[k] * (1.0 - a) * 2.0 / math.sqrt(q)
+    if cd > 0.0:
+        J = _HERTZ_TIME - J  # past the maximum indentation: the whole contact minus the way back
+    return dmax / ve * J
+
+
+@njit(cache=True)
+def _ladder(h, h_ref, up):
+    """Index of the ladder step just below (up=False) or above (up=True) h; -1 if outside the ladder."""
+    x = LADDER_PER_OCTAVE * math.log2(h / h_ref) + LADDER_CENTRE
+    k = int(math.ceil(x - 1e-12)) if up else int(math.floor(x + 1e-12))
+    return k if 0 <= k < LADDER_SIZE else -1
+
+
+@njit(cache=True)
+def _ladder_h(k, h_ref):
+    return h_ref * 2.0 ** ((k - LADDER_CENTRE) / LADDER_PER_OCTAVE)
+
+
+@njit(cache=True)
+def _table(tabs, built, off, wall, kind, k, h_ref, u, b, xq, bq, n, modes, par):
+    """The table of (wall, kind, ladder index k), built on first use."""
+    if not built[wall, kind, k]:
+        _build(tabs[wall, kind, k], off, kind, _ladder_h(k, h_ref), wall, u, b, xq, bq, n, modes, par)
+        built[wall, kind, k] = True
+    return tabs[wall, kind, k]
+
+
+@njit(cache=True)
+def _active(Y, ct, st, wall, n, modes, par):
+    """(c, c') of `wall`."""
+    cl, cld, cr, crd = _closing_at(Y, ct, st, n, modes, par)
+    return (cl, cld) if wall == 0 else (cr, crd)
+
+
+@njit(cache=True)
+def _resolution(tail, F, s):
+    """max |c_m| / max |F| over the two highest Legendre coefficients c_m of the step's force polynomial:
+    small when the force is resolved (spectral decay), O(1) when it is not (a near-release inside)."""
+    top = 0.0
+    fmax = 0.0
+    for k in range(s):
+        fmax = max(fmax, abs(F[k]))
+    for r in range(2):
+        acc = 0.0
+        for k in range(s):
+            acc += tail[r, k] * F[k]
+        top = max(top, abs(acc))
+    return top / fmax if fmax > 0.0 else 0.0
+
+
+@njit(cache=True)
+def _forward_step(tab, off, Y, ct, st, wall, n, s, par, ws, A, ratio, tail):
+    """Solve a step from Y that has no release inside: nodal forces in ws[_F], first guess ratio times the
+    free indentation (ratio is updated). False if Newton's method failed, an indentation is not positive or
+    the force is not resolved."""
+    chom = ws[_CHOM]
+    delta = ws[_DELTA]
+    _free_closing(tab, off, Y, ct, st, wall, n, s, par, chom, ws[_FS, :0], ws[_DCHOM])
+    for i in range(s):
+        delta[i] = ratio[i] * chom[i]
+    if _newton(tab, off, chom, delta, ws[_F], ws[_D], A, ws[_RHS], s, par[_KH]) < 0:
+        return False
+    for i in range(s):
+        if not delta[i] > 0.0:
+            return False
+    for i in range(s):
+        ratio[i] = delta[i] / chom[i]
+    return _resolution(tail, ws[_F], s) <= _RESOLUTION_TOL
+
+
+@njit(cache=True)
+def _release_step(tab, off, S, G, phase, ct, st, d, d_lo, d_hi, c_e, cd_e, wall, n, s, par, ws, A, ratio):
+    """Newton's method for the release step of table `tab` that starts d before the last step's end (phase
+    ct, st there; state series S): unknowns the nodal indentations and d, equations the collocation and
+    c_w = 0 at the step's end. d is kept in [d_lo, d_hi] (the series' range). Returns (status, d): 0
+    converged, 1 failed, 2 d left its range (the release is elsewhere: another ladder length); the nodal
+    forces are left in ws[_F]."""
+    chom = ws[_CHOM]
+    dchom = ws[_DCHOM]
+    delta = ws[_DELTA]
+    F = ws[_F]
+    D = ws[_D]
+    rhs = ws[_RHS]
+    Om = par[_OM]
+    kH = par[_KH]
+    p = S.shape[0]
+    sgn = 1.0 if wall == 0 else -1.0
+    Wr = par[_WLR] if wall == 0 else par[_WRR]
+    Wi = par[_WLI] if wall == 0 else par[_WRI]
+    oW = off[_W]
+    for i in range(s):
+        delta[i] = ratio[i] * c_e
+    _closing_series(tab, off, S, wall, n, s, G)
+    for i in range(s + 1):
+        phase[0, i], phase[1, i] = _rotate(1.0, 0.0, Om * tab[off[_TAU] + i])
+    for _ in range(30):
+        # c_hom at the nodes and its derivative in the start time, from the series in d
+        cb, sb = _rotate(ct, st, -Om * d)
+        for i in range(s + 1):
+            val = G[p - 1, i]
+            dval = (p - 1) * G[p - 1, i]
+            for q in range(p - 2, -1, -1):
+                val = val * d + G[q, i]
+                if q > 0:
+                    dval = dval * d + q * G[q, i]
+            c = cb * phase[0, i] - sb * phase[1, i]
+            si = sb * phase[0, i] + cb * phase[1, i]
+            chom[i] = val + sgn * (Wr * c - Wi * si) - par[_G]
+            dchom[i] = -dval - sgn * Om * (Wr * si + Wi * c)
+        _forces(delta, F, D, kH, s)
+        # residuals delta_i - c_hom,i + sum_k W_ik F_k at the nodes and c_w at the end; d/dd = -d/dt_start
+        scale = 0.0
+        for i in range(s + 1):
+            last = i == s
+            acc = chom[i] if last else delta[i] - chom[i]
+            for k in range(s):
+                wik = tab[oW + i * s + k]
+                acc += -wik * F[k] if last else wik * F[k]
+                A[i, k] = -wik * D[k] if last else wik * D[k]
+            if not last:
+                A[i, i] += 1.0
+            A[i, s] = -dchom[i] if last else dchom[i]
+            rhs[i] = acc
+            scale = max(scale, abs(chom[i]))
+        if not _solve_in_place(A, rhs, s + 1):
+            return 1, d
+        change = abs(rhs[s] * cd_e)
+        for i in range(s):
+            delta[i] -= rhs[i]
+            change = max(change, abs(rhs[i]))
+        d -= rhs[s]
+        if not (change <= 1e3 * scale and math.isfinite(d)):
+            return 1, d
+        if not d_lo <= d <= d_hi:
+            return 2, d
+        if change <= _NEWTON_TOL * scale:
+            _forces(delta, F, D, kH, s)
+            for i in range(s):
+                if not delta[i] > 0.0:
+                    return 1, d
+            for i in range(s):
+                ratio[i] = delta[i] / c_e
+            return 0, d
+    return 1, d
+
+
+@njit(cache=True)
+def contact(Y, t, t_stop, wall, tabs, built, off, u, b, xq, bq, M_onset, M_regular, tail, h_ref, n, modes, par,
+            memo, ws, A, S, G, phase):
+    """Integrate the contact with `wall` (0 left, 1 right) from its located onset (t, Y) to its release.
+
+    Returns (outcome, t, steps): RELEASED with Y the state at the release time t, or FALLBACK with Y the
+    valid state at t (the onset itself if steps == 0) from where the Dormand-Prince contact goes on.
+    memo[0 / 1 / 2, :s]: indentations of the last onset / regular / release step over their first guess.
+    ws, A, S, G, phase: workspace (`workspace`).
+    """
+    s = u.size
+    m = 2 * n + 2
+    Om = par[_OM]
+    kH = par[_KH]
+    sgn = 1.0 if wall == 0 else -1.0
+    ct = math.cos(Om * t)
+    st = math.sin(Om * t)
+    _, v = _active(Y, ct, st, wall, n, modes, par)
+    if not v > 0.0:
+        return FALLBACK, t, 0
+    t_hertz = _HERTZ_TIME * (5.0 * par[_MA] * v * v / (4.0 * kH)) ** 0.4 / v
+    k = _ladder(min(_ONSET_FRACTION * t_hertz, _MAX_STEP_PERIODS * h_ref), h_ref, False)
+    if k < 0 or t + 1.5 * t_hertz >= t_stop:
+        return FALLBACK, t, 0
+    kind = ONSET
+    Ynew = ws[_YNEW, :Y.size]
+    steps = 0
+    halvings = 0
+    for _ in range(100):
+        # a step (onset or regular) from the last accepted state; it is repeated at half the length if it
+        # failed (Newton, a release inside, unresolved force) or ended too close to the release (its force
+        # is then not smooth in the step's time), at most _MAX_HALVINGS times in a contact
+        tab = _table(tabs, built, off, wall, kind, k, h_ref, u, b, xq, bq, n, modes, par)
+        h = _ladder_h(k, h_ref)
+        R = 0.0
+        ok = _forward_step(tab, off, Y, ct, st, wall, n, s, par, ws, A, memo[kind], tail)
+        if ok:
+            _end_state(tab, off, Y, Ynew, ws[_F], ct, st, wall, n, s, par)
+            c1, s1 = _rotate(ct, st, Om * h)
+            c_e, cd_e = _active(Ynew, c1, s1, wall, n, modes, par)
+            if c_e > 0.0:
+                R = _time_to_release(c_e, cd_e, par[_MA], kH)
+        if R < _CLEARANCE * h:
+            k -= LADDER_PER_OCTAVE
+            halvings += 1
+            if k < 0 or halvings > _MAX_HALVINGS:
+                return FALLBACK, t, steps
+            continue
+        Y[:] = Ynew
+        t += h
+        norm = 1.5 - 0.5 * (c1 * c1 + s1 * s1)  # keeps cos^2 + sin^2 = 1 to rounding
+        ct = c1 * norm
+        st = s1 * norm
+        steps += 1
+        if R <= _RELEASE_REACH * h:
+            # the release step: its end is the release, its start t - d lies in the last step (series there)
+            Fs = ws[_FS, :S.shape[0]]
+            _series(Y, ws[_F, :s], M_onset if kind == ONSET else M_regular, h, wall, n, modes, par, S, Fs)
+            for _attempt in range(3):
+                k = _ladder(R + 0.1 * h, h_ref, True)
+                if k < 0:
+                    return FALLBACK, t, steps
+                tab = _table(tabs, built, off, wall, RELEASE, k, h_ref, u, b, xq, bq, n, modes, par)
+                h_k = _ladder_h(k, h_ref)
+                status, d = _release_step(tab, off, S, G, phase, ct, st, h_k - R, -0.3 * h, 0.6 * h, c_e, cd_e, wall,
+                                          n, s, par, ws, A, memo[2])
+                if status == 1:
+                    return FALLBACK, t, steps
+                R = h_k - min(max(d, -0.3 * h), 0.6 * h)  # the release as found (or as far as the series reaches)
+                if (status == 0 and 0.0 <= d <= 0.25 * h) or R > _RELEASE_REACH * h:
+                    break
+            if status == 0 and 0.0 <= d <= 0.25 * h and _resolution(tail, ws[_F], s) <= _RESOLUTION_TOL:
+                if t - d + h_k >= t_stop:
+                    return FALLBACK, t, steps
+                # the state at the release step's start: the series, without the overlap's share of F_w
+                Ys = ws[_YS]
+                _series_at(S, d, Ys, ws[_YD], m)
+                cs, ss = _rotate(ct, st, -Om * d)
+                ore, oim = _overlap_fourier(Fs, d, ct, st, Om)
+                Ynew[:m] = Ys[:m]
+                Ynew[m:] = Y[m:]
+                frow = 2 * n + 2 if wall == 0 else 2 * n + 4
+                Ynew[frow] -= sgn * ore
+                Ynew[frow + 1] -= sgn * oim
+                _end_state(tab, off, Ynew, Y, ws[_F], cs, ss, wall, n, s, par)
+                return RELEASED, t - d + h_k, steps + 1
+            # the contact lasts longer than predicted, or its end is not resolved: a regular step first
+        k = _ladder(min(R / 1.6, _MAX_STEP_PERIODS * h_ref), h_ref, False)
+        if k < 0 or t + 1.5 * R >= t_stop:
+            return FALLBACK, t, steps
+        kind = REGULAR
+    return FALLBACK, t, steps
+
+
+def workspace(s: int, n: int, order: int = SERIES_ORDER) -> tuple[np.ndarray, ...]:
+    """Scratch arrays of `contact` (ws, A, S, G, phase) and a fresh memo of first guesses."""
+    width = max(s + 1, 2 * n + 6, order)
+    u = Nodes(s, order).u
+    memo = np.empty((3, s))
+    memo[0] = 0.85  # onset: indentation / free indentation (Hertz: ~0.7 at the half contact)
+    memo[1] = 0.9
+    memo[2] = (1.0 - u) ** 2  # release: indentation / indentation at the start, linear in time to the end
+    return (np.zeros((_WS_ROWS, width)), np.zeros((s + 1, s + 1)), np.zeros((order, 2 * n + 2)),
+            np.zeros((order, s + 1)), np.zeros((2, s + 1)), memo)
+
+
+# ----------------------------------------------------------------------------------------------------------
+# tables per system
+# ----------------------------------------------------------------------------------------------------------
+class Tables:
+    """The ladder of tables of one system (filled on first use by `contact`), with the universal node data."""
+
+    def __init__(self, n: int):
+        self.nodes = Nodes()
+        self.off = _offsets(NODES, n)
+        self.tabs = np.zeros((2, 3, LADDER_SIZE, int(self.off[_SIZE])))
+        self.built = np.zeros((2, 3, LADDER_SIZE), dtype=np.bool_)
+
+
+#: Tables of the most recently used systems (a few MB each). They depend on the modes, the wall values and
+#: the sphere's mass only, so a whole sweep (and every point of a study with the same D) shares them.
+_CACHE: OrderedDict[bytes, Tables] = OrderedDict()
+_CACHE_SIZE = 4
+
+
+def tables_for(modes: np.ndarray, m_a: float) -> Tables:
+    """The `Tables` of the system with this modal table (rows of `sim.flight`) and sphere mass m_a (kg)."""
+    key = np.ascontiguousarray(modes[[_SIG, _WD, _W2, _PL, _PR]]).tobytes() + np.float64(m_a).tobytes()
+    tables = _CACHE.pop(key, None)
+    if tables is None:
+        tables = Tables(modes.shape[1])
+    _CACHE[key] = tables
+    while len(_CACHE) > _CACHE_SIZE:
+        _CACHE.popitem(last=False)
+    return tables
+
+
+def arguments(sys, modes: np.ndarray) -> tuple:
+    """The tuple `sim.exact._advance` passes on to `contact` for one run_step call (fresh first guesses)."""
+    tables = tables_for(modes, sys.m_a)
+    nodes = tables.nodes
+    n = modes.shape[1]
+    ws, A, S, G, phase, memo = workspace(NODES, n)
+    h_ref = 2.0 * math.pi / math.sqrt(float(np.max(modes[_W2])))
+    return (tables.tabs, tables.built, tables.off, nodes.u, nodes.b, nodes.xq, nodes.bq, nodes.onset, nodes.regular,
+            nodes.tail, h_ref, memo, ws, A, S, G, phase)
