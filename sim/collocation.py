@@ -24,7 +24,11 @@ of a period or a record instant, a failed Newton iteration) fall back to the Dor
 
 Accuracy: the force is interpolated by a polynomial of degree s - 1 in u, so a step has the order of
 its interpolation (about s + 1 for the modal response, 2 s for the force impulse, Gauss quadrature);
-with s = 10 a whole impact has a rebound error near 1e-9 (tests/sim/test_exact.py).
+with s = 10 a whole impact has a rebound error near 1e-10 (tests/sim/test_collocation.py).
+
+Development note: `sim.exact`'s compiled period loop embeds these kernels, and numba's cache only tracks
+each function's own file: after editing this module, delete sim/__pycache__/*.nb* (installs are not
+affected: a new version brings new files).
 """
 from __future__ import annotations
 
@@ -77,6 +81,7 @@ class Nodes:
         x, w = legendre.leggauss(s)
         self.u = 0.5 * (x + 1.0)
         self.b = 0.5 * w
+        self.wb = np.array([1.0 / np.prod(self.u[k] - np.delete(self.u, k)) for k in range(s)])
         xq, wq = legendre.leggauss(TABLE_QUADRATURE)
         self.xq = 0.5 * (xq + 1.0)
         self.bq = 0.5 * wq
@@ -123,13 +128,18 @@ def _map(kind, u):
 
 
 @njit(cache=True, inline="always")
-def _lagrange(u, v, k):
-    """l_k(v) on the nodes u."""
-    out = 1.0
-    for m in range(u.size):
-        if m != k:
-            out *= (v - u[m]) / (u[k] - u[m])
-    return out
+def _lagrange(u, wb, v, out):
+    """out[k] = l_k(v), the Lagrange basis on the nodes u (wb: 1 / prod_m!=k (u_k - u_m)), by prefix and
+    suffix products (no divisions)."""
+    s = u.size
+    acc = 1.0
+    for k in range(s):
+        out[k] = acc
+        acc *= v - u[k]
+    acc = 1.0
+    for k in range(s - 1, -1, -1):
+        out[k] *= acc * wb[k]
+        acc *= v - u[k]
 
 
 # table offsets: P, Q, W, BX, BV, BZ, BZD, TR, TAU, WQ, size
@@ -137,26 +147,27 @@ _P, _Q, _W, _BX, _BV, _BZ, _BZD, _TR, _TAU, _WQ, _SIZE = range(11)
 
 
 @njit(cache=True)
-def _build(tab, off, kind, h, wall, u, b, xq, bq, n, modes, par):
+def _build(tab, off, kind, h, wall, u, wb, b, xq, bq, n, modes, par):
     """Fill one table (layout of `_offsets`) for a step of length h with the time map `kind` at wall 0/1.
 
     P, Q: c_hom at node i (row s: the step's end) = sum_j P_ij x_j + Q_ij v_j + (harmonic and sphere terms).
     W: c_w at node i drops by sum_k W_ik F_k. BX, BV, BZ, BZD: end-state response to the nodal force F_k.
     TR: mode transitions over h. TAU: node times. WQ: quadrature weights of int F dt over the step.
+    The impulse responses are the transitions' entries: x(t) = b(t), x'(t) = d(t) per unit velocity.
     """
     s = u.size
-    r = s + 1
     sgn = 1.0 if wall == 0 else -1.0
     row = _PL if wall == 0 else _PR
-    ma = par[_MA]
+    inv_ma = 1.0 / par[_MA]
+    lag_k = np.empty(s)
     tab[:] = 0.0
-    for i in range(r):
+    for i in range(s + 1):
         ui = u[i] if i < s else 1.0
         wi, _ = _map(kind, ui)
         tau = h * wi
         tab[off[_TAU] + i] = tau
         for j in range(n):
-            a, bb, c, d = _transition(tau, modes[_SIG, j], modes[_WD, j], modes[_W2, j])
+            a, bb, c, d = _transition(tau, modes, j)
             tab[off[_P] + i * n + j] = sgn * modes[row, j] * a
             tab[off[_Q] + i * n + j] = sgn * modes[row, j] * bb
         # W[i, k] = int_0^ui K(tau - h w(v)) l_k(v) h w'(v) dv
@@ -164,28 +175,30 @@ def _build(tab, off, kind, h, wall, u, b, xq, bq, n, modes, par):
             v = ui * xq[q]
             wv, dv = _map(kind, v)
             lag = tau - h * wv
-            K = lag / ma
+            K = lag * inv_ma
             for j in range(n):
-                K += modes[row, j] ** 2 * math.exp(-modes[_SIG, j] * lag) * math.sin(modes[_WD, j] * lag) / modes[_WD, j]
+                K += modes[row, j] ** 2 * _transition(lag, modes, j)[1]
             weight = ui * bq[q] * K * h * dv
+            _lagrange(u, wb, v, lag_k)
             for k in range(s):
-                tab[off[_W] + i * s + k] += weight * _lagrange(u, v, k)
+                tab[off[_W] + i * s + k] += weight * lag_k[k]
     for q in range(xq.size):
         v = xq[q]
         wv, dv = _map(kind, v)
         lag = h - h * wv
+        _lagrange(u, wb, v, lag_k)
+        for j in range(n):
+            a, bb, c, d = _transition(lag, modes, j)
+            for k in range(s):
+                lw = bq[q] * lag_k[k] * h * dv
+                tab[off[_BX] + k * n + j] -= sgn * modes[row, j] * bb * lw
+                tab[off[_BV] + k * n + j] -= sgn * modes[row, j] * d * lw
         for k in range(s):
-            lw = bq[q] * _lagrange(u, v, k) * h * dv
-            tab[off[_BZ] + k] += sgn * lag * lw / ma
-            tab[off[_BZD] + k] += sgn * lw / ma
-            for j in range(n):
-                e = math.exp(-modes[_SIG, j] * lag)
-                si = math.sin(modes[_WD, j] * lag)
-                co = math.cos(modes[_WD, j] * lag)
-                tab[off[_BX] + k * n + j] -= sgn * modes[row, j] * e * si / modes[_WD, j] * lw
-                tab[off[_BV] + k * n + j] -= sgn * modes[row, j] * e * (co - modes[_SIG, j] / modes[_WD, j] * si) * lw
+            lw = bq[q] * lag_k[k] * h * dv
+            tab[off[_BZ] + k] += sgn * lag * lw * inv_ma
+            tab[off[_BZD] + k] += sgn * lw * inv_ma
     for j in range(n):
-        a, bb, c, d = _transition(h, modes[_SIG, j], modes[_WD, j], modes[_W2, j])
+        a, bb, c, d = _transition(h, modes, j)
         tab[off[_TR] + j] = a
         tab[off[_TR] + n + j] = bb
         tab[off[_TR] + 2 * n + j] = c
@@ -488,10 +501,10 @@ def _ladder_h(k, h_ref):
 
 
 @njit(cache=True)
-def _table(tabs, built, off, wall, kind, k, h_ref, u, b, xq, bq, n, modes, par):
+def _table(tabs, built, off, wall, kind, k, h_ref, u, wb, b, xq, bq, n, modes, par):
     """The table of (wall, kind, ladder index k), built on first use."""
     if not built[wall, kind, k]:
-        _build(tabs[wall, kind, k], off, kind, _ladder_h(k, h_ref), wall, u, b, xq, bq, n, modes, par)
+        _build(tabs[wall, kind, k], off, kind, _ladder_h(k, h_ref), wall, u, wb, b, xq, bq, n, modes, par)
         built[wall, kind, k] = True
     return tabs[wall, kind, k]
 
@@ -616,7 +629,7 @@ def _release_step(tab, off, S, G, phase, ct, st, d, d_lo, d_hi, c_e, cd_e, wall,
 
 
 @njit(cache=True)
-def contact(Y, t, t_stop, wall, tabs, built, off, u, b, xq, bq, M_onset, M_regular, tail, h_ref, n, modes, par,
+def contact(Y, t, t_stop, wall, tabs, built, off, u, wb, b, xq, bq, M_onset, M_regular, tail, h_ref, n, modes, par,
             memo, ws, A, S, G, phase):
     """Integrate the contact with `wall` (0 left, 1 right) from its located onset (t, Y) to its release.
 
@@ -647,7 +660,7 @@ def contact(Y, t, t_stop, wall, tabs, built, off, u, b, xq, bq, M_onset, M_regul
         # a step (onset or regular) from the last accepted state; it is repeated at half the length if it
         # failed (Newton, a release inside, unresolved force) or ended too close to the release (its force
         # is then not smooth in the step's time), at most _MAX_HALVINGS times in a contact
-        tab = _table(tabs, built, off, wall, kind, k, h_ref, u, b, xq, bq, n, modes, par)
+        tab = _table(tabs, built, off, wall, kind, k, h_ref, u, wb, b, xq, bq, n, modes, par)
         h = _ladder_h(k, h_ref)
         R = 0.0
         ok = _forward_step(tab, off, Y, ct, st, wall, n, s, par, ws, A, memo[kind], tail)
@@ -677,7 +690,7 @@ def contact(Y, t, t_stop, wall, tabs, built, off, u, b, xq, bq, M_onset, M_regul
                 k = _ladder(R + 0.1 * h, h_ref, True)
                 if k < 0:
                     return FALLBACK, t, steps
-                tab = _table(tabs, built, off, wall, RELEASE, k, h_ref, u, b, xq, bq, n, modes, par)
+                tab = _table(tabs, built, off, wall, RELEASE, k, h_ref, u, wb, b, xq, bq, n, modes, par)
                 h_k = _ladder_h(k, h_ref)
                 status, d = _release_step(tab, off, S, G, phase, ct, st, h_k - R, -0.3 * h, 0.6 * h, c_e, cd_e, wall,
                                           n, s, par, ws, A, memo[2])
@@ -709,15 +722,15 @@ def contact(Y, t, t_stop, wall, tabs, built, off, u, b, xq, bq, M_onset, M_regul
     return FALLBACK, t, steps
 
 
-def workspace(s: int, n: int, order: int = SERIES_ORDER) -> tuple[np.ndarray, ...]:
-    """Scratch arrays of `contact` (ws, A, S, G, phase) and a fresh memo of first guesses."""
-    width = max(s + 1, 2 * n + 6, order)
-    u = Nodes(s, order).u
+def workspace(nodes: Nodes, n: int) -> tuple[np.ndarray, ...]:
+    """Scratch arrays of `contact` (ws, A, S, G, phase) for n modes, and a fresh memo of first guesses."""
+    s = nodes.u.size
+    order = nodes.onset.shape[0]
     memo = np.empty((3, s))
     memo[0] = 0.85  # onset: indentation / free indentation (Hertz: ~0.7 at the half contact)
     memo[1] = 0.9
-    memo[2] = (1.0 - u) ** 2  # release: indentation / indentation at the start, linear in time to the end
-    return (np.zeros((_WS_ROWS, width)), np.zeros((s + 1, s + 1)), np.zeros((order, 2 * n + 2)),
+    memo[2] = (1.0 - nodes.u) ** 2  # release: indentation / indentation at the start, linear in time to the end
+    return (np.zeros((_WS_ROWS, max(s + 1, 2 * n + 6, order))), np.zeros((s + 1, s + 1)), np.zeros((order, 2 * n + 2)),
             np.zeros((order, s + 1)), np.zeros((2, s + 1)), memo)
 
 
@@ -757,7 +770,7 @@ def arguments(sys, modes: np.ndarray) -> tuple:
     tables = tables_for(modes, sys.m_a)
     nodes = tables.nodes
     n = modes.shape[1]
-    ws, A, S, G, phase, memo = workspace(NODES, n)
+    ws, A, S, G, phase, memo = workspace(nodes, n)
     h_ref = 2.0 * math.pi / math.sqrt(float(np.max(modes[_W2])))
-    return (tables.tabs, tables.built, tables.off, nodes.u, nodes.b, nodes.xq, nodes.bq, nodes.onset, nodes.regular,
+    return (tables.tabs, tables.built, tables.off, nodes.u, nodes.wb, nodes.b, nodes.xq, nodes.bq, nodes.onset, nodes.regular,
             nodes.tail, h_ref, memo, ws, A, S, G, phase)

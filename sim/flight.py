@@ -7,8 +7,8 @@ import math
 from numba import njit
 
 # rows of the per-mode constant table
-_SIG, _WD, _W2, _PL, _PR, _RHR, _RHI, _APL, _APR, _SRE, _SIM, _SCX, _SCV = range(13)
-_N_ROWS = 13
+_SIG, _WD, _W2, _PL, _PR, _RHR, _RHI, _APL, _APR, _SRE, _SIM, _SCX, _SCV, _SOW, _IWD, _W2OW = range(16)
+_N_ROWS = 16
 # entries of the scalar parameter vector
 (_OM, _ABASE, _MA, _KH, _G, _WLR, _WLI, _WRR, _WRI, _PRE, _PIM, _TOL, _VMIN, _HG, _ML0, _MR0, _SCZ, _SCZD,
  _HMAX) = range(19)
@@ -19,19 +19,20 @@ _N_PAR = 19
 # free flight in closed form
 # ----------------------------------------------------------------------------------------------------------
 @njit(cache=True, inline="always")
-def _transition(tau, sig, wd, w2):
-    """Damped-oscillator transition over tau: (x, v)(tau) = [[a, b], [c, d]] (x0, v0)."""
-    e = math.exp(-sig * tau)
-    co = math.cos(wd * tau)
-    si = math.sin(wd * tau)
-    return e * (co + sig / wd * si), e * si / wd, -e * w2 / wd * si, e * (co - sig / wd * si)
+def _transition(tau, modes, j):
+    """Transition of the damped oscillator j over tau: (x, v)(tau) = [[a, b], [c, d]] (x0, v0)."""
+    e = math.exp(-modes[_SIG, j] * tau)
+    co = math.cos(modes[_WD, j] * tau)
+    si = math.sin(modes[_WD, j] * tau)
+    q = modes[_SOW, j] * si  # sigma / omega_d sin: the rows hold the ratios (no divisions here)
+    return e * (co + q), e * si * modes[_IWD, j], -e * modes[_W2OW, j] * si, e * (co - q)
 
 
 @njit(cache=True)
 def _flight_transitions(tau, modes, tr):
     """tr[:, j] = transition (a, b, c, d) of mode j over a free flight of length tau."""
     for j in range(modes.shape[1]):
-        tr[0, j], tr[1, j], tr[2, j], tr[3, j] = _transition(tau, modes[_SIG, j], modes[_WD, j], modes[_W2, j])
+        tr[0, j], tr[1, j], tr[2, j], tr[3, j] = _transition(tau, modes, j)
 
 
 @njit(cache=True)
@@ -74,16 +75,21 @@ def _closing_at(Y, ct, st, n, modes, par):
     return sl - z - g, sld - zd, -(sr - z) - g, -(srd - zd)
 
 
+# 1 / (k (k + 1)) for the nested Taylor series of `_rotate` (multiplications: a chain of divisions is slow)
+_C12, _C34, _C56, _C78, _C910, _C1112 = 1 / 2, 1 / 12, 1 / 30, 1 / 56, 1 / 90, 1 / 132
+_S23, _S45, _S67, _S89, _S1011, _S1213 = 1 / 6, 1 / 20, 1 / 42, 1 / 72, 1 / 110, 1 / 156
+
+
 @njit(cache=True, inline="always")
 def _rotate(ct, st, angle):
     """cos, sin(theta + angle) from cos, sin(theta); Taylor series (to 1e-20) for the small angles of contacts."""
     if abs(angle) < 0.2:
         a2 = angle * angle
-        ca = 1.0 - a2 / 2.0 * (1.0 - a2 / 12.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0 * (1.0 - a2 / 90.0 * (1.0 - a2 / 132.0)))))
-        sa = angle * (1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0 * (1.0 - a2 / 72.0 * (1.0 - a2 / 110.0 * (1.0 - a2 / 156.0))))))
+        ca = 1.0 - a2 * _C12 * (1.0 - a2 * _C34 * (1.0 - a2 * _C56 * (1.0 - a2 * _C78 * (1.0 - a2 * _C910
+                                                                                            * (1.0 - a2 * _C1112)))))
+        sa = angle * (1.0 - a2 * _S23 * (1.0 - a2 * _S45 * (1.0 - a2 * _S67 * (1.0 - a2 * _S89 * (1.0 - a2 * _S1011
+                                                                                                * (1.0 - a2 * _S1213))))))
     else:
         ca = math.cos(angle)
         sa = math.sin(angle)
     return ct * ca - st * sa, st * ca + ct * sa
-
-

@@ -30,7 +30,7 @@ def _table(modes, par, kind, h, wall=0, nodes=None, quadrature=C.TABLE_QUADRATUR
     xq, bq = np.polynomial.legendre.leggauss(quadrature)
     off = C._offsets(nodes.u.size, N9)
     tab = np.zeros(off[C._SIZE])
-    C._build(tab, off, kind, h, wall, nodes.u, nodes.b, 0.5 * (xq + 1), 0.5 * bq, N9, modes, par)
+    C._build(tab, off, kind, h, wall, nodes.u, nodes.wb, nodes.b, 0.5 * (xq + 1), 0.5 * bq, N9, modes, par)
     return tab, off
 
 
@@ -77,7 +77,9 @@ def test_backward_series_is_the_step_solution(beam, kind, M):
         # shorter step reaches w = fraction at u' = fraction (regular) or sqrt(fraction) (onset)
         scale = fraction if kind == C.REGULAR else math.sqrt(fraction)
         part, _ = _table(modes, par, kind, fraction * h)
-        lag = np.array([[C._lagrange(nodes.u, scale * v, k) for k in range(nodes.u.size)] for v in nodes.u])
+        lag = np.empty((nodes.u.size, nodes.u.size))
+        for row, v in zip(lag, nodes.u):
+            C._lagrange(nodes.u, nodes.wb, scale * v, row)
         Ypart = np.empty_like(Y)
         C._end_state(part, off, Y, Ypart, lag @ F, 1.0, 0.0, 0, N9, nodes.u.size, par)
         Yb, Yd = np.empty(2 * N9 + 2), np.empty(2 * N9 + 2)
@@ -101,7 +103,7 @@ def test_observed_order_of_a_collocation_step(beam):
     y_ref, onsets, releases, _ = reference_run(y0, span, OMEGA, 0.0, sys)
     assert releases.size == 0
     steps, errors = [], []
-    ws, A, *_ = C.workspace(4, N9)
+    ws, A, *_ = C.workspace(nodes, N9)
     for n_steps in (2, 3, 4, 6):
         h = span / n_steps
         tab, off = _table(modes, par, C.REGULAR, h, nodes=nodes)
