@@ -39,7 +39,7 @@ import numpy as np
 from numba import njit
 from numpy.polynomial import legendre, polynomial
 
-from sim.flight import (_G, _KH, _MA, _OM, _PL, _PR, _SIG, _W2, _WD, _WLI, _WLR, _WRI, _WRR, _closing_at, _rotate,
+from sim.flight import (_G, _IMA, _KH, _MA, _OM, _PL, _PR, _SIG, _W2, _WD, _WLI, _WLR, _WRI, _WRR, _closing_at, _rotate,
                         _transition)
 
 #: Gauss nodes per collocation step.
@@ -158,7 +158,7 @@ def _build(tab, off, kind, h, wall, u, wb, b, xq, bq, n, modes, par):
     s = u.size
     sgn = 1.0 if wall == 0 else -1.0
     row = _PL if wall == 0 else _PR
-    inv_ma = 1.0 / par[_MA]
+    inv_ma = par[_IMA]
     lag_k = np.empty(s)
     tab[:] = 0.0
     for i in range(s + 1):
@@ -366,21 +366,23 @@ def _series(Yend, F, M, h, wall, n, modes, par, S, Fs):
     sgn = 1.0 if wall == 0 else -1.0
     row = _PL if wall == 0 else _PR
     scale = 1.0
+    inv_h = 1.0 / h
     for q in range(p):
         acc = 0.0
         for k in range(s):
             acc += M[q, k] * F[k]
         Fs[q] = acc * scale
-        scale /= h
+        scale *= inv_h
     for i in range(2 * n + 2):
         S[0, i] = Yend[i]
     for q in range(p - 1):
+        inv = 1.0 / (q + 1)
         for j in range(n):
-            S[q + 1, j] = -S[q, n + j] / (q + 1)
+            S[q + 1, j] = -S[q, n + j] * inv
             S[q + 1, n + j] = (2.0 * modes[_SIG, j] * S[q, n + j] + modes[_W2, j] * S[q, j]
-                               + sgn * modes[row, j] * Fs[q]) / (q + 1)
-        S[q + 1, 2 * n] = -S[q, 2 * n + 1] / (q + 1)
-        S[q + 1, 2 * n + 1] = -sgn * Fs[q] / par[_MA] / (q + 1)
+                               + sgn * modes[row, j] * Fs[q]) * inv
+        S[q + 1, 2 * n] = -S[q, 2 * n + 1] * inv
+        S[q + 1, 2 * n + 1] = -sgn * Fs[q] * par[_IMA] * inv
 
 
 @njit(cache=True)
@@ -629,15 +631,15 @@ def _release_step(tab, off, S, G, phase, ct, st, d, d_lo, d_hi, c_e, cd_e, wall,
 
 
 @njit(cache=True)
-def contact(Y, t, t_stop, wall, tabs, built, off, u, wb, b, xq, bq, M_onset, M_regular, tail, h_ref, n, modes, par,
-            memo, ws, A, S, G, phase):
+def contact(Y, t, t_stop, wall, n, modes, par, colloc):
     """Integrate the contact with `wall` (0 left, 1 right) from its located onset (t, Y) to its release.
 
     Returns (outcome, t, steps): RELEASED with Y the state at the release time t, or FALLBACK with Y the
     valid state at t (the onset itself if steps == 0) from where the Dormand-Prince contact goes on.
-    memo[0 / 1 / 2, :s]: indentations of the last onset / regular / release step over their first guess.
-    ws, A, S, G, phase: workspace (`workspace`).
+    colloc: the tuple of `arguments` (tables, node data, first guesses and workspace); in it memo[0 / 1 / 2]
+    holds the indentations of the last onset / regular / release step over their first guess.
     """
+    tabs, built, off, u, wb, b, xq, bq, M_onset, M_regular, tail, h_ref, memo, ws, A, S, G, phase = colloc
     s = u.size
     m = 2 * n + 2
     Om = par[_OM]
@@ -771,6 +773,6 @@ def arguments(sys, modes: np.ndarray) -> tuple:
     nodes = tables.nodes
     n = modes.shape[1]
     ws, A, S, G, phase, memo = workspace(nodes, n)
-    h_ref = 2.0 * math.pi / math.sqrt(float(np.max(modes[_W2])))
-    return (tables.tabs, tables.built, tables.off, nodes.u, nodes.wb, nodes.b, nodes.xq, nodes.bq, nodes.onset, nodes.regular,
-            nodes.tail, h_ref, memo, ws, A, S, G, phase)
+    h_ref = 2.0 * math.pi / math.sqrt(float(np.max(modes[_W2])))  # period of the highest mode
+    return (tables.tabs, tables.built, tables.off, nodes.u, nodes.wb, nodes.b, nodes.xq, nodes.bq, nodes.onset,
+            nodes.regular, nodes.tail, h_ref, memo, ws, A, S, G, phase)

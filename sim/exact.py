@@ -57,10 +57,10 @@ from numba import njit
 
 from sim import collocation
 from sim.errors import SimulationDiverged, SimulationInputError
-from sim.flight import (_ABASE, _APL, _APR, _G, _HG, _HMAX, _IWD, _KH, _MA, _ML0, _MR0, _N_PAR, _N_ROWS, _OM, _PIM,
-                        _PL, _PR, _PRE, _RHI, _RHR, _SCV, _SCX, _SCZ, _SCZD, _SIG, _SIM, _SOW, _SRE, _TOL, _VMIN, _W2,
-                        _W2OW, _WD, _WLI, _WLR, _WRI, _WRR, _apply_flight, _closing, _closing_at, _flight_transitions,
-                        _rotate, _transition)
+from sim.flight import (_ABASE, _APL, _APR, _G, _HG, _HMAX, _IMA, _IWD, _KH, _MA, _ML0, _MR0, _N_PAR, _N_ROWS,
+                        _OM, _PIM, _PL, _PR, _PRE, _RHI, _RHR, _SCV, _SCX, _SCZ, _SCZD, _SIG, _SIM, _SOW, _SRE, _TOL,
+                        _VMIN, _W2, _W2OW, _WD, _WLI, _WLR, _WRI, _WRR, _apply_flight, _closing, _closing_at,
+                        _flight_transitions, _rotate, _transition)
 from sim.system import SystemArrays, check_run_step
 
 #: Free-flight grid steps per excitation period (certification cells; no effect on accuracy).
@@ -110,7 +110,7 @@ def _curvature_bounds(Y, n, modes, par):
     Mr = par[_MR0]
     for j in range(n):
         x = Y[j]
-        q = (Y[n + j] + modes[_SIG, j] * x) / modes[_WD, j]
+        q = (Y[n + j] + modes[_SIG, j] * x) * modes[_IWD, j]
         A = math.sqrt(x * x + q * q) * modes[_W2, j]
         Ml += modes[_APL, j] * A
         Mr += modes[_APR, j] * A
@@ -184,7 +184,7 @@ def _rhs(ct, st, Y, out, n, modes, par):
         out[j] = v
         out[n + j] = -2.0 * modes[_SIG, j] * v - modes[_W2, j] * Y[j] - modes[_PL, j] * fl - modes[_PR, j] * fr
     out[2 * n] = Y[2 * n + 1]
-    out[2 * n + 1] = (fl + fr) / par[_MA]
+    out[2 * n + 1] = (fl + fr) * par[_IMA]
     out[2 * n + 2] = fl * ct
     out[2 * n + 3] = -fl * st
     out[2 * n + 4] = fr * ct
@@ -527,10 +527,7 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
                 status = _OK
                 extra = 0
                 if at_onset and use_collocation:
-                    tabs, built, off, u, wb, b, xq, bq, M_onset, M_regular, tail, h_ref, memo_c, ws, Aw, S, G, phase = colloc
-                    outcome, t_new, steps = collocation.contact(Y, t, t_stop, onset_wall, tabs, built, off, u, wb, b,
-                                                                xq, bq, M_onset, M_regular, tail, h_ref, n, modes, par,
-                                                                memo_c, ws, Aw, S, G, phase)
+                    outcome, t_new, steps = collocation.contact(Y, t, t_stop, onset_wall, n, modes, par, colloc)
                     counters[_C_COLLOC] += steps
                     released = outcome == collocation.RELEASED
                     t = t_new
@@ -573,15 +570,15 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
                 if not A_valid:
                     for j in range(n):
                         x = Y[j]
-                        q = (Y[n + j] + modes[_SIG, j] * x) / modes[_WD, j]
+                        q = (Y[n + j] + modes[_SIG, j] * x) * modes[_IWD, j]
                         A[j] = math.sqrt(x * x + q * q)
                     A_valid = True
                 counters[_C_GRID] += 1
                 _apply_flight(Y, Ynew, hg, tr_g, n)
                 c0l, c0ld, c0r, c0rd = _closing_at(Y, rot_g[0, k], rot_g[1, k], n, modes, par)
                 c1l, c1ld, c1r, c1rd = _closing_at(Ynew, rot_g[0, k + 1], rot_g[1, k + 1], n, modes, par)
-                Bl = par[_ML0] * hg * hg / 8.0
-                Br = par[_MR0] * hg * hg / 8.0
+                Bl = par[_ML0] * hg * hg * 0.125
+                Br = par[_MR0] * hg * hg * 0.125
                 Ml = par[_ML0]
                 Mr = par[_MR0]
                 for j in range(n):
@@ -687,6 +684,7 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
     modes[_SOW], modes[_IWD], modes[_W2OW] = sig / wd, 1.0 / wd, omega**2 / wd
     par = np.zeros(_N_PAR)
     par[_OM], par[_ABASE], par[_MA], par[_KH], par[_G] = Omega, a_base, sys.m_a, sys.k_H, sys.g
+    par[_IMA] = 1.0 / sys.m_a
     par[_WLR], par[_WLI], par[_WRR], par[_WRI] = Wl.real, Wl.imag, Wr.real, Wr.imag
     par[_PRE], par[_PIM] = P.real, P.imag
     par[_TOL] = GAP_TOLERANCE * sys.g

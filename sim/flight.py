@@ -11,8 +11,8 @@ _SIG, _WD, _W2, _PL, _PR, _RHR, _RHI, _APL, _APR, _SRE, _SIM, _SCX, _SCV, _SOW, 
 _N_ROWS = 16
 # entries of the scalar parameter vector
 (_OM, _ABASE, _MA, _KH, _G, _WLR, _WLI, _WRR, _WRI, _PRE, _PIM, _TOL, _VMIN, _HG, _ML0, _MR0, _SCZ, _SCZD,
- _HMAX) = range(19)
-_N_PAR = 19
+ _HMAX, _IMA) = range(20)
+_N_PAR = 20
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -85,10 +85,10 @@ def _rotate(ct, st, angle):
     """cos, sin(theta + angle) from cos, sin(theta); Taylor series (to 1e-20) for the small angles of contacts."""
     if abs(angle) < 0.2:
         a2 = angle * angle
-        ca = 1.0 - a2 * _C12 * (1.0 - a2 * _C34 * (1.0 - a2 * _C56 * (1.0 - a2 * _C78 * (1.0 - a2 * _C910
-                                                                                            * (1.0 - a2 * _C1112)))))
-        sa = angle * (1.0 - a2 * _S23 * (1.0 - a2 * _S45 * (1.0 - a2 * _S67 * (1.0 - a2 * _S89 * (1.0 - a2 * _S1011
-                                                                                                * (1.0 - a2 * _S1213))))))
+        ca = 1.0 - a2 * _C12 * (1.0 - a2 * _C34 * (1.0 - a2 * _C56 * (1.0 - a2 * _C78 * (
+            1.0 - a2 * _C910 * (1.0 - a2 * _C1112)))))
+        sa = angle * (1.0 - a2 * _S23 * (1.0 - a2 * _S45 * (1.0 - a2 * _S67 * (1.0 - a2 * _S89 * (
+            1.0 - a2 * _S1011 * (1.0 - a2 * _S1213))))))
     else:
         ca = math.cos(angle)
         sa = math.sin(angle)
