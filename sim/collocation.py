@@ -8,7 +8,7 @@ the closing function exactly as (Duhamel)
     K_w(t) = sum_j phi_w,j^2 exp(-sigma_j t) sin(omega_dj t) / omega_dj + t / m_a,
 
 c_hom being the free flight from Y_a (closed form, `sim.exact`). F is represented by its values at s Gauss
-nodes of a time map t = t_a + h w(u), u in [0, 1] (the maps of `sim.exact._warp`: u^2 at an onset,
+nodes of a time map t = t_a + h w(u), u in [0, 1] (`sim.flight._time_map`: u^2 at an onset,
 u (2 - u) before a release, so that F ~ (time to the end)^1.5 becomes a smooth function of u), and the
 s nodal equations F_i = k_H c_w(t_i)^1.5 are solved by Newton's method. Everything linear is exact:
 the s x s weights of the convolution, the modal and sphere responses to each nodal force, and the
@@ -39,8 +39,8 @@ import numpy as np
 from numba import njit
 from numpy.polynomial import legendre, polynomial
 
-from sim.flight import (_G, _IMA, _KH, _MA, _OM, _PL, _PR, _SIG, _W2, _WD, _WLI, _WLR, _WRI, _WRR, _closing_at, _rotate,
-                        _transition)
+from sim.flight import (ONSET, REGULAR, RELEASE, _G, _IMA, _KH, _MA, _OM, _PL, _PR, _SIG, _W2, _WD, _WLI, _WLR, _WRI,
+                        _WRR, _closing_at, _rotate, _time_map, _transition)
 
 #: Gauss nodes per collocation step.
 NODES = 10
@@ -57,9 +57,6 @@ LADDER_CENTRE = 48
 _NEWTON_TOL = 1e-6
 #: Gauss-Legendre points of the quadratures that build the tables.
 TABLE_QUADRATURE = 32
-
-# time maps (as in sim.exact._warp)
-ONSET, REGULAR, RELEASE = 0, 1, 2
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -118,16 +115,6 @@ class Nodes:
 
 
 @njit(cache=True, inline="always")
-def _map(kind, u):
-    """(w(u), w'(u)) of the step's time map t = t_a + h w(u)."""
-    if kind == ONSET:
-        return u * u, 2.0 * u
-    if kind == RELEASE:
-        return u * (2.0 - u), 2.0 * (1.0 - u)
-    return u, 1.0
-
-
-@njit(cache=True, inline="always")
 def _lagrange(u, wb, v, out):
     """out[k] = l_k(v), the Lagrange basis on the nodes u (wb: 1 / prod_m!=k (u_k - u_m)), by prefix and
     suffix products (no divisions)."""
@@ -163,7 +150,7 @@ def _build(tab, off, kind, h, wall, u, wb, b, xq, bq, n, modes, par):
     tab[:] = 0.0
     for i in range(s + 1):
         ui = u[i] if i < s else 1.0
-        wi, _ = _map(kind, ui)
+        wi, _ = _time_map(kind, ui)
         tau = h * wi
         tab[off[_TAU] + i] = tau
         for j in range(n):
@@ -173,7 +160,7 @@ def _build(tab, off, kind, h, wall, u, wb, b, xq, bq, n, modes, par):
         # W[i, k] = int_0^ui K(tau - h w(v)) l_k(v) h w'(v) dv
         for q in range(xq.size):
             v = ui * xq[q]
-            wv, dv = _map(kind, v)
+            wv, dv = _time_map(kind, v)
             lag = tau - h * wv
             K = lag * inv_ma
             for j in range(n):
@@ -184,7 +171,7 @@ def _build(tab, off, kind, h, wall, u, wb, b, xq, bq, n, modes, par):
                 tab[off[_W] + i * s + k] += weight * lag_k[k]
     for q in range(xq.size):
         v = xq[q]
-        wv, dv = _map(kind, v)
+        wv, dv = _time_map(kind, v)
         lag = h - h * wv
         _lagrange(u, wb, v, lag_k)
         for j in range(n):
@@ -204,7 +191,7 @@ def _build(tab, off, kind, h, wall, u, wb, b, xq, bq, n, modes, par):
         tab[off[_TR] + 2 * n + j] = c
         tab[off[_TR] + 3 * n + j] = d
     for k in range(s):
-        _, dk = _map(kind, u[k])
+        _, dk = _time_map(kind, u[k])
         tab[off[_WQ] + k] = b[k] * h * dk
 
 
@@ -247,28 +234,19 @@ def _solve_in_place(A, x, m):
 
 
 @njit(cache=True)
-def _free_closing(tab, off, Y, ct, st, wall, n, s, par, out, Yd, dout):
-    """out[i] = c_w at node i (i = s: the step's end) of the free flight from Y at phase (ct, st).
-
-    With Yd (dY/dt at the step's start, size > 0) also dout[i] = d out[i] / d t_start."""
+def _free_closing(tab, off, Y, ct, st, wall, n, s, par, out):
+    """out[i] = c_w at node i (i = s: the step's end) of the free flight from Y at phase (ct, st)."""
     sgn = 1.0 if wall == 0 else -1.0
     Wr = par[_WLR] if wall == 0 else par[_WRR]
     Wi = par[_WLI] if wall == 0 else par[_WRI]
     Om = par[_OM]
-    g = par[_G]
-    deriv = Yd.size > 0
     for i in range(s + 1):
         tau = tab[off[_TAU] + i]
         acc = 0.0
-        dacc = 0.0
         for j in range(n):
             acc += tab[off[_P] + i * n + j] * Y[j] + tab[off[_Q] + i * n + j] * Y[n + j]
-            if deriv:
-                dacc += tab[off[_P] + i * n + j] * Yd[j] + tab[off[_Q] + i * n + j] * Yd[n + j]
         c, si = _rotate(ct, st, Om * tau)
-        out[i] = acc + sgn * (Wr * c - Wi * si - Y[2 * n] - tau * Y[2 * n + 1]) - g
-        if deriv:
-            dout[i] = dacc + sgn * (-Om * (Wr * si + Wi * c) - Yd[2 * n] - tau * Yd[2 * n + 1])
+        out[i] = acc + sgn * (Wr * c - Wi * si - Y[2 * n] - tau * Y[2 * n + 1]) - par[_G]
 
 
 @njit(cache=True, inline="always")
@@ -385,19 +363,24 @@ def _series(Yend, F, M, h, wall, n, modes, par, S, Fs):
         S[q + 1, 2 * n + 1] = -sgn * Fs[q] * par[_IMA] * inv
 
 
+@njit(cache=True, inline="always")
+def _horner(C, col, x):
+    """(sum_q C[q, col] x^q, its derivative in x)."""
+    p = C.shape[0]
+    val = C[p - 1, col]
+    slope = (p - 1) * C[p - 1, col]
+    for q in range(p - 2, -1, -1):
+        val = val * x + C[q, col]
+        if q > 0:
+            slope = slope * x + q * C[q, col]
+    return val, slope
+
+
 @njit(cache=True)
-def _series_at(S, sigma, Y, Yd, m):
-    """Y = state at t_e - sigma, Yd = its time derivative (first m components)."""
-    p = S.shape[0]
+def _series_at(S, sigma, Y, m):
+    """Y[:m] = the state at t_e - sigma from the series S of `_series`."""
     for i in range(m):
-        acc = S[p - 1, i]
-        dacc = (p - 1) * S[p - 1, i]
-        for q in range(p - 2, -1, -1):
-            acc = acc * sigma + S[q, i]
-            if q > 0:
-                dacc = dacc * sigma + q * S[q, i]
-        Y[i] = acc
-        Yd[i] = -dacc
+        Y[i] = _horner(S, i, sigma)[0]
 
 
 @njit(cache=True)
@@ -459,8 +442,8 @@ _MAX_STEP_PERIODS = 1.0
 # outcome of `contact`
 RELEASED, FALLBACK = 0, 1
 # rows of the workspace `ws`
-_CHOM, _DCHOM, _DELTA, _F, _D, _RHS, _YNEW, _YS, _YD, _FS = range(10)
-_WS_ROWS = 10
+_CHOM, _DCHOM, _DELTA, _F, _D, _RHS, _YNEW, _YS, _FS = range(9)
+_WS_ROWS = 9
 # 6-point Gauss-Legendre on [0, 1] for `_time_to_release`
 _GL6_X = np.array([0.033765242898423975, 0.16939530676686776, 0.3806904069584015, 0.6193095930415985,
                    0.8306046932331322, 0.966234757101576])
@@ -541,7 +524,7 @@ def _forward_step(tab, off, Y, ct, st, wall, n, s, par, ws, A, ratio, tail):
     the force is not resolved."""
     chom = ws[_CHOM]
     delta = ws[_DELTA]
-    _free_closing(tab, off, Y, ct, st, wall, n, s, par, chom, ws[_FS, :0], ws[_DCHOM])
+    _free_closing(tab, off, Y, ct, st, wall, n, s, par, chom)
     for i in range(s):
         delta[i] = ratio[i] * chom[i]
     if _newton(tab, off, chom, delta, ws[_F], ws[_D], A, ws[_RHS], s, par[_KH]) < 0:
@@ -569,7 +552,6 @@ def _release_step(tab, off, S, G, phase, ct, st, d, d_lo, d_hi, c_e, cd_e, wall,
     rhs = ws[_RHS]
     Om = par[_OM]
     kH = par[_KH]
-    p = S.shape[0]
     sgn = 1.0 if wall == 0 else -1.0
     Wr = par[_WLR] if wall == 0 else par[_WRR]
     Wi = par[_WLI] if wall == 0 else par[_WRI]
@@ -583,31 +565,29 @@ def _release_step(tab, off, S, G, phase, ct, st, d, d_lo, d_hi, c_e, cd_e, wall,
         # c_hom at the nodes and its derivative in the start time, from the series in d
         cb, sb = _rotate(ct, st, -Om * d)
         for i in range(s + 1):
-            val = G[p - 1, i]
-            dval = (p - 1) * G[p - 1, i]
-            for q in range(p - 2, -1, -1):
-                val = val * d + G[q, i]
-                if q > 0:
-                    dval = dval * d + q * G[q, i]
+            val, dval = _horner(G, i, d)
             c = cb * phase[0, i] - sb * phase[1, i]
             si = sb * phase[0, i] + cb * phase[1, i]
             chom[i] = val + sgn * (Wr * c - Wi * si) - par[_G]
             dchom[i] = -dval - sgn * Om * (Wr * si + Wi * c)
         _forces(delta, F, D, kH, s)
-        # residuals delta_i - c_hom,i + sum_k W_ik F_k at the nodes and c_w at the end; d/dd = -d/dt_start
-        scale = 0.0
-        for i in range(s + 1):
-            last = i == s
-            acc = chom[i] if last else delta[i] - chom[i]
+        # residuals delta_i - c_hom,i + sum_k W_ik F_k at the nodes, then c_w at the end; d/dd = -d/dt_start
+        scale = abs(chom[s])
+        for i in range(s):
+            acc = delta[i] - chom[i]
             for k in range(s):
-                wik = tab[oW + i * s + k]
-                acc += -wik * F[k] if last else wik * F[k]
-                A[i, k] = -wik * D[k] if last else wik * D[k]
-            if not last:
-                A[i, i] += 1.0
-            A[i, s] = -dchom[i] if last else dchom[i]
+                acc += tab[oW + i * s + k] * F[k]
+                A[i, k] = tab[oW + i * s + k] * D[k]
+            A[i, i] += 1.0
+            A[i, s] = dchom[i]
             rhs[i] = acc
             scale = max(scale, abs(chom[i]))
+        acc = chom[s]
+        for k in range(s):
+            acc -= tab[oW + s * s + k] * F[k]
+            A[s, k] = -tab[oW + s * s + k] * D[k]
+        A[s, s] = -dchom[s]
+        rhs[s] = acc
         if not _solve_in_place(A, rhs, s + 1):
             return 1, d
         change = abs(rhs[s] * cd_e)
@@ -706,7 +686,7 @@ def contact(Y, t, t_stop, wall, n, modes, par, colloc):
                     return FALLBACK, t, steps
                 # the state at the release step's start: the series, without the overlap's share of F_w
                 Ys = ws[_YS]
-                _series_at(S, d, Ys, ws[_YD], m)
+                _series_at(S, d, Ys, m)
                 cs, ss = _rotate(ct, st, -Om * d)
                 ore, oim = _overlap_fourier(Fs, d, ct, st, Om)
                 Ynew[:m] = Ys[:m]

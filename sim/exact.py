@@ -57,10 +57,10 @@ from numba import njit
 
 from sim import collocation
 from sim.errors import SimulationDiverged, SimulationInputError
-from sim.flight import (_ABASE, _APL, _APR, _G, _HG, _HMAX, _IMA, _IWD, _KH, _MA, _ML0, _MR0, _N_PAR, _N_ROWS,
-                        _OM, _PIM, _PL, _PR, _PRE, _RHI, _RHR, _SCV, _SCX, _SCZ, _SCZD, _SIG, _SIM, _SOW, _SRE, _TOL,
-                        _VMIN, _W2, _W2OW, _WD, _WLI, _WLR, _WRI, _WRR, _apply_flight, _closing, _closing_at,
-                        _flight_transitions, _rotate, _transition)
+from sim.flight import (GRAZE, ONSET, REGULAR, RELEASE, _ABASE, _APL, _APR, _G, _HG, _HMAX, _IMA, _IWD, _KH, _MA,
+                        _ML0, _MR0, _N_PAR, _N_ROWS, _OM, _PIM, _PL, _PR, _PRE, _RHI, _RHR, _SCV, _SCX, _SCZ, _SCZD,
+                        _SIG, _SIM, _SOW, _SRE, _TOL, _VMIN, _W2, _W2OW, _WD, _WLI, _WLR, _WRI, _WRR, _apply_flight,
+                        _closing, _closing_at, _flight_transitions, _rotate, _time_map, _transition)
 from sim.system import SystemArrays, check_run_step
 
 #: Free-flight grid steps per excitation period (certification cells; no effect on accuracy).
@@ -161,8 +161,6 @@ def _search(Y, t0, tau_end, n, modes, par, scratch, counters):
 # turns one ulp into a different trajectory; with a cold numba cache serial and parallel runs then differed
 # (tests/sim/test_batch.py failed 3 times out of 3 on a fresh checkout), breaking issue 6's bit-identity.
 _FAST = False
-# kinds of Dormand-Prince step: t = t_a + phi(u), u in [0, 1] (see `_dp_step`)
-_REGULAR, _ONSET, _RELEASE, _GRAZE = 0, 1, 2, 3
 
 
 @njit(cache=True, inline="always", fastmath=_FAST)
@@ -193,19 +191,10 @@ def _rhs(ct, st, Y, out, n, modes, par):
 
 @njit(cache=True, inline="always")
 def _warp(kind, u, s):
-    """(phi(u), phi'(u)) of the step's time map t = t_a + phi(u), u in [0, 1], phi(1) = s.
-
-    At a contact onset (release) the Hertz force behaves like (t - t_on)^1.5 ((t_rel - t)^1.5) and a
-    step in t loses its order (local error O(h^2.5)); with t - t_on = s u^2 (t_rel - t = s (1 - u)^2) the
-    force is a smooth function of u and the step keeps its 5th order. _GRAZE handles both ends at once.
-    """
-    if kind == _REGULAR:
-        return s * u, s
-    if kind == _ONSET:
-        return s * u * u, 2.0 * s * u
-    if kind == _RELEASE:
-        return s * u * (2.0 - u), 2.0 * s * (1.0 - u)
-    return s * u * u * (3.0 - 2.0 * u), 6.0 * s * u * (1.0 - u)
+    """(phi(u), phi'(u)) of a step of length s with the time map `kind` of `sim.flight._time_map`: with it
+    an onset or release step keeps its 5th order (in t the local error is O(h^2.5) there)."""
+    w, dw = _time_map(kind, u)
+    return s * w, s * dw
 
 
 @njit(cache=True, fastmath=_FAST)
@@ -373,7 +362,7 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
             v_rel = max(abs(cd_act + cdd * tau), 1e-6)
             s_rel = (0.5 / (memo[1] * v_rel**1.5)) ** 0.4 if memo[1] > 0.0 else step
             if tau <= 1.2 * s_rel and tau <= 1.25 * step and tau < t_stop - t:
-                s, err, found = _locate_release(Y, t, ct, st, tau, min(2.0 * step, t_stop - t), _RELEASE, wall_left, K,
+                s, err, found = _locate_release(Y, t, ct, st, tau, min(2.0 * step, t_stop - t), RELEASE, wall_left, K,
                                                 tmp, Ynew, n, modes, par, counters)
                 if found:
                     memo[1] = max(err, 1e-3) / (v_rel**1.5 * s**2.5)
@@ -390,7 +379,7 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
                 # approach so that the release step left over is s_rel (never longer than the step control allows)
                 step = min(step, max(tau - 0.9 * s_rel, 0.5 * tau))
                 last = False
-        kind = _ONSET if first else _REGULAR
+        kind = ONSET if first else REGULAR
         err = _dp_step(Y, ct, st, step, kind, K, tmp, Ynew, n, modes, par)
         if not math.isfinite(err):
             return t, h, False, _NONFINITE, extra
@@ -408,7 +397,7 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
         ncl, ncld, ncr, ncrd = _closing_at(Ynew, ct1, st1, n, modes, par)
         if ncl <= 0.0 and ncr <= 0.0:
             # release inside (t, t + step]: a step with the release time map ending exactly there
-            kind = _GRAZE if first else _RELEASE
+            kind = GRAZE if first else RELEASE
             c_end = ncl if wall_left else ncr
             cd_end = ncld if wall_left else ncrd
             guess = step - c_end / cd_end if cd_end < 0.0 else 0.5 * step
@@ -424,7 +413,7 @@ def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, f
                 # the release-map step still ends (barely, |c| ~ rounding) closed while the regular step ended
                 # open: c hovers at 0 (sphere riding on the wall); release at the regular step's end
                 s = step
-                _dp_step(Y, ct, st, s, _ONSET if first else _REGULAR, K, tmp, Ynew, n, modes, par)
+                _dp_step(Y, ct, st, s, ONSET if first else REGULAR, K, tmp, Ynew, n, modes, par)
             for i in range(Y.size):
                 Y[i] = Ynew[i]
             return t + s, h, True, _OK, extra
@@ -622,7 +611,8 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
         cim = par[_PIM]
         for j in range(n):
             dx = Y[j] - X0[j]
-            nre = -(Y[n + j] - X0[n + j]) - 2.0 * modes[_SIG, j] * dx - modes[_PL, j] * Y[2 * n + 2] - modes[_PR, j] * Y[2 * n + 4]
+            nre = (-(Y[n + j] - X0[n + j]) - 2.0 * modes[_SIG, j] * dx - modes[_PL, j] * Y[2 * n + 2]
+                   - modes[_PR, j] * Y[2 * n + 4])
             nim = -Om * dx - modes[_PL, j] * Y[2 * n + 3] - modes[_PR, j] * Y[2 * n + 5]
             cre += 2.0 / T * (modes[_RHR, j] * nre - modes[_RHI, j] * nim)
             cim += 2.0 / T * (modes[_RHR, j] * nim + modes[_RHI, j] * nre)

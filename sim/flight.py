@@ -48,6 +48,27 @@ def _apply_flight(Y, Ynew, tau, tr, n):
         Ynew[i] = Y[i]
 
 
+# time maps of a contact step, t = t_a + h w(u) with u in [0, 1] (`_time_map`)
+ONSET, REGULAR, RELEASE, GRAZE = 0, 1, 2, 3
+
+
+@njit(cache=True, inline="always")
+def _time_map(kind, u):
+    """(w(u), w'(u)) of a contact step's time map t = t_a + h w(u), w(1) = 1.
+
+    At a contact onset (release) the Hertz force behaves like (t - t_on)^1.5 ((t_rel - t)^1.5) and a step
+    in t loses its order; with t - t_on = h u^2 (t_rel - t = h (1 - u)^2) the force is a smooth function of
+    u. GRAZE handles both ends at once (a whole graze in one step).
+    """
+    if kind == ONSET:
+        return u * u, 2.0 * u
+    if kind == RELEASE:
+        return u * (2.0 - u), 2.0 * (1.0 - u)
+    if kind == GRAZE:
+        return u * u * (3.0 - 2.0 * u), 6.0 * u * (1.0 - u)
+    return u, 1.0
+
+
 @njit(cache=True, inline="always")
 def _closing(Y, t, n, modes, par):
     """(c_l, c_l', c_r, c_r') at phase time t: contact at a wall when its c > 0 (Eqs. 4-6)."""

@@ -82,8 +82,8 @@ def test_backward_series_is_the_step_solution(beam, kind, M):
             C._lagrange(nodes.u, nodes.wb, scale * v, row)
         Ypart = np.empty_like(Y)
         C._end_state(part, off, Y, Ypart, lag @ F, 1.0, 0.0, 0, N9, nodes.u.size, par)
-        Yb, Yd = np.empty(2 * N9 + 2), np.empty(2 * N9 + 2)
-        C._series_at(S, (1.0 - fraction) * h, Yb, Yd, 2 * N9 + 2)
+        Yb = np.empty(2 * N9 + 2)
+        C._series_at(S, (1.0 - fraction) * h, Yb, 2 * N9 + 2)
         scale_state = np.concatenate([np.full(N9, np.abs(Y[:N9]).max()), np.full(N9, np.abs(Y[N9:2 * N9]).max()),
                                       [abs(Y[2 * N9]), abs(Y[2 * N9 + 1])]])
         assert np.max(np.abs(Yb - Ypart[:2 * N9 + 2]) / scale_state) < 1e-10

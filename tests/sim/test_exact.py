@@ -212,7 +212,7 @@ def test_release_is_located_when_the_first_guess_ends_short():
     guess = 0.3e-6  # ends short of the release
     for first_guess in (guess, 3 * guess):
         Ynew = np.zeros_like(Y)
-        s, err, found = exact._locate_release(Y, 0.0, 1.0, 0.0, first_guess, 4e-6, exact._RELEASE, True, K,
+        s, err, found = exact._locate_release(Y, 0.0, 1.0, 0.0, first_guess, 4e-6, exact.RELEASE, True, K,
                                               np.zeros_like(Y), Ynew, n, modes, par, counters)
         c_left = exact._closing(Ynew, s, n, modes, par)[0]
         assert found and err <= 1.0
