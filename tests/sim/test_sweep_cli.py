@@ -80,6 +80,21 @@ def test_bad_input_is_one_line_exit_2(tmp_path, model_file, capsys, args, messag
     assert not (out / "sweep.csv").exists()
 
 
+@pytest.mark.parametrize("command", [["sweep", "--level", "6"], ["overview", "--levels", "5,6"]])
+@pytest.mark.parametrize("args", [["--integrator", "rk4"], ["--reps", "0"]])
+def test_bad_input_leaves_no_out_folder(tmp_path, model_file, capsys, command, args):
+    """Inputs only the simulation rejects (after --out was created): the new folder is removed again, a
+    folder that existed before is kept."""
+    out = tmp_path / "new" / "out"
+    assert main([*command, *FAST, "--model", model_file, "--out", str(out), *args]) == 2
+    assert not out.exists()
+    kept = tmp_path / "kept"
+    kept.mkdir()
+    assert main([*command, *FAST, "--model", model_file, "--out", str(kept), *args]) == 2
+    assert kept.is_dir()
+    capsys.readouterr()
+
+
 def test_malformed_model_file(tmp_path, capsys):
     bad = tmp_path / "bad.toml"
     bad.write_text("frequencies_hz = [117.4, 'x']\n")

@@ -74,34 +74,35 @@ def run(args: argparse.Namespace) -> int:
     levels = parse_levels(args.levels)
     protocol = build_protocol(args)
     model, impactor = build_system(args)
-    folder = output_folder(args.out)
-    results = []
-    for level in tqdm(levels, desc="overview", unit="level", disable=None, leave=False):
-        results.append(sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed))
-    data = {
-        "levels": levels,
-        "resonant_mean": [r.resonant_mean for r in results],
-        "resonant_max": [r.resonant_max for r in results],
-        "resonant_mean_lo": [float(r.resonant_mean_samples.min()) for r in results],
-        "resonant_mean_hi": [float(r.resonant_mean_samples.max()) for r in results],
-        "resonant_max_lo": [float(r.resonant_max_samples.min()) for r in results],
-        "resonant_max_hi": [float(r.resonant_max_samples.max()) for r in results],
-        "eta_resonant_mean": [r.eta_resonant_mean for r in results],
-        "eta_resonant_max": [r.eta_resonant_max for r in results],
-        "regime": [r.regime for r in results],
-        "impacts_per_period": [float(r.impacts_per_period[r.eta == r.eta_resonant_mean][0]) for r in results],
-        "sweeps": [r.to_dict() for r in results],
-        "reps": args.reps, "seed": args.seed, "model": model.source,
-        "wall_time_s": time.perf_counter() - started,
-    }
-    if folder is not None:
-        write_csv(folder / "overview.csv",
-                  ["level", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "resonant_max", "resonant_max_lo",
-                   "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max", "impacts_per_period", "regime"],
-                  [data[k] for k in ("levels", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "resonant_max",
-                                     "resonant_max_lo", "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max",
-                                     "impacts_per_period", "regime")])
-        write_text(folder / "overview.json", dumps(data) + "\n")
+    with output_folder(args.out) as folder:
+        results = []
+        for level in tqdm(levels, desc="overview", unit="level", disable=None, leave=False):
+            results.append(sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed))
+        data = {
+            "levels": levels,
+            "resonant_mean": [r.resonant_mean for r in results],
+            "resonant_max": [r.resonant_max for r in results],
+            "resonant_mean_lo": [float(r.resonant_mean_samples.min()) for r in results],
+            "resonant_mean_hi": [float(r.resonant_mean_samples.max()) for r in results],
+            "resonant_max_lo": [float(r.resonant_max_samples.min()) for r in results],
+            "resonant_max_hi": [float(r.resonant_max_samples.max()) for r in results],
+            "eta_resonant_mean": [r.eta_resonant_mean for r in results],
+            "eta_resonant_max": [r.eta_resonant_max for r in results],
+            "regime": [r.regime for r in results],
+            "impacts_per_period": [float(r.impacts_per_period[r.eta == r.eta_resonant_mean][0]) for r in results],
+            "sweeps": [r.to_dict() for r in results],
+            "reps": args.reps, "seed": args.seed, "model": model.source,
+            "wall_time_s": time.perf_counter() - started,
+        }
+        if folder is not None:
+            write_csv(folder / "overview.csv",
+                      ["level", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "resonant_max",
+                       "resonant_max_lo", "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max",
+                       "impacts_per_period", "regime"],
+                      [data[k] for k in ("levels", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi",
+                                         "resonant_max", "resonant_max_lo", "resonant_max_hi", "eta_resonant_mean",
+                                         "eta_resonant_max", "impacts_per_period", "regime")])
+            write_text(folder / "overview.json", dumps(data) + "\n")
     if args.plot:
         plot_overview(levels, results, args.plot, f"{protocol.sequence}, {args.reps} runs ({protocol.integrator})")
     if args.json:

@@ -6,7 +6,9 @@ with `ies overview`.
 from __future__ import annotations
 
 import argparse
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Iterator
 
 NAME = "sweep"
 HELP = "stepped-sine frequency response (mean and max amplitude per eta, spread over repetitions; Fig. 5)"
@@ -102,17 +104,26 @@ def build_protocol(args: argparse.Namespace):
                        integrator=args.integrator, dt_scale=args.dt_scale, start=args.start)
 
 
-def output_folder(path: str | None) -> Path | None:
-    """Create --out DIR up front (a clear error if it cannot be a folder)."""
+@contextmanager
+def output_folder(path: str | None) -> Iterator[Path | None]:
+    """--out DIR, created up front (a clear error if it cannot be a folder) and removed again if the command
+    fails before writing anything into it (no empty result folders after a bad input)."""
     from uq.errors import StudyError
 
     if path is None:
-        return None
+        yield None
+        return
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
         raise StudyError(f"--out {folder} exists and is not a folder; choose another path")
+    created = not folder.exists()
     folder.mkdir(parents=True, exist_ok=True)
-    return folder
+    try:
+        yield folder
+    except BaseException:
+        if created and not any(folder.iterdir()):
+            folder.rmdir()
+        raise
 
 
 def write_csv(path: Path, header: list[str], columns: list) -> None:
@@ -162,19 +173,20 @@ def run(args: argparse.Namespace) -> int:
     level = check_level(args.level)
     protocol = build_protocol(args)
     model, impactor = build_system(args)
-    folder = output_folder(args.out)
-    result = sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed)
-    data = result.to_dict()
-    data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps, model=model.source,
-                impactor=None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
-                                                        "k_H_N_per_m1p5": impactor.k_H},
-                D1=float(model.damping_ratios[0]))
-    if folder is not None:
-        write_csv(folder / "sweep.csv",
-                  ["eta", "mean", "mean_lo", "mean_hi", "max", "max_lo", "max_hi", "cv", "impacts_per_period", "regime"],
-                  [result.eta, result.mean, result.mean_lo, result.mean_hi, result.max, result.max_lo, result.max_hi,
-                   result.cv, result.impacts_per_period, result.regime_per_eta])
-        write_text(folder / "sweep.json", dumps(data) + "\n")
+    with output_folder(args.out) as folder:
+        result = sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed)
+        data = result.to_dict()
+        data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps, model=model.source,
+                    impactor=None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
+                                                            "k_H_N_per_m1p5": impactor.k_H},
+                    D1=float(model.damping_ratios[0]))
+        if folder is not None:
+            write_csv(folder / "sweep.csv",
+                      ["eta", "mean", "mean_lo", "mean_hi", "max", "max_lo", "max_hi", "cv", "impacts_per_period",
+                       "regime"],
+                      [result.eta, result.mean, result.mean_lo, result.mean_hi, result.max, result.max_lo,
+                       result.max_hi, result.cv, result.impacts_per_period, result.regime_per_eta])
+            write_text(folder / "sweep.json", dumps(data) + "\n")
     if args.plot:
         plot_sweep(result, args.plot, f"a_base/a_base* = {level:g}, {result.n_samples} samples ({protocol.integrator})")
     if args.json:
