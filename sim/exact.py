@@ -66,7 +66,7 @@ from sim.system import SystemArrays, check_run_step
 #: Free-flight grid steps per excitation period (certification cells; no effect on accuracy).
 GRID_PER_PERIOD = 48
 #: Default tolerance of the Dormand-Prince contact steps, relative to the clearance g (error per step, in m / g).
-#: They only take the contacts collocation leaves (2 %), so it is tight: energy within 4e-7 over 1000 impacts.
+#: They only take the contacts collocation leaves (2 %), so it is tight: energy within 3-4e-7 over 1000 impacts.
 CONTACT_RTOL = 1e-10
 #: Onset/release location tolerance on the closing function, relative to g.
 GAP_TOLERANCE = 1e-12
