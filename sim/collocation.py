@@ -234,8 +234,9 @@ def _solve_in_place(A, x, m):
 
 
 @njit(cache=True)
-def _free_closing(tab, off, Y, ct, st, wall, n, s, par, out):
-    """out[i] = c_w at node i (i = s: the step's end) of the free flight from Y at phase (ct, st)."""
+def _free_closing(tab, off, Y, ct, st, wall, n, s, par, out, Yd=None, out_d=None):
+    """out[i] = c_w at node i (i = s: the step's end) of the free flight from Y at phase (ct, st); with
+    Yd = dY/dt at the start, out_d[i] = the derivative of out[i] in the step's start time."""
     sgn = 1.0 if wall == 0 else -1.0
     Wr = par[_WLR] if wall == 0 else par[_WRR]
     Wi = par[_WLI] if wall == 0 else par[_WRI]
@@ -247,6 +248,11 @@ def _free_closing(tab, off, Y, ct, st, wall, n, s, par, out):
             acc += tab[off[_P] + i * n + j] * Y[j] + tab[off[_Q] + i * n + j] * Y[n + j]
         c, si = _rotate(ct, st, Om * tau)
         out[i] = acc + sgn * (Wr * c - Wi * si - Y[2 * n] - tau * Y[2 * n + 1]) - par[_G]
+        if Yd is not None:
+            acc = 0.0
+            for j in range(n):
+                acc += tab[off[_P] + i * n + j] * Yd[j] + tab[off[_Q] + i * n + j] * Yd[n + j]
+            out_d[i] = acc - sgn * (Om * (Wr * si + Wi * c) + Yd[2 * n] + tau * Yd[2 * n + 1])
 
 
 @njit(cache=True, inline="always")
@@ -379,21 +385,18 @@ def _horner(C, col, x):
 @njit(cache=True)
 def _series_at(S, sigma, Y, m):
     """Y[:m] = the state at t_e - sigma from the series S of `_series`."""
+    p = S.shape[0]
     for i in range(m):
-        Y[i] = _horner(S, i, sigma)[0]
+        val = S[p - 1, i]
+        for q in range(p - 2, -1, -1):
+            val = val * sigma + S[q, i]
+        Y[i] = val
 
 
-@njit(cache=True)
-def _closing_series(tab, off, S, wall, n, s, G):
-    """G[q, i]: Taylor coefficients in sigma of the modal and sphere part of c_hom at node i of a step that
-    starts at t_e - sigma (state series S from `_series`); the harmonic part is added by the caller."""
-    sgn = 1.0 if wall == 0 else -1.0
-    for q in range(S.shape[0]):
-        for i in range(s + 1):
-            acc = 0.0
-            for j in range(n):
-                acc += tab[off[_P] + i * n + j] * S[q, j] + tab[off[_Q] + i * n + j] * S[q, n + j]
-            G[q, i] = acc - sgn * (S[q, 2 * n] + tab[off[_TAU] + i] * S[q, 2 * n + 1])
+#: 1 / k for k = 1, 2, ... (the integrals of the powers in `_overlap_fourier`)
+_INV = 1.0 / np.arange(1.0, 40.0)
+#: Terms of the exponential's series in `_overlap_fourier` ((Omega sigma)^5 / 5! < 1e-12 for Omega sigma < 0.01).
+_OVERLAP_TERMS = 5
 
 
 @njit(cache=True)
@@ -401,20 +404,22 @@ def _overlap_fourier(Fs, sigma, ct_e, st_e, Om):
     """int over [t_e - sigma, t_e] of F(t) exp(-i Omega t) dt from the force's series (Omega sigma << 1)."""
     jr = 0.0
     ji = 0.0
+    power = sigma  # sigma^(q + 1)
     for q in range(Fs.size):
-        fact = 1.0
-        for m in range(5):
-            term = Fs[q] * fact * sigma ** (q + m + 1) / (q + m + 1)
-            # (i Omega)^m / m!
+        term = Fs[q] * power
+        for m in range(_OVERLAP_TERMS):
+            # Fs[q] sigma^(q + m + 1) (i Omega)^m / m! / (q + m + 1)
+            part = term * _INV[q + m]
             if m % 4 == 0:
-                jr += term
+                jr += part
             elif m % 4 == 1:
-                ji += term
+                ji += part
             elif m % 4 == 2:
-                jr -= term
+                jr -= part
             else:
-                ji -= term
-            fact *= Om / (m + 1)
+                ji -= part
+            term *= Om * sigma * _INV[m]
+        power *= sigma
     return ct_e * jr + st_e * ji, ct_e * ji - st_e * jr
 
 
@@ -455,7 +460,7 @@ _GL6_W = np.array([0.08566224618958517, 0.1803807865240693, 0.23395696728634552,
 def _time_to_release(c, cd, ma, kH):
     """Time left in a contact at indentation c > 0 and rate cd, for a Hertz impact of the sphere on a
     rigid wall with the same energy (a first guess for the release step)."""
-    E = 0.5 * ma * cd * cd + 0.4 * kH * c ** 2.5
+    E = 0.5 * ma * cd * cd + 0.4 * kH * c * c * math.sqrt(c)
     dmax = (2.5 * E / kH) ** 0.4
     ve = math.sqrt(2.0 * E / ma)
     xi = min(c / dmax, 1.0)
@@ -465,7 +470,7 @@ def _time_to_release(c, cd, ma, kH):
     for k in range(6):
         w = a + (1.0 - a) * _GL6_X[k]
         e = 1.0 - w * w
-        q = (1.0 - e ** 2.5) / (1.0 - e) if e < 1.0 else 2.5
+        q = (1.0 - e * e * math.sqrt(e)) / (1.0 - e) if e < 1.0 else 2.5
         J += _GL6_W[k] * (1.0 - a) * 2.0 / math.sqrt(q)
     if cd > 0.0:
         J = _HERTZ_TIME - J  # past the maximum indentation: the whole contact minus the way back
@@ -538,38 +543,40 @@ def _forward_step(tab, off, Y, ct, st, wall, n, s, par, ws, A, ratio, tail):
 
 
 @njit(cache=True)
-def _release_step(tab, off, S, G, phase, ct, st, d, d_lo, d_hi, c_e, cd_e, wall, n, s, par, ws, A, ratio):
+def _release_step(tab, off, S, Fs, ct, st, d, d_lo, d_hi, c_e, cd_e, wall, n, s, modes, par, ws, A, ratio):
     """Newton's method for the release step of table `tab` that starts d before the last step's end (phase
-    ct, st there; state series S): unknowns the nodal indentations and d, equations the collocation and
-    c_w = 0 at the step's end. d is kept in [d_lo, d_hi] (the series' range). Returns (status, d): 0
-    converged, 1 failed, 2 d left its range (the release is elsewhere: another ladder length); the nodal
-    forces are left in ws[_F]."""
+    ct, st there; series S of the state, Fs of the force): unknowns the nodal indentations and d, equations
+    the collocation and c_w = 0 at the step's end. d is kept in [d_lo, d_hi] (the series' range). Returns
+    (status, d): 0 converged, 1 failed, 2 d left its range (the release is elsewhere: another ladder
+    length); the nodal forces are left in ws[_F]."""
     chom = ws[_CHOM]
     dchom = ws[_DCHOM]
     delta = ws[_DELTA]
     F = ws[_F]
     D = ws[_D]
     rhs = ws[_RHS]
+    Ys = ws[_YS]
+    Yd = ws[_YNEW]
     Om = par[_OM]
     kH = par[_KH]
     sgn = 1.0 if wall == 0 else -1.0
-    Wr = par[_WLR] if wall == 0 else par[_WRR]
-    Wi = par[_WLI] if wall == 0 else par[_WRI]
+    row = _PL if wall == 0 else _PR
     oW = off[_W]
     for i in range(s):
         delta[i] = ratio[i] * c_e
-    _closing_series(tab, off, S, wall, n, s, G)
-    for i in range(s + 1):
-        phase[0, i], phase[1, i] = _rotate(1.0, 0.0, Om * tab[off[_TAU] + i])
     for _ in range(30):
-        # c_hom at the nodes and its derivative in the start time, from the series in d
+        # the start state (series at d), its rate dY/dt (Eqs. 3-7 with the force's series) and c_hom at the nodes
+        _series_at(S, d, Ys, 2 * n + 2)
+        f = Fs[Fs.size - 1]
+        for q in range(Fs.size - 2, -1, -1):
+            f = f * d + Fs[q]
+        for j in range(n):
+            Yd[j] = Ys[n + j]
+            Yd[n + j] = -2.0 * modes[_SIG, j] * Ys[n + j] - modes[_W2, j] * Ys[j] - sgn * modes[row, j] * f
+        Yd[2 * n] = Ys[2 * n + 1]
+        Yd[2 * n + 1] = sgn * f * par[_IMA]
         cb, sb = _rotate(ct, st, -Om * d)
-        for i in range(s + 1):
-            val, dval = _horner(G, i, d)
-            c = cb * phase[0, i] - sb * phase[1, i]
-            si = sb * phase[0, i] + cb * phase[1, i]
-            chom[i] = val + sgn * (Wr * c - Wi * si) - par[_G]
-            dchom[i] = -dval - sgn * Om * (Wr * si + Wi * c)
+        _free_closing(tab, off, Ys, cb, sb, wall, n, s, par, chom, Yd, dchom)
         _forces(delta, F, D, kH, s)
         # residuals delta_i - c_hom,i + sum_k W_ik F_k at the nodes, then c_w at the end; d/dd = -d/dt_start
         scale = abs(chom[s])
@@ -619,7 +626,7 @@ def contact(Y, t, t_stop, wall, n, modes, par, colloc):
     colloc: the tuple of `arguments` (tables, node data, first guesses and workspace); in it memo[0 / 1 / 2]
     holds the indentations of the last onset / regular / release step over their first guess.
     """
-    tabs, built, off, u, wb, b, xq, bq, M_onset, M_regular, tail, h_ref, memo, ws, A, S, G, phase = colloc
+    tabs, built, off, u, wb, b, xq, bq, M_onset, M_regular, tail, h_ref, memo, ws, A, S = colloc
     s = u.size
     m = 2 * n + 2
     Om = par[_OM]
@@ -674,8 +681,8 @@ def contact(Y, t, t_stop, wall, n, modes, par, colloc):
                     return FALLBACK, t, steps
                 tab = _table(tabs, built, off, wall, RELEASE, k, h_ref, u, wb, b, xq, bq, n, modes, par)
                 h_k = _ladder_h(k, h_ref)
-                status, d = _release_step(tab, off, S, G, phase, ct, st, h_k - R, -0.3 * h, 0.6 * h, c_e, cd_e, wall,
-                                          n, s, par, ws, A, memo[2])
+                status, d = _release_step(tab, off, S, Fs, ct, st, h_k - R, -0.3 * h, 0.6 * h, c_e, cd_e, wall, n, s,
+                                          modes, par, ws, A, memo[2])
                 if status == 1:
                     return FALLBACK, t, steps
                 R = h_k - min(max(d, -0.3 * h), 0.6 * h)  # the release as found (or as far as the series reaches)
@@ -705,15 +712,14 @@ def contact(Y, t, t_stop, wall, n, modes, par, colloc):
 
 
 def workspace(nodes: Nodes, n: int) -> tuple[np.ndarray, ...]:
-    """Scratch arrays of `contact` (ws, A, S, G, phase) for n modes, and a fresh memo of first guesses."""
+    """Scratch arrays of `contact` (ws, A, S) for n modes, and a fresh memo of first guesses."""
     s = nodes.u.size
     order = nodes.onset.shape[0]
     memo = np.empty((3, s))
     memo[0] = 0.85  # onset: indentation / free indentation (Hertz: ~0.7 at the half contact)
     memo[1] = 0.9
     memo[2] = (1.0 - nodes.u) ** 2  # release: indentation / indentation at the start, linear in time to the end
-    return (np.zeros((_WS_ROWS, max(s + 1, 2 * n + 6, order))), np.zeros((s + 1, s + 1)), np.zeros((order, 2 * n + 2)),
-            np.zeros((order, s + 1)), np.zeros((2, s + 1)), memo)
+    return np.zeros((_WS_ROWS, max(s + 1, 2 * n + 6, order))), np.zeros((s + 1, s + 1)), np.zeros((order, 2 * n + 2)), memo
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -752,7 +758,7 @@ def arguments(sys, modes: np.ndarray) -> tuple:
     tables = tables_for(modes, sys.m_a)
     nodes = tables.nodes
     n = modes.shape[1]
-    ws, A, S, G, phase, memo = workspace(nodes, n)
+    ws, A, S, memo = workspace(nodes, n)
     h_ref = 2.0 * math.pi / math.sqrt(float(np.max(modes[_W2])))  # period of the highest mode
     return (tables.tabs, tables.built, tables.off, nodes.u, nodes.wb, nodes.b, nodes.xq, nodes.bq, nodes.onset,
-            nodes.regular, nodes.tail, h_ref, memo, ws, A, S, G, phase)
+            nodes.regular, nodes.tail, h_ref, memo, ws, A, S)
