@@ -155,8 +155,8 @@ def _build(tab, off, kind, h, wall, u, wb, b, xq, bq, n, modes, par):
         tab[off[_TAU] + i] = tau
         for j in range(n):
             a, bb, c, d = _transition(tau, modes, j)
-            tab[off[_P] + i * n + j] = sgn * modes[row, j] * a
-            tab[off[_Q] + i * n + j] = sgn * modes[row, j] * bb
+            tab[off[_P] + j * (s + 1) + i] = sgn * modes[row, j] * a
+            tab[off[_Q] + j * (s + 1) + i] = sgn * modes[row, j] * bb
         # W[i, k] = int_0^ui K(tau - h w(v)) l_k(v) h w'(v) dv
         for q in range(xq.size):
             v = ui * xq[q]
@@ -168,7 +168,7 @@ def _build(tab, off, kind, h, wall, u, wb, b, xq, bq, n, modes, par):
             weight = ui * bq[q] * K * h * dv
             _lagrange(u, wb, v, lag_k)
             for k in range(s):
-                tab[off[_W] + i * s + k] += weight * lag_k[k]
+                tab[off[_W] + k * (s + 1) + i] += weight * lag_k[k]
     for q in range(xq.size):
         v = xq[q]
         wv, dv = _time_map(kind, v)
@@ -199,60 +199,74 @@ def _build(tab, off, kind, h, wall, u, wb, b, xq, bq, n, modes, par):
 # one step: the free closing function at the nodes, Newton on the nodal indentations, the end state
 # ----------------------------------------------------------------------------------------------------------
 @njit(cache=True)
-def _solve_in_place(A, x, m):
-    """x <- A^-1 x for the leading m x m block of A (Gaussian elimination, partial pivoting; A destroyed)."""
+def _solve_in_place(AT, x, m):
+    """x <- A^-1 x for the leading m x m block of A, given by columns (AT[k, i] = A[i, k]; destroyed):
+    Gaussian elimination with partial pivoting, column-oriented so that the inner loops run along
+    contiguous memory."""
     for c in range(m):
         p = c
-        best = abs(A[c, c])
+        best = abs(AT[c, c])
         for r in range(c + 1, m):
-            if abs(A[r, c]) > best:
-                best = abs(A[r, c])
+            if abs(AT[c, r]) > best:
+                best = abs(AT[c, r])
                 p = r
         if best == 0.0:
             return False
         if p != c:
             for k in range(m):
-                tmp = A[c, k]
-                A[c, k] = A[p, k]
-                A[p, k] = tmp
+                tmp = AT[k, c]
+                AT[k, c] = AT[k, p]
+                AT[k, p] = tmp
             tmp = x[c]
             x[c] = x[p]
             x[p] = tmp
-        inv = 1.0 / A[c, c]
+        inv = 1.0 / AT[c, c]
+        for r in range(c + 1, m):
+            AT[c, r] *= inv  # the multipliers
         xc = x[c]
         for r in range(c + 1, m):
-            f = A[r, c] * inv
-            for k in range(c + 1, m):
-                A[r, k] -= f * A[c, k]
-            x[r] -= f * xc
-    for c in range(m - 1, -1, -1):
-        acc = x[c]
+            x[r] -= AT[c, r] * xc
         for k in range(c + 1, m):
-            acc -= A[c, k] * x[k]
-        x[c] = acc / A[c, c]
+            a = AT[k, c]
+            for r in range(c + 1, m):
+                AT[k, r] -= AT[c, r] * a
+    for c in range(m - 1, -1, -1):
+        x[c] /= AT[c, c]
+        xc = x[c]
+        for r in range(c):
+            x[r] -= AT[c, r] * xc
     return True
 
 
 @njit(cache=True)
-def _free_closing(tab, off, Y, ct, st, wall, n, s, par, out, Yd=None, out_d=None):
-    """out[i] = c_w at node i (i = s: the step's end) of the free flight from Y at phase (ct, st); with
-    Yd = dY/dt at the start, out_d[i] = the derivative of out[i] in the step's start time."""
+def _free_closing(tab, off, ph, Y, ct, st, wall, n, s, par, out, Yd=None, out_d=None):
+    """out[i] = c_w at node i (i = s: the step's end) of the free flight from Y at phase (ct, st) (ph: the
+    node phases of `_phases`); with Yd = dY/dt at the start, out_d[i] = d out[i] / d(start time)."""
     sgn = 1.0 if wall == 0 else -1.0
     Wr = par[_WLR] if wall == 0 else par[_WRR]
     Wi = par[_WLI] if wall == 0 else par[_WRI]
     Om = par[_OM]
-    for i in range(s + 1):
+    oP = off[_P]
+    oQ = off[_Q]
+    r = s + 1
+    for i in range(r):
         tau = tab[off[_TAU] + i]
-        acc = 0.0
-        for j in range(n):
-            acc += tab[off[_P] + i * n + j] * Y[j] + tab[off[_Q] + i * n + j] * Y[n + j]
-        c, si = _rotate(ct, st, Om * tau)
-        out[i] = acc + sgn * (Wr * c - Wi * si - Y[2 * n] - tau * Y[2 * n + 1]) - par[_G]
+        c = ct * ph[0, i] - st * ph[1, i]
+        si = st * ph[0, i] + ct * ph[1, i]
+        out[i] = sgn * (Wr * c - Wi * si - Y[2 * n] - tau * Y[2 * n + 1]) - par[_G]
         if Yd is not None:
-            acc = 0.0
-            for j in range(n):
-                acc += tab[off[_P] + i * n + j] * Yd[j] + tab[off[_Q] + i * n + j] * Yd[n + j]
-            out_d[i] = acc - sgn * (Om * (Wr * si + Wi * c) + Yd[2 * n] + tau * Yd[2 * n + 1])
+            out_d[i] = -sgn * (Om * (Wr * si + Wi * c) + Yd[2 * n] + tau * Yd[2 * n + 1])
+    # the modes, all nodes at once: P, Q are stored mode by mode
+    for j in range(n):
+        x = Y[j]
+        v = Y[n + j]
+        for i in range(r):
+            out[i] += tab[oP + j * r + i] * x + tab[oQ + j * r + i] * v
+        if Yd is not None:
+            x = Yd[j]
+            v = Yd[n + j]
+            for i in range(r):
+                out_d[i] += tab[oP + j * r + i] * x + tab[oQ + j * r + i] * v
 
 
 @njit(cache=True, inline="always")
@@ -275,17 +289,21 @@ def _newton(tab, off, chom, delta, F, D, A, rhs, s, kH):
 
     Returns the number of iterations, or -1 if Newton's method did not converge."""
     oW = off[_W]
+    r = s + 1
     for it in range(40):
         _forces(delta, F, D, kH, s)
+        # residuals delta_i - chom_i + sum_k W_ik F_k and the Jacobian by columns (W is stored by columns)
         scale = 0.0
         for i in range(s):
-            acc = delta[i] - chom[i]
-            for k in range(s):
-                acc += tab[oW + i * s + k] * F[k]
-                A[i, k] = tab[oW + i * s + k] * D[k]
-            A[i, i] += 1.0
-            rhs[i] = acc
+            rhs[i] = delta[i] - chom[i]
             scale = max(scale, abs(chom[i]))
+        for k in range(s):
+            f = F[k]
+            dk = D[k]
+            for i in range(s):
+                rhs[i] += tab[oW + k * r + i] * f
+                A[k, i] = tab[oW + k * r + i] * dk
+            A[k, k] += 1.0
         if not _solve_in_place(A, rhs, s):
             return -1
         change = 0.0
@@ -301,20 +319,20 @@ def _newton(tab, off, chom, delta, F, D, A, rhs, s, kH):
 
 
 @njit(cache=True)
-def _end_state(tab, off, Y, Yout, F, ct, st, wall, n, s, par):
+def _end_state(tab, off, ph, Y, Yout, F, ct, st, wall, n, s, par):
     """Yout = the state at the step's end: transitions, responses to the nodal forces, and the Fourier
-    integral of the contact force over the step (Gauss quadrature)."""
+    integral of the contact force over the step (Gauss quadrature; ph: the node phases of `_phases`)."""
     oTR = off[_TR]
     for j in range(n):
         x = Y[j]
         v = Y[n + j]
-        xe = tab[oTR + j] * x + tab[oTR + n + j] * v
-        ve = tab[oTR + 2 * n + j] * x + tab[oTR + 3 * n + j] * v
-        for k in range(s):
-            xe += tab[off[_BX] + k * n + j] * F[k]
-            ve += tab[off[_BV] + k * n + j] * F[k]
-        Yout[j] = xe
-        Yout[n + j] = ve
+        Yout[j] = tab[oTR + j] * x + tab[oTR + n + j] * v
+        Yout[n + j] = tab[oTR + 2 * n + j] * x + tab[oTR + 3 * n + j] * v
+    for k in range(s):
+        f = F[k]
+        for j in range(n):
+            Yout[j] += tab[off[_BX] + k * n + j] * f
+            Yout[n + j] += tab[off[_BV] + k * n + j] * f
     h = tab[off[_TAU] + s]
     ze = Y[2 * n] + h * Y[2 * n + 1]
     zde = Y[2 * n + 1]
@@ -323,7 +341,8 @@ def _end_state(tab, off, Y, Yout, F, ct, st, wall, n, s, par):
     for k in range(s):
         ze += tab[off[_BZ] + k] * F[k]
         zde += tab[off[_BZD] + k] * F[k]
-        c, si = _rotate(ct, st, par[_OM] * tab[off[_TAU] + k])
+        c = ct * ph[0, k] - st * ph[1, k]
+        si = st * ph[0, k] + ct * ph[1, k]
         wf = tab[off[_WQ] + k] * F[k]
         re += wf * c
         im -= wf * si
@@ -384,13 +403,13 @@ def _horner(C, col, x):
 
 @njit(cache=True)
 def _series_at(S, sigma, Y, m):
-    """Y[:m] = the state at t_e - sigma from the series S of `_series`."""
+    """Y[:m] = the state at t_e - sigma from the series S of `_series` (Horner, all components at once)."""
     p = S.shape[0]
     for i in range(m):
-        val = S[p - 1, i]
-        for q in range(p - 2, -1, -1):
-            val = val * sigma + S[q, i]
-        Y[i] = val
+        Y[i] = S[p - 1, i]
+    for q in range(p - 2, -1, -1):
+        for i in range(m):
+            Y[i] = Y[i] * sigma + S[q, i]
 
 
 #: 1 / k for k = 1, 2, ... (the integrals of the powers in `_overlap_fourier`)
@@ -500,6 +519,16 @@ def _table(tabs, built, off, wall, kind, k, h_ref, u, wb, b, xq, bq, n, modes, p
 
 
 @njit(cache=True)
+def _phases(phases, phased, tab, off, kind, k, Om, s):
+    """cos, sin(Omega tau_i) at the nodes and the end (i = s) of table (kind, k), on first use in a run."""
+    if not phased[kind, k]:
+        for i in range(s + 1):
+            phases[kind, k, 0, i], phases[kind, k, 1, i] = _rotate(1.0, 0.0, Om * tab[off[_TAU] + i])
+        phased[kind, k] = True
+    return phases[kind, k]
+
+
+@njit(cache=True)
 def _active(Y, ct, st, wall, n, modes, par):
     """(c, c') of `wall`."""
     cl, cld, cr, crd = _closing_at(Y, ct, st, n, modes, par)
@@ -523,13 +552,13 @@ def _resolution(tail, F, s):
 
 
 @njit(cache=True)
-def _forward_step(tab, off, Y, ct, st, wall, n, s, par, ws, A, ratio, tail):
+def _forward_step(tab, off, ph, Y, ct, st, wall, n, s, par, ws, A, ratio, tail):
     """Solve a step from Y that has no release inside: nodal forces in ws[_F], first guess ratio times the
     free indentation (ratio is updated). False if Newton's method failed, an indentation is not positive or
     the force is not resolved."""
     chom = ws[_CHOM]
     delta = ws[_DELTA]
-    _free_closing(tab, off, Y, ct, st, wall, n, s, par, chom)
+    _free_closing(tab, off, ph, Y, ct, st, wall, n, s, par, chom)
     for i in range(s):
         delta[i] = ratio[i] * chom[i]
     if _newton(tab, off, chom, delta, ws[_F], ws[_D], A, ws[_RHS], s, par[_KH]) < 0:
@@ -543,7 +572,7 @@ def _forward_step(tab, off, Y, ct, st, wall, n, s, par, ws, A, ratio, tail):
 
 
 @njit(cache=True)
-def _release_step(tab, off, S, Fs, ct, st, d, d_lo, d_hi, c_e, cd_e, wall, n, s, modes, par, ws, A, ratio):
+def _release_step(tab, off, ph, S, Fs, ct, st, d, d_lo, d_hi, c_e, cd_e, wall, n, s, modes, par, ws, A, ratio):
     """Newton's method for the release step of table `tab` that starts d before the last step's end (phase
     ct, st there; series S of the state, Fs of the force): unknowns the nodal indentations and d, equations
     the collocation and c_w = 0 at the step's end. d is kept in [d_lo, d_hi] (the series' range). Returns
@@ -576,25 +605,27 @@ def _release_step(tab, off, S, Fs, ct, st, d, d_lo, d_hi, c_e, cd_e, wall, n, s,
         Yd[2 * n] = Ys[2 * n + 1]
         Yd[2 * n + 1] = sgn * f * par[_IMA]
         cb, sb = _rotate(ct, st, -Om * d)
-        _free_closing(tab, off, Ys, cb, sb, wall, n, s, par, chom, Yd, dchom)
+        _free_closing(tab, off, ph, Ys, cb, sb, wall, n, s, par, chom, Yd, dchom)
         _forces(delta, F, D, kH, s)
         # residuals delta_i - c_hom,i + sum_k W_ik F_k at the nodes, then c_w at the end; d/dd = -d/dt_start
         scale = abs(chom[s])
         for i in range(s):
-            acc = delta[i] - chom[i]
-            for k in range(s):
-                acc += tab[oW + i * s + k] * F[k]
-                A[i, k] = tab[oW + i * s + k] * D[k]
-            A[i, i] += 1.0
-            A[i, s] = dchom[i]
-            rhs[i] = acc
+            rhs[i] = delta[i] - chom[i]
             scale = max(scale, abs(chom[i]))
-        acc = chom[s]
+        rhs[s] = chom[s]
+        r = s + 1
         for k in range(s):
-            acc -= tab[oW + s * s + k] * F[k]
-            A[s, k] = -tab[oW + s * s + k] * D[k]
+            f = F[k]
+            dk = D[k]
+            for i in range(s):
+                rhs[i] += tab[oW + k * r + i] * f
+                A[k, i] = tab[oW + k * r + i] * dk
+            A[k, k] += 1.0
+            rhs[s] -= tab[oW + k * r + s] * f
+            A[k, s] = -tab[oW + k * r + s] * dk
+        for i in range(s):
+            A[s, i] = dchom[i]
         A[s, s] = -dchom[s]
-        rhs[s] = acc
         if not _solve_in_place(A, rhs, s + 1):
             return 1, d
         change = abs(rhs[s] * cd_e)
@@ -626,7 +657,7 @@ def contact(Y, t, t_stop, wall, n, modes, par, colloc):
     colloc: the tuple of `arguments` (tables, node data, first guesses and workspace); in it memo[0 / 1 / 2]
     holds the indentations of the last onset / regular / release step over their first guess.
     """
-    tabs, built, off, u, wb, b, xq, bq, M_onset, M_regular, tail, h_ref, memo, ws, A, S = colloc
+    tabs, built, off, u, wb, b, xq, bq, M_onset, M_regular, tail, h_ref, memo, ws, A, S, phases, phased = colloc
     s = u.size
     m = 2 * n + 2
     Om = par[_OM]
@@ -650,12 +681,14 @@ def contact(Y, t, t_stop, wall, n, modes, par, colloc):
         # failed (Newton, a release inside, unresolved force) or ended too close to the release (its force
         # is then not smooth in the step's time), at most _MAX_HALVINGS times in a contact
         tab = _table(tabs, built, off, wall, kind, k, h_ref, u, wb, b, xq, bq, n, modes, par)
+        ph = _phases(phases, phased, tab, off, kind, k, Om, s)
         h = _ladder_h(k, h_ref)
         R = 0.0
-        ok = _forward_step(tab, off, Y, ct, st, wall, n, s, par, ws, A, memo[kind], tail)
+        ok = _forward_step(tab, off, ph, Y, ct, st, wall, n, s, par, ws, A, memo[kind], tail)
         if ok:
-            _end_state(tab, off, Y, Ynew, ws[_F], ct, st, wall, n, s, par)
-            c1, s1 = _rotate(ct, st, Om * h)
+            _end_state(tab, off, ph, Y, Ynew, ws[_F], ct, st, wall, n, s, par)
+            c1 = ct * ph[0, s] - st * ph[1, s]
+            s1 = st * ph[0, s] + ct * ph[1, s]
             c_e, cd_e = _active(Ynew, c1, s1, wall, n, modes, par)
             if c_e > 0.0:
                 R = _time_to_release(c_e, cd_e, par[_MA], kH)
@@ -680,8 +713,9 @@ def contact(Y, t, t_stop, wall, n, modes, par, colloc):
                 if k < 0:
                     return FALLBACK, t, steps
                 tab = _table(tabs, built, off, wall, RELEASE, k, h_ref, u, wb, b, xq, bq, n, modes, par)
+                ph = _phases(phases, phased, tab, off, RELEASE, k, Om, s)
                 h_k = _ladder_h(k, h_ref)
-                status, d = _release_step(tab, off, S, Fs, ct, st, h_k - R, -0.3 * h, 0.6 * h, c_e, cd_e, wall, n, s,
+                status, d = _release_step(tab, off, ph, S, Fs, ct, st, h_k - R, -0.3 * h, 0.6 * h, c_e, cd_e, wall, n, s,
                                           modes, par, ws, A, memo[2])
                 if status == 1:
                     return FALLBACK, t, steps
@@ -701,7 +735,7 @@ def contact(Y, t, t_stop, wall, n, modes, par, colloc):
                 frow = 2 * n + 2 if wall == 0 else 2 * n + 4
                 Ynew[frow] -= sgn * ore
                 Ynew[frow + 1] -= sgn * oim
-                _end_state(tab, off, Ynew, Y, ws[_F], cs, ss, wall, n, s, par)
+                _end_state(tab, off, ph, Ynew, Y, ws[_F], cs, ss, wall, n, s, par)
                 return RELEASED, t - d + h_k, steps + 1
             # the contact lasts longer than predicted, or its end is not resolved: a regular step first
         k = _ladder(min(R / 1.6, _MAX_STEP_PERIODS * h_ref), h_ref, False)
@@ -754,11 +788,13 @@ def tables_for(modes: np.ndarray, m_a: float) -> Tables:
 
 
 def arguments(sys, modes: np.ndarray) -> tuple:
-    """The tuple `sim.exact._advance` passes on to `contact` for one run_step call (fresh first guesses)."""
+    """The tuple `sim.exact._advance` passes on to `contact` for one run_step call (fresh first guesses, and
+    room for the node phases of its Omega)."""
     tables = tables_for(modes, sys.m_a)
     nodes = tables.nodes
     n = modes.shape[1]
     ws, A, S, memo = workspace(nodes, n)
     h_ref = 2.0 * math.pi / math.sqrt(float(np.max(modes[_W2])))  # period of the highest mode
     return (tables.tabs, tables.built, tables.off, nodes.u, nodes.wb, nodes.b, nodes.xq, nodes.bq, nodes.onset,
-            nodes.regular, nodes.tail, h_ref, memo, ws, A, S)
+            nodes.regular, nodes.tail, h_ref, memo, ws, A, S, np.zeros((3, LADDER_SIZE, 2, NODES + 1)),
+            np.zeros((3, LADDER_SIZE), dtype=np.bool_))

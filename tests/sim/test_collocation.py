@@ -34,6 +34,12 @@ def _table(modes, par, kind, h, wall=0, nodes=None, quadrature=C.TABLE_QUADRATUR
     return tab, off
 
 
+def _phases(tab, off, s, Omega=OMEGA):
+    """cos, sin(Omega tau) at the nodes and the end of a table (what `C._phases` caches per run)."""
+    tau = tab[off[C._TAU]:off[C._TAU] + s + 1]
+    return np.vstack([np.cos(Omega * tau), np.sin(Omega * tau)])
+
+
 @pytest.mark.parametrize("kind", [C.ONSET, C.REGULAR, C.RELEASE])
 def test_tables_are_converged_in_their_quadrature(beam, kind):
     """Every block of a table (a 40 us step, the highest mode turning by 5 rad) agrees with the same table
@@ -68,7 +74,7 @@ def test_backward_series_is_the_step_solution(beam, kind, M):
     Y = _state_in_contact(sys)
     F = 40.0 + 30.0 * np.sin(3.0 * nodes.u)  # nodal forces (N): any smooth pulse piece
     Yend = np.empty_like(Y)
-    C._end_state(tab, off, Y, Yend, F, 1.0, 0.0, 0, N9, nodes.u.size, par)
+    C._end_state(tab, off, _phases(tab, off, nodes.u.size), Y, Yend, F, 1.0, 0.0, 0, N9, nodes.u.size, par)
     S = np.zeros((C.SERIES_ORDER, 2 * N9 + 2))
     Fs = np.zeros(C.SERIES_ORDER)
     C._series(Yend, F, getattr(nodes, M), h, 0, N9, modes, par, S, Fs)
@@ -81,7 +87,8 @@ def test_backward_series_is_the_step_solution(beam, kind, M):
         for row, v in zip(lag, nodes.u):
             C._lagrange(nodes.u, nodes.wb, scale * v, row)
         Ypart = np.empty_like(Y)
-        C._end_state(part, off, Y, Ypart, lag @ F, 1.0, 0.0, 0, N9, nodes.u.size, par)
+        C._end_state(part, off, _phases(part, off, nodes.u.size), Y, Ypart, lag @ F, 1.0, 0.0, 0, N9, nodes.u.size,
+                     par)
         Yb = np.empty(2 * N9 + 2)
         C._series_at(S, (1.0 - fraction) * h, Yb, 2 * N9 + 2)
         scale_state = np.concatenate([np.full(N9, np.abs(Y[:N9]).max()), np.full(N9, np.abs(Y[N9:2 * N9]).max()),
@@ -110,10 +117,11 @@ def test_observed_order_of_a_collocation_step(beam):
         Y = np.zeros(2 * N9 + 6)
         Y[:2 * N9 + 2] = y0
         ratio = np.ones(4)
+        ph = _phases(tab, off, 4, Omega=par[C._OM])
         for _ in range(n_steps):
-            assert C._forward_step(tab, off, Y, 1.0, 0.0, 0, N9, 4, par, ws, A, ratio, nodes.tail * 0.0)
+            assert C._forward_step(tab, off, ph, Y, 1.0, 0.0, 0, N9, 4, par, ws, A, ratio, nodes.tail * 0.0)
             Ynew = np.empty_like(Y)
-            C._end_state(tab, off, Y, Ynew, ws[C._F, :4].copy(), 1.0, 0.0, 0, N9, 4, par)
+            C._end_state(tab, off, ph, Y, Ynew, ws[C._F, :4].copy(), 1.0, 0.0, 0, N9, 4, par)
             Y = Ynew
         steps.append(h)
         errors.append(abs(Y[2 * N9 + 1] - y_ref[2 * N9 + 1]) / 0.3)
