@@ -498,6 +498,7 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
     at_onset = False
     onset_wall = 0
     h_contact = 0.0
+    c1l = c1ld = c1r = c1rd = 0.0
     t = 0.0
     for p in range(n_periods):
         Y[2 * n + 2:] = 0.0
@@ -505,11 +506,13 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
         onsets = 0
         k = 0  # grid index of the current point (free flight on the grid) or of the last grid point passed
         A_valid = False
+        c_valid = False  # c_l, c_r and their rates at the current grid point known from the last grid step
         t = 0.0 if not in_contact else t
         while True:
             wall = -1  # set to 0/1 when a search locates an onset (state in tmp, at t + tau)
             tau = 0.0
             if in_contact:
+                c_valid = False
                 ks = (int(t / (stride * hg)) + 1) * stride
                 t_stop = T if ks >= N else ks * hg
                 released = False
@@ -564,7 +567,10 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
                     A_valid = True
                 counters[_C_GRID] += 1
                 _apply_flight(Y, Ynew, hg, tr_g, n)
-                c0l, c0ld, c0r, c0rd = _closing_at(Y, rot_g[0, k], rot_g[1, k], n, modes, par)
+                if c_valid:  # the end of the last accepted grid step
+                    c0l, c0ld, c0r, c0rd = c1l, c1ld, c1r, c1rd
+                else:
+                    c0l, c0ld, c0r, c0rd = _closing_at(Y, rot_g[0, k], rot_g[1, k], n, modes, par)
                 c1l, c1ld, c1r, c1rd = _closing_at(Ynew, rot_g[0, k + 1], rot_g[1, k + 1], n, modes, par)
                 Bl = par[_ML0] * hg * hg * 0.125
                 Br = par[_MR0] * hg * hg * 0.125
@@ -582,6 +588,7 @@ def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, s
                     tau, wall = _search(Y, t, hg, n, modes, par, tmp, counters)
                     if wall == -2:
                         return _STALLED_SEARCH, p
+                c_valid = wall < 0
                 if wall < 0:
                     Y[:] = Ynew
                     for j in range(n):
