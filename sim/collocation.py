@@ -63,8 +63,9 @@ TABLE_QUADRATURE = 32
 # tables: layout and construction
 # ----------------------------------------------------------------------------------------------------------
 def _offsets(s: int, n: int) -> np.ndarray:
-    """Offsets of P, Q ((s+1) x n), W ((s+1) x s), BX, BV (s x n), BZ, BZD (s), TR (4 x n), TAU (s+1),
-    WQ (s) in a table, and the table's size (int64 array, indexed by _P ... _SIZE)."""
+    """Offsets of P, Q (n x (s+1), mode by mode), W (s x (s+1), column by column), BX, BV (s x n), BZ, BZD
+    (s), TR (4 x n), TAU (s+1), WQ (s) in a table, and the table's size (int64 array, indexed by _P ... _SIZE).
+    The layouts put the inner loops of the kernels along contiguous memory."""
     r = s + 1
     sizes = (r * n, r * n, r * s, s * n, s * n, s, s, 4 * n, r, s)
     return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
@@ -386,19 +387,6 @@ def _series(Yend, F, M, h, wall, n, modes, par, S, Fs):
                                + sgn * modes[row, j] * Fs[q]) * inv
         S[q + 1, 2 * n] = -S[q, 2 * n + 1] * inv
         S[q + 1, 2 * n + 1] = -sgn * Fs[q] * par[_IMA] * inv
-
-
-@njit(cache=True, inline="always")
-def _horner(C, col, x):
-    """(sum_q C[q, col] x^q, its derivative in x)."""
-    p = C.shape[0]
-    val = C[p - 1, col]
-    slope = (p - 1) * C[p - 1, col]
-    for q in range(p - 2, -1, -1):
-        val = val * x + C[q, col]
-        if q > 0:
-            slope = slope * x + q * C[q, col]
-    return val, slope
 
 
 @njit(cache=True)

@@ -169,8 +169,8 @@ def test_energy_conserved_over_1000_impacts():
 
     Collocated contacts conserve it to ~1e-10 per impact; the drift comes from the contacts that fall back
     to the Dormand-Prince pair (5-10 % in this ringing, undamped case; 2 % in the rig's sweeps) and
-    depends on rtol and on the (chaotic) trajectory: 3e-7 to 4e-7 at the default 1e-10, 3e-8 to 3e-7 at
-    1e-11 (tests/benchmarks/test_exact_energy.py). The test runs at 1e-11."""
+    depends on rtol and on the (chaotic) trajectory: 3e-7 to 9e-7 at 1e-10, 6e-9 to 3e-7 at the default 1e-11
+    (tests/benchmarks/test_exact_energy.py)."""
     model = cantilever_like_model(undamped=True)
     model = ModalModel(frequencies_hz=model.frequencies_hz, damping_ratios=np.full(N9, 1e-15),
                        phi_wall_left=model.phi_wall_left, phi_wall_right=model.phi_wall_right,
@@ -189,7 +189,7 @@ def test_energy_conserved_over_1000_impacts():
     e0 = energy(y)
     impacts = 0
     while impacts < 1000:
-        _, imp = exact.run_step(y, 20, 2 * math.pi * 100.0, 0.0, sys, rtol=1e-11)
+        _, imp = exact.run_step(y, 20, 2 * math.pi * 100.0, 0.0, sys)
         impacts += int(imp.sum())
     drift = abs(energy(y) - e0) / e0
     print(f"\n{impacts} impacts: relative energy change {drift:.2e}")
