@@ -284,27 +284,34 @@ def _forces(delta, F, D, kH, s):
             D[k] = 0.0
 
 
+@njit(cache=True, inline="always")
+def _collocation_equations(tab, off, chom, delta, F, D, A, rhs, s):
+    """The s collocation equations and their Jacobian: rhs[i] = delta_i - chom_i + sum_k W_ik F_k and
+    A[k, i] = delta_ik + W_ik D_k (by columns, as W is stored). Returns max |chom_i| (the indentation scale)."""
+    oW = off[_W]
+    r = s + 1
+    scale = 0.0
+    for i in range(s):
+        rhs[i] = delta[i] - chom[i]
+        scale = max(scale, abs(chom[i]))
+    for k in range(s):
+        f = F[k]
+        dk = D[k]
+        for i in range(s):
+            rhs[i] += tab[oW + k * r + i] * f
+            A[k, i] = tab[oW + k * r + i] * dk
+        A[k, k] += 1.0
+    return scale
+
+
 @njit(cache=True)
 def _newton(tab, off, chom, delta, F, D, A, rhs, s, kH):
     """Solve delta_i = chom_i - sum_k W_ik F(delta_k) for the nodal indentations (delta holds the guess).
 
     Returns the number of iterations, or -1 if Newton's method did not converge."""
-    oW = off[_W]
-    r = s + 1
     for it in range(40):
         _forces(delta, F, D, kH, s)
-        # residuals delta_i - chom_i + sum_k W_ik F_k and the Jacobian by columns (W is stored by columns)
-        scale = 0.0
-        for i in range(s):
-            rhs[i] = delta[i] - chom[i]
-            scale = max(scale, abs(chom[i]))
-        for k in range(s):
-            f = F[k]
-            dk = D[k]
-            for i in range(s):
-                rhs[i] += tab[oW + k * r + i] * f
-                A[k, i] = tab[oW + k * r + i] * dk
-            A[k, k] += 1.0
+        scale = _collocation_equations(tab, off, chom, delta, F, D, A, rhs, s)
         if not _solve_in_place(A, rhs, s):
             return -1
         change = 0.0
@@ -595,22 +602,13 @@ def _release_step(tab, off, ph, S, Fs, ct, st, d, d_lo, d_hi, c_e, cd_e, wall, n
         cb, sb = _rotate(ct, st, -Om * d)
         _free_closing(tab, off, ph, Ys, cb, sb, wall, n, s, par, chom, Yd, dchom)
         _forces(delta, F, D, kH, s)
-        # residuals delta_i - c_hom,i + sum_k W_ik F_k at the nodes, then c_w at the end; d/dd = -d/dt_start
-        scale = abs(chom[s])
-        for i in range(s):
-            rhs[i] = delta[i] - chom[i]
-            scale = max(scale, abs(chom[i]))
+        # the collocation equations at the nodes, then c_w = 0 at the end, and the column of d (d/dd = -d/dt_start)
+        scale = max(_collocation_equations(tab, off, chom, delta, F, D, A, rhs, s), abs(chom[s]))
         rhs[s] = chom[s]
         r = s + 1
         for k in range(s):
-            f = F[k]
-            dk = D[k]
-            for i in range(s):
-                rhs[i] += tab[oW + k * r + i] * f
-                A[k, i] = tab[oW + k * r + i] * dk
-            A[k, k] += 1.0
-            rhs[s] -= tab[oW + k * r + s] * f
-            A[k, s] = -tab[oW + k * r + s] * dk
+            rhs[s] -= tab[oW + k * r + s] * F[k]
+            A[k, s] = -tab[oW + k * r + s] * D[k]
         for i in range(s):
             A[s, i] = dchom[i]
         A[s, s] = -dchom[s]

@@ -12,6 +12,8 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.special import gamma as gamma_fn
 
+from sim import exact
+from sim.energy import energy_parts
 from sim.system import Impactor, ModalModel, system_arrays
 
 
@@ -101,6 +103,26 @@ def cantilever_like_model(n_modes: int = 9, undamped: bool = False) -> ModalMode
         phi_wall_left=phi_c, phi_wall_right=phi_c, phi_tip=0.96 * phi_c,
         participation=np.sqrt(np.array(_EFFECTIVE_MASS_FRACTION[:n_modes]) * mass),
         source="tests: cantilever-like")
+
+
+def ringing_energy_drift(**run_step_options) -> tuple[float, int, dict]:
+    """Relative change of the total energy (`sim.energy`) over >= 1000 impacts of the sphere launched at
+    0.5 m/s in the undamped (D = 1e-15), unforced cantilever-like beam, by `sim.exact.run_step` in calls of
+    20 periods at 100 Hz with these options; with the number of impacts and the kernel's counters."""
+    base = cantilever_like_model(undamped=True)
+    model = ModalModel(frequencies_hz=base.frequencies_hz, damping_ratios=np.full(base.n_modes, 1e-15),
+                       phi_wall_left=base.phi_wall_left, phi_wall_right=base.phi_wall_right,
+                       phi_tip=base.phi_tip, participation=base.participation)
+    sys = system_arrays(model, Impactor())
+    y = np.zeros(2 * base.n_modes + 2)
+    y[-1] = 0.5
+    e0 = energy_parts(y, sys)["total"][0]
+    impacts = 0
+    stats: dict = {}
+    while impacts < 1000:
+        _, imp = exact.run_step(y, 20, 2 * math.pi * 100.0, 0.0, sys, stats=stats, **run_step_options)
+        impacts += int(imp.sum())
+    return abs(energy_parts(y, sys)["total"][0] - e0) / e0, impacts, stats
 
 
 def test_reference_reproduces_the_hertz_impact_on_a_rigid_wall():
