@@ -580,7 +580,7 @@ def _release_step(tab, off, ph, S, Fs, ct, st, d, d_lo, d_hi, c_e, cd_e, wall, n
     D = ws[_D]
     rhs = ws[_RHS]
     Ys = ws[_YS]
-    Yd = ws[_YNEW]
+    Yd = ws[_YNEW]  # dY/dt at the start (the row is free while the release step runs)
     Om = par[_OM]
     kH = par[_KH]
     sgn = 1.0 if wall == 0 else -1.0

@@ -67,8 +67,8 @@ from sim.system import SystemArrays, check_run_step
 GRID_PER_PERIOD = 48
 #: Default tolerance of the Dormand-Prince contact steps, relative to the clearance g (error per step, in m / g).
 #: They only take the contacts collocation leaves (2 % in sweeps), so it is tight: the energy drift over 1000
-#: impacts is theirs, 3e-7 to 9e-7 at 1e-10 depending on the trajectory, 6e-9 to 3e-7 at 1e-11 (about 2 % more
-#: time per point; tests/benchmarks/test_exact_energy.py).
+#: impacts is theirs, 3e-7 to 9e-7 at 1e-10 depending on the trajectory, 6e-9 to 3e-7 at 1e-11, at no measurable
+#: cost per point (tests/benchmarks/test_exact_energy.py).
 CONTACT_RTOL = 1e-11
 #: Onset/release location tolerance on the closing function, relative to g.
 GAP_TOLERANCE = 1e-12
