@@ -20,7 +20,7 @@ import numpy as np
 from uq.errors import StudyError
 from uq.interval import Band, Design, DesignPoint, axis_design, band, box_design
 from uq.output import dumps, write_text
-from uq.runner import ResultStore, Task, check_scheduler, prepare_output, run_tasks
+from uq.runner import ResultStore, Task, dask_client, prepare_output, run_tasks
 from uq.study import Study
 
 
@@ -88,11 +88,14 @@ def _runs_rows(results: dict, points: Sequence[dict], study: Study, outputs: Seq
     return rows
 
 
-def _start(study: Study, out: Path | None, resume: bool, scheduler: str | None) -> tuple[Any, Path, StudyResult]:
+def _checked_model(study: Study) -> Any:
     model = study.make_model()
     model.check()
-    if scheduler is not None:
-        check_scheduler(scheduler)
+    return model
+
+
+def _start(study: Study, model: Any, out: Path | None, resume: bool) -> tuple[Any, Path, StudyResult]:
+    """The model with its rig built, and the output folder (prepared only once the cluster, if any, answered)."""
     if hasattr(model, "with_rig"):
         model = model.with_rig()
     folder = prepare_output(out or study.output, resume=resume)
@@ -127,7 +130,7 @@ def interval_designs(study: Study) -> list[Design]:
 def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, scheduler: str | None = None,
                        resume: bool = False, progress: bool = True, client: Any = None) -> StudyResult:
     """Interval study (Figs. 7 and 8): bands of the repetition-mean resonant levels per excitation level."""
-    model, folder, result = _start(study, out, resume, scheduler)
+    model = _checked_model(study)
     designs = interval_designs(study)
     nominal = DesignPoint(study.space.nominal(), "nominal", "nominal")
     unique: dict[tuple, dict] = {nominal.key(): dict(nominal.values)}
@@ -136,10 +139,12 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
             unique.setdefault(p.key(), dict(p.values))
     points = list(unique.values())
     index = {key: i for i, key in enumerate(unique)}
-    t0 = time.perf_counter()
-    results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
-                        scheduler=scheduler, progress=progress, client=client)
-    elapsed = time.perf_counter() - t0
+    with dask_client(scheduler, client) as client:  # one connection for the whole study
+        model, folder, result = _start(study, model, out, resume)
+        t0 = time.perf_counter()
+        results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
+                                 progress=progress, client=client)
+        elapsed = time.perf_counter() - t0
     names, outputs = study.space.names, list(model.banded_outputs)
     level_labels = [f"level {lv:g}" for lv in study.levels]
     stats = statistics(model, results, points, study)
@@ -212,14 +217,16 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     with the share of their variance that is repetition noise."""
     from uq.sobol import sobol_indices, sobol_sample
 
-    model, folder, result = _start(study, out, resume, scheduler)
+    model = _checked_model(study)
     n = n or study.sobol_n
     X = sobol_sample(study.space, n, seed=study.seed)
     points = [study.space.from_values(x) for x in X]
-    t0 = time.perf_counter()
-    results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
-                        scheduler=scheduler, progress=progress, client=client)
-    elapsed = time.perf_counter() - t0
+    with dask_client(scheduler, client) as client:  # one connection for the whole study
+        model, folder, result = _start(study, model, out, resume)
+        t0 = time.perf_counter()
+        results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
+                                 progress=progress, client=client)
+        elapsed = time.perf_counter() - t0
     names, outputs = study.space.names, list(model.banded_outputs)
     rows, summary_rows, per_level = [], [], {}
     stats = statistics(model, results, points, study)

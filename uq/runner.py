@@ -18,9 +18,10 @@ import math
 import os
 import sys
 import time
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, is_dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping, Sequence
+from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 from uq.errors import StudyError
 from uq.output import write_text
@@ -139,9 +140,18 @@ def _run_one(model: Callable, key: str, task: Task, seed: int) -> tuple[str, dic
     return key, evaluate(model, task, seed)
 
 
-def check_scheduler(address: str) -> None:
-    """Refuse an unreachable Dask scheduler before anything is written (one-line StudyError)."""
-    _connect(address).close()
+@contextmanager
+def dask_client(scheduler: str | None, client: Any = None) -> Iterator[Any]:
+    """The Dask client of a study, connected once for all its tasks: `client` as given, else a connection to
+    `scheduler` (an unreachable address is a one-line StudyError; closed on exit), else None (local)."""
+    if client is not None or scheduler is None:
+        yield client
+        return
+    own = _connect(scheduler)
+    try:
+        yield own
+    finally:
+        own.close()
 
 
 def _connect(address: str):

@@ -46,6 +46,15 @@ def test_sobol_command_on_ishigami(tmp_path, capsys):
     assert meta["study"]["sobol"]["n"] == 64 and meta["summary"]["base_sample"] == 512
 
 
+def test_sobol_bad_sample_size_writes_nothing(tmp_path, capsys):
+    study = tmp_path / "s.toml"
+    study.write_text("[study]\nkind = 'sobol'\nmodel = 'ishigami'\n")
+    assert main(["sobol", str(study), "--n", "100", "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "power of two" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "o").exists()
+
+
 def test_noisy_model_noise_share_and_no_false_flags(tmp_path, models_on_path):
     from uq.study import load_study
     from uq.execute import run_interval_study, run_sobol_study
@@ -136,4 +145,13 @@ def test_reproduce_bad_integrator_writes_nothing(tmp_path, capsys):
     assert main(["reproduce", "all", "--quick", "--integrator", "rk99", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert "unknown integrator 'rk99'" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_reproduce_unreachable_scheduler_fails_before_the_calibration(tmp_path, capsys):
+    pytest.importorskip("distributed")
+    out = tmp_path / "o"
+    assert main(["reproduce", "all", "--quick", "--scheduler", "tcp://127.0.0.1:9", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "cannot reach the Dask scheduler" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()

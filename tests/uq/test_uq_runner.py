@@ -58,13 +58,19 @@ def test_jobs_2_gives_identical_numbers(serial, tmp_path):
     assert data_of(out) == data_of(serial)
 
 
-def test_dask_local_cluster_gives_identical_numbers(serial, tmp_path):
+def test_dask_local_cluster_gives_identical_numbers(serial, tmp_path, monkeypatch):
     distributed = pytest.importorskip("distributed")
+    from uq import runner
+
+    addresses = []
+    connect = runner._connect
+    monkeypatch.setattr(runner, "_connect", lambda address: addresses.append(address) or connect(address))
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         out = tmp_path / "out"
         assert main(["interval", str(tiny_study(tmp_path)), "--out", str(out), "--scheduler",
                      cluster.scheduler_address, "--quiet", "--jobs", "1", "--no-figures"]) == 0
     assert data_of(out) == data_of(serial)
+    assert addresses == [cluster.scheduler_address]  # one connection serves the whole study
 
 
 def test_unreachable_scheduler_is_one_line(tmp_path, capsys):

@@ -16,6 +16,7 @@ import subprocess
 import sys
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 NAME = "reproduce"
 HELP = "reproduce the paper's Figs. 7 and 8 (uncertainty of D, g, k_H) with the shipped studies"
@@ -91,11 +92,7 @@ def with_calibration(study, k_H_cal: float):
 
 
 def run(args: argparse.Namespace) -> int:
-    from uq.errors import StudyError
-    from uq.execute import run_interval_study
-    from uq.figures import interval_figures
-    from uq.runner import check_writable
-    from uq.space import K_H_STAR, calibrated_k_H
+    from uq.runner import check_writable, dask_client
     from uq.study import load_study
 
     figures = ("fig7", "fig8") if args.figure == "all" else (args.figure,)
@@ -106,8 +103,19 @@ def run(args: argparse.Namespace) -> int:
         studies = [replace(s, modal_model=args.model) for s in studies]
     for s in studies:
         s.make_model().check()  # bad settings (e.g. an unknown integrator) fail here, before anything is written
+    with dask_client(args.scheduler) as client:  # connected once, first: a bad address leaves nothing behind
+        check_writable(args.out)
+        return _reproduce(args, figures, studies, client)
+
+
+def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list, client: Any) -> int:
+    """Calibration (unless disabled), then each figure's interval study, its figures and its summary."""
+    from uq.errors import StudyError
+    from uq.execute import run_interval_study
+    from uq.figures import interval_figures
+    from uq.space import K_H_STAR, calibrated_k_H
+
     out = args.out
-    check_writable(out)
     calibration = None
     if args.calibration is not None:
         calibration = {"k_H": calibrated_k_H(args.calibration), "source": str(args.calibration)}
@@ -123,8 +131,8 @@ def run(args: argparse.Namespace) -> int:
     for figure, study in zip(figures, studies):
         folder = out / figure
         print(f"{figure}: {study.source} -> {folder}/")
-        result = run_interval_study(study, out=folder, jobs=args.jobs, scheduler=args.scheduler,
-                                    resume=args.resume, progress=not args.quiet)
+        result = run_interval_study(study, out=folder, jobs=args.jobs, client=client, resume=args.resume,
+                                    progress=not args.quiet)
         paths = interval_figures(result.folder)
         s = result.summary
         print(f"{figure}: {s['tasks']} runs ({s['ran']} run now), {s['failed_runs']} failed, "
