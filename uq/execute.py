@@ -94,12 +94,19 @@ def _checked_model(study: Study) -> Any:
     return model
 
 
-def _start(study: Study, model: Any, out: Path | None, resume: bool) -> tuple[Any, Path, StudyResult]:
-    """The model with its rig built, and the output folder (prepared only once the cluster, if any, answered)."""
-    if hasattr(model, "with_rig"):
-        model = model.with_rig()
-    folder = prepare_output(out or study.output, resume=resume)
-    return model, folder, StudyResult(folder)
+def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, resume: bool, jobs: int,
+                scheduler: str | None, progress: bool, client: Any) -> tuple[Any, StudyResult, dict, int, float]:
+    """Connect to the cluster once (if any), then prepare the output folder and run every task of `points`.
+
+    Returns the model (rig built), the StudyResult, results by task, how many ran now, and the time (s)."""
+    with dask_client(scheduler, client) as client:
+        if hasattr(model, "with_rig"):
+            model = model.with_rig()
+        folder = prepare_output(out or study.output, resume=resume)
+        t0 = time.perf_counter()
+        results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
+                                 progress=progress, client=client)
+        return model, StudyResult(folder), results, ran, time.perf_counter() - t0
 
 
 def _metadata(study: Study, model: Any, result: StudyResult, extra: dict) -> Path:
@@ -139,12 +146,9 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
             unique.setdefault(p.key(), dict(p.values))
     points = list(unique.values())
     index = {key: i for i, key in enumerate(unique)}
-    with dask_client(scheduler, client) as client:  # one connection for the whole study
-        model, folder, result = _start(study, model, out, resume)
-        t0 = time.perf_counter()
-        results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
-                                 progress=progress, client=client)
-        elapsed = time.perf_counter() - t0
+    model, result, results, ran, elapsed = _run_points(study, model, points, out, resume, jobs, scheduler, progress,
+                                                       client)
+    folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
     level_labels = [f"level {lv:g}" for lv in study.levels]
     stats = statistics(model, results, points, study)
@@ -221,12 +225,9 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     n = n or study.sobol_n
     X = sobol_sample(study.space, n, seed=study.seed)
     points = [study.space.from_values(x) for x in X]
-    with dask_client(scheduler, client) as client:  # one connection for the whole study
-        model, folder, result = _start(study, model, out, resume)
-        t0 = time.perf_counter()
-        results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
-                                 progress=progress, client=client)
-        elapsed = time.perf_counter() - t0
+    model, result, results, ran, elapsed = _run_points(study, model, points, out, resume, jobs, scheduler, progress,
+                                                       client)
+    folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
     rows, summary_rows, per_level = [], [], {}
     stats = statistics(model, results, points, study)
