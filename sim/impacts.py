@@ -59,9 +59,10 @@ class ImpactDetection:
     """Impacts found by `detect_impacts` (Appendix D.1).
 
     times (s), walls ("left", "right", or "unknown" when both sensors see the same), peaks (envelope height,
-    m/s^2): every impact at the lowest threshold, in time order; thresholds: the factors (-) applied to reference_rms, the RMS of the low-passed tip
-    acceleration (m/s^2); excitation_hz (Hz) and whether it was estimated; fs (Hz), duration (s) of the
-    signal; highpass_hz, lowpass_hz (Hz), min_separation (s): the settings used.
+    m/s^2): every impact at the lowest threshold, in time order; thresholds: the factors (-) applied to
+    reference_rms, the RMS of the low-passed tip acceleration (m/s^2); excitation_hz (Hz) and whether it
+    was estimated; fs (Hz), duration (s) of the signal; highpass_hz, lowpass_hz (Hz), min_separation (s):
+    the settings used.
     """
 
     times: np.ndarray
