@@ -1,0 +1,211 @@
+"""Modal reconstruction between impacts, Eq. 9 (sim.modal_fit): exact recovery of known coefficients, the
+conditioning of the mode-1 split, the warnings, and the simulator's modal energies after impacts."""
+import json
+
+import numpy as np
+import pytest
+
+from sim.errors import SimulationInputError
+from sim.modal_fit import GUARD, MAX_CONDITION, fit_modes, load_model, plot_modal_fit
+from sim.modal_file import save_modal_model
+from sim.signals import make_signal
+
+FS = 51200.0
+
+
+def eq9_velocity(tau, model, Omega, A, B, alpha, beta):
+    """d/dtau of Eq. 9 written out term by term (tau from the window's start, s)."""
+    w, D, phi = model.omega, model.damping_ratios, model.phi_tip
+    sigma, wd = D * w, w * np.sqrt(1 - D**2)
+    tau = tau[:, None]
+    free = np.exp(-sigma * tau) * ((-sigma * alpha + wd * beta) * np.cos(wd * tau) - (sigma * beta + wd * alpha) * np.sin(wd * tau))
+    particular = Omega * (-A * np.sin(Omega * tau[:, 0]) + B * np.cos(Omega * tau[:, 0]))
+    return phi[0] * particular + free @ phi
+
+
+def window_state(model, Omega, A, B, alpha, beta):
+    """s_j(0), s_j'(0) of Eq. 9's coefficients (mode 1 with its particular part)."""
+    w, D = model.omega, model.damping_ratios
+    s0 = alpha.copy()
+    v0 = -D * w * alpha + w * np.sqrt(1 - D**2) * beta
+    s0[0] += A
+    v0[0] += Omega * B
+    return s0, v0
+
+
+def synthetic_velocity(model, Omega, impacts, duration, seed=0, noise=0.0):
+    """Tip velocity that follows Eq. 9 with random coefficients in each window between impacts (jumps at the
+    impacts); returns the signal and the coefficients of each window with tau from its first sample after the
+    guard."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(duration * FS)) / FS
+    v = np.zeros(t.size)
+    truth = []
+    bounds = np.r_[impacts, t[-1] + 1.0]
+    scale = 1e-3 / np.arange(1, model.n_modes + 1) ** 2  # m sqrt(kg): mode 1 ~ 1 mm, higher modes smaller
+    for impact, following in zip(bounds[:-1], bounds[1:]):
+        A, B = rng.normal(0, 1e-3, 2)
+        alpha, beta = rng.normal(0, 1, (2, model.n_modes)) * scale
+        start = t[np.searchsorted(t, impact + GUARD)]
+        inside = (t > impact) & (t < following)
+        v[inside] = eq9_velocity(t[inside] - start, model, Omega, A, B, alpha, beta)
+        truth.append((A, B, alpha, beta))
+    v += rng.normal(0.0, noise * np.std(v), t.size)
+    return make_signal(t, {"v_tip": v}), truth
+
+
+@pytest.fixture(scope="module")
+def rig():
+    return load_model("builtin")
+
+
+def test_known_coefficients_are_recovered_exactly(rig):
+    Omega = 0.976 * rig.omega[0]
+    impacts = np.array([0.002, 0.0061, 0.0105, 0.0152])
+    signal, truth = synthetic_velocity(rig, Omega, impacts, 0.02)
+    fit = fit_modes(signal, rig, impacts, excitation_hz=Omega / (2 * np.pi))
+    assert not fit.warnings and len(fit.windows) == impacts.size
+    for window, (A, B, alpha, beta) in zip(fit.windows, truth):
+        assert window.well_posed and window.residual < 1e-9
+        s0, v0 = window_state(rig, Omega, A, B, alpha, beta)
+        np.testing.assert_allclose(window.displacement, s0, rtol=1e-7, atol=1e-12 * np.abs(s0).max())
+        np.testing.assert_allclose(window.velocity, v0, rtol=1e-7, atol=1e-12 * np.abs(v0).max())
+        np.testing.assert_allclose(window.energies, 0.5 * (v0**2 + (rig.omega * s0) ** 2), rtol=1e-6)
+        np.testing.assert_allclose([window.A, window.B], [A, B], rtol=1e-5)
+        np.testing.assert_allclose(window.alpha, alpha, rtol=1e-5, atol=1e-9 * np.abs(alpha).max())
+        np.testing.assert_allclose(window.beta, beta, rtol=1e-5, atol=1e-9 * np.abs(beta).max())
+    np.testing.assert_allclose(fit.reconstruction(signal.t[200:300]), signal["v_tip"][200:300], rtol=1e-8, atol=1e-12)
+    energies = fit.energies
+    assert fit.higher_share == pytest.approx(energies[:, 1:].sum() / energies.sum())
+
+
+def test_mode_one_energy_is_well_determined_where_its_split_is_not(rig):
+    """Omega = 0.976 omega_1 over 4 ms windows: Eq. 9's own columns (particular solution and free mode 1)
+    are nearly collinear, ours are not; with noise A and alpha_1 scatter, mode 1's state does not."""
+    Omega = 0.976 * rig.omega[0]
+    impacts = np.arange(0.002, 0.04, 0.0043)
+    signal, truth = synthetic_velocity(rig, Omega, impacts, 0.045, seed=3, noise=1e-4)
+    fit = fit_modes(signal, rig, impacts, excitation_hz=Omega / (2 * np.pi))
+    energy_error, split_error = [], []
+    for window, (A, B, alpha, beta) in zip(fit.windows, truth):
+        s0, v0 = window_state(rig, Omega, A, B, alpha, beta)
+        energy_error.append(abs(window.energies[0] / (0.5 * (v0[0] ** 2 + (rig.omega[0] * s0[0]) ** 2)) - 1))
+        split_error.append(abs(window.A - A) / np.hypot(A, B))
+    assert max(energy_error) < 2e-3 and max(split_error) > 10 * max(energy_error)
+    # condition numbers: Eq. 9's columns as they stand against the ones of the fit
+    tau = signal.t[: int(0.0039 * FS)]
+    columns = [eq9_velocity(tau, rig, Omega, *unit) for unit in _unit_coefficients(rig.n_modes)]
+    naive = np.column_stack(columns)
+    naive /= np.linalg.norm(naive, axis=0)
+    assert np.linalg.cond(naive) > 10 * max(window.condition for window in fit.windows)
+    assert max(window.condition for window in fit.windows) < MAX_CONDITION
+
+
+def _unit_coefficients(n):
+    for k in range(2 * n + 2):
+        c = np.zeros(2 * n + 2)
+        c[k] = 1.0
+        yield c[0], c[1], c[2:2 + n], c[2 + n:]
+
+
+def test_short_windows_are_flagged_or_skipped(rig):
+    Omega = 0.976 * rig.omega[0]
+    impacts = np.array([0.002, 0.0061, 0.0068, 0.0080, 0.0121])  # 0.7 ms, 1.2 ms - guards, then 4 ms
+    signal, _ = synthetic_velocity(rig, Omega, impacts, 0.016)
+    fit = fit_modes(signal, rig, impacts, excitation_hz=Omega / (2 * np.pi))
+    assert [round(w.impact, 4) for w in fit.windows] == [0.002, 0.0068, 0.008, 0.0121]
+    assert [w.well_posed for w in fit.windows] == [True, False, True, True]
+    assert len(fit.warnings) == 2
+    assert "after the impact at 0.006100 s" in fit.warnings[0] and "not fitted" in fit.warnings[0]
+    assert "after the impact at 0.006800 s" in fit.warnings[1] and "shorter than one period of mode 2" in fit.warnings[1]
+
+
+def test_a_missed_impact_is_flagged_by_the_misfit(rig):
+    Omega = 0.976 * rig.omega[0]
+    impacts = np.array([0.002, 0.0061, 0.0105])
+    signal, _ = synthetic_velocity(rig, Omega, impacts, 0.015)
+    complete = fit_modes(signal, rig, impacts, excitation_hz=Omega / (2 * np.pi))
+    missing = fit_modes(signal, rig, impacts[[0, 2]], excitation_hz=Omega / (2 * np.pi))
+    assert all(w.well_posed for w in complete.windows)
+    assert [w.well_posed for w in missing.windows] == [False, True]
+    assert "relative misfit" in missing.warnings[0]
+
+
+@pytest.mark.timeout(600)
+@pytest.mark.parametrize("impacts", ["simulator", "detected"])
+def test_simulated_modal_energies_after_impacts(impacts):
+    """Issue 15 acceptance: the simulator's modal energies after impacts within 2 % (mode 1) and 10 %
+    (modes 2..9), in every well-posed window, with the simulator's contact onsets or with the detector's
+    impacts at its defaults (its false detections only split windows; windows holding a contact it missed
+    are flagged by their misfit)."""
+    from _traces import rig_trace
+
+    trace = rig_trace()
+    s = trace.signal
+    given = trace.contacts.times if impacts == "simulator" else None
+    fit = fit_modes(s, trace.model, given, excitation_hz=trace.Omega / (2 * np.pi))
+    good = [w for w in fit.windows if w.well_posed]
+    assert len(good) >= (120 if impacts == "simulator" else 40)
+    n = trace.model.n_modes
+    errors = []
+    for window in good:
+        row = trace.states[int(round((window.start - s.t[0]) * s.fs))]
+        true = 0.5 * (row[n:2 * n] ** 2 + (trace.model.omega * row[:n]) ** 2)
+        errors.append(np.abs(window.energies / true - 1))
+    errors = np.array(errors)
+    assert errors[:, 0].max() <= 0.02 and errors[:, 1:].max() <= 0.10, errors.max(axis=0)
+    assert 0.0 < fit.higher_share < 0.5
+
+
+def test_model_option(tmp_path, rig):
+    assert rig.n_modes == 9 and "seed rig" in rig.source
+    path = tmp_path / "rig.toml"
+    save_modal_model(rig, path)
+    np.testing.assert_allclose(load_model(path).frequencies_hz, rig.frequencies_hz)
+    with pytest.raises(SimulationInputError, match="not found"):
+        load_model(tmp_path / "nothing.toml")
+
+
+@pytest.mark.parametrize("columns, options, expected", [
+    ({"a_tip": 1}, {"impacts": [0.01]}, "missing column(s) v_tip"),
+    ({"v_tip": 1}, {}, "missing column(s) a_left, a_right, a_tip"),
+    ({"v_tip": 1}, {"impacts": [0.01], "guard": -1.0}, "guard"),
+    ({"v_tip": 1}, {"impacts": [np.nan]}, "impact times"),
+    ({"v_tip": 1}, {"impacts": [0.01], "excitation_hz": 0.0}, "excitation frequency"),
+    ({"v_tip": 1}, {"impacts": [0.01], "max_residual": 0.0}, "max_residual"),
+    ({"v_tip": 1}, {"impacts": [0.01], "model": "no-such-model.toml"}, "not found"),
+])
+def test_bad_input_gives_one_line(columns, options, expected):
+    t = np.arange(2048) / FS
+    signal = make_signal(t, {name: np.cos(2 * np.pi * 117 * t) for name in columns})
+    options = {"model": "builtin", **options}
+    with pytest.raises(SimulationInputError) as info:
+        fit_modes(signal, options.pop("model"), **options)
+    assert expected in str(info.value) and "\n" not in str(info.value)
+
+
+def test_result_as_json(rig):
+    Omega = 0.976 * rig.omega[0]
+    signal, _ = synthetic_velocity(rig, Omega, np.array([0.002, 0.0061]), 0.01)
+    fit = fit_modes(signal, rig, [0.002, 0.0061], excitation_hz=Omega / (2 * np.pi))
+    document = json.loads(json.dumps(fit.to_dict()))
+    assert document["higher_share"] == pytest.approx(fit.higher_share)
+    assert len(document["windows"]) == 2 and len(document["windows"][0]["energies"]) == 9
+    assert {"condition", "residual", "well_posed", "A", "B", "alpha", "beta"} <= set(document["windows"][0])
+
+
+def test_plot_is_written_atomically(tmp_path, rig):
+    Omega = 0.976 * rig.omega[0]
+    impacts = np.array([0.002, 0.0061, 0.0105])
+    signal, _ = synthetic_velocity(rig, Omega, impacts, 0.015)
+    fit = fit_modes(signal, rig, impacts, excitation_hz=Omega / (2 * np.pi))
+    target = plot_modal_fit(fit, tmp_path / "fig9b.png", velocity_scale=0.5)
+    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fig9b.png"]
+    for path, options, expected in ((tmp_path / "missing" / "f.png", {}, "does not exist"),
+                                    (tmp_path / "f.xyz", {}, "unknown figure format"),
+                                    (tmp_path / "f.png", {"velocity_scale": -1.0}, "velocity_scale"),
+                                    (tmp_path / "f.png", {"t_range": (0.01, 0.0)}, "t_range")):
+        with pytest.raises(SimulationInputError, match=expected):
+            plot_modal_fit(fit, path, **options)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fig9b.png"]
