@@ -244,17 +244,16 @@ def ring_down_bound(fs: float, highpass_hz: float, span: float = RING_DOWN_SPAN)
 
 def _without_ring_down(peaks: np.ndarray, heights: np.ndarray, bound: np.ndarray,
                        margin: float = RING_DOWN_MARGIN) -> np.ndarray:
-    """The peaks that no larger peak explains as its filter ring-down: going from the largest down, a peak
-    is dropped if its height <= margin * (height of a kept peak) * bound[lag in samples]."""
-    kept: list[int] = []
+    """The peaks (ascending sample indices) that no larger peak explains as its filter ring-down: going from
+    the largest down, a peak is dropped if its height <= margin * (height of a kept peak) * bound[lag]."""
+    kept = np.zeros(peaks.size, dtype=bool)
+    first = np.searchsorted(peaks, peaks - bound.size + 1)  # the neighbours within the bound's span
+    stop = np.searchsorted(peaks, peaks + bound.size)
     for q in np.argsort(-heights, kind="stable"):
-        if kept:
-            lag = np.abs(peaks[kept] - peaks[q])
-            near = lag < bound.size
-            if np.any(heights[q] <= margin * heights[kept][near] * bound[lag[near]]):
-                continue
-        kept.append(int(q))
-    return np.sort(peaks[kept])
+        near = first[q] + np.flatnonzero(kept[first[q]:stop[q]])
+        if not np.any(heights[q] <= margin * heights[near] * bound[np.abs(peaks[near] - peaks[q])]):
+            kept[q] = True
+    return peaks[kept]
 
 
 def _wall(left_peak: float, right_peak: float) -> str:
