@@ -156,7 +156,9 @@ def estimate_excitation_hz(x: np.ndarray, fs: float, max_hz: float) -> float:
 
     The largest peak of the Hann-windowed spectrum (DC and the lowest two bins excluded) is refined by a
     least-squares fit of c + a cos(2 pi f t) + b sin(2 pi f t) over f within one bin of it (unfiltered x:
-    components far from f barely change the fit, while a filter's edge transients would bias it).
+    components far from f barely change the fit, while a filter's edge transients would bias it). Free
+    vibration of the resonant mode (set off by the impacts) pulls the estimate towards omega_1: by 0.1 %
+    (almost periodic) and 0.2 % (strongly modulated response) on simulated traces of the rig at level 7.4.
     """
     n = x.size
     resolution = fs / n

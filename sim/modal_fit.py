@@ -185,6 +185,9 @@ def load_model(spec: str | os.PathLike | ModalModel) -> ModalModel:
         return seed_rig_model(n_modes=9)
     from sim.modal_file import load_modal_model
 
+    if not Path(spec).exists():
+        raise SimulationInputError(f"unknown model {str(spec)!r}: give 'builtin' or the path of a modal-model file "
+                                   "(.toml, as written by `ies modes --save`)")
     return load_modal_model(spec)
 
 
