@@ -26,13 +26,13 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 import tomllib
 from pathlib import Path
 
 import numpy as np
 
 from sim.errors import SimulationInputError
+from sim.files import write_text
 from sim.system import ModalModel
 
 FORMAT_NAME = "ies-modal-model"
@@ -114,23 +114,10 @@ def modal_model_document(model: ModalModel) -> dict:
 
 
 def save_modal_model(model: ModalModel, path: str | os.PathLike) -> Path:
-    """Write `model` as a modal-model file, atomically (a temporary file renamed onto `path`)."""
+    """Write `model` as a modal-model file (format in this module's docstring), atomically (`sim.files`)."""
     import tomli_w
 
-    target = Path(path)
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise SimulationInputError(f"cannot write {target}: folder {folder} does not exist; create it or choose another path")
-    if target.is_dir():
-        raise SimulationInputError(f"cannot write {target}: it is a folder; give a file name such as modes.toml")
-    text = _HEADER + tomli_w.dumps(modal_model_document(model))
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=".toml", dir=folder)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return target
+        return write_text(path, _HEADER + tomli_w.dumps(modal_model_document(model)))
+    except (FileNotFoundError, IsADirectoryError) as exc:  # a missing folder, or a folder named as the file
+        raise SimulationInputError(exc.strerror) from None

@@ -72,7 +72,7 @@ def test_indentation_reference_is_reported_and_the_raw_scan_stays_available(tmp_
     captured = capsys.readouterr()
     assert captured.out == "" and captured.err.count("\n") == 1 and "--denoise -3" in captured.err
     from scans import DEFAULT_DENOISE
-    from uq.commands.calibrate import DEFAULT_DENOISE_UM
+    from bem_contact.cli import DEFAULT_DENOISE_UM
 
     assert DEFAULT_DENOISE_UM * 1e-6 == pytest.approx(DEFAULT_DENOISE, rel=1e-12)  # the CLI's copy of the default
     assert main(["calibrate", str(path), "--denoise", "400", "--json", *FAST]) == 0

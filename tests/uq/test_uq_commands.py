@@ -106,7 +106,7 @@ def test_reproduce_rejects_bad_calibration(tmp_path, capsys):
 
 
 def test_calibrated_k_H_becomes_the_upper_bound():
-    from uq.commands.reproduce import study_file, with_calibration
+    from uq.commands import study_file, with_calibration
     from uq.space import K_H_STAR
     from uq.study import load_study
 
@@ -120,7 +120,7 @@ def test_calibrated_k_H_becomes_the_upper_bound():
 
 def test_reproduce_uses_the_calibrated_k_H(tmp_path, monkeypatch, capsys):
     """`ies reproduce` end to end on a tiny simulator study: calibrated k_H bound, data, figures, trends."""
-    import uq.commands.reproduce as reproduce
+    import uq.commands as reproduce
     from uq.space import K_H_STAR
 
     tiny = tmp_path / "tiny.toml"
