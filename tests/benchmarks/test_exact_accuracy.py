@@ -5,15 +5,10 @@ and for the paper's ode3 at dt, dt/2, dt/4, dt/8 (dt = 2 pi/(15 omega_9)), on a 
 
 Run: pytest -m benchmark tests/benchmarks/test_exact_accuracy.py -s
 """
-import sys
-from pathlib import Path
-
 import pytest
 
 from sim import exact, ode3
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sim"))
-from test_exact import per_impact_errors  # noqa: E402
+from tests.sim.test_exact import per_impact_errors
 
 pytestmark = pytest.mark.benchmark
 

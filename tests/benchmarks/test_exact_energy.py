@@ -4,13 +4,9 @@ contact by Dormand-Prince at rtol 1e-7.
 
 Run: pytest -m benchmark tests/benchmarks/test_exact_energy.py -s
 """
-import sys
-from pathlib import Path
-
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sim"))
-from test_exact_reference import ringing_energy_drift  # noqa: E402
+from sim.references import ringing_energy_drift
 
 pytestmark = pytest.mark.benchmark
 

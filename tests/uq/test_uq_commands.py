@@ -1,14 +1,12 @@
 """`ies sobol`, `ies interval` and `ies reproduce` end to end on analytic and noisy models."""
 import csv
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from uq.cli import main
 
-HERE = Path(__file__).parent
 AB = """
 [parameters.a]
 nominal = 0.5
@@ -24,11 +22,6 @@ max = 1.0
 def rows(path):
     with open(path, newline="") as fh:
         return list(csv.DictReader(fh))
-
-
-@pytest.fixture
-def models_on_path(monkeypatch):
-    monkeypatch.syspath_prepend(str(HERE))
 
 
 def test_sobol_command_on_ishigami(tmp_path, capsys):
@@ -55,11 +48,11 @@ def test_sobol_bad_sample_size_writes_nothing(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
-def test_noisy_model_noise_share_and_no_false_flags(tmp_path, models_on_path):
+def test_noisy_model_noise_share_and_no_false_flags(tmp_path):
     from uq.study import load_study
     from uq.execute import run_interval_study, run_sobol_study
 
-    text = "[study]\nkind = '{kind}'\nmodel = '_uq_models:noisy_linear'\nrepetitions = {reps}\nseed = 3\n" + AB
+    text = "[study]\nkind = '{kind}'\nmodel = 'uq.test_functions:noisy_linear'\nrepetitions = {reps}\nseed = 3\n" + AB
     path = tmp_path / "i.toml"
     path.write_text(text.format(kind="interval", reps=8) + "[interval]\ndesigns = ['individual', 'joint']\ninterior = 3\n")
     res = run_interval_study(load_study(path), out=tmp_path / "i", progress=False)
@@ -74,9 +67,9 @@ def test_noisy_model_noise_share_and_no_false_flags(tmp_path, models_on_path):
     assert share == pytest.approx(0.01 / (5 / 12 + 0.01), rel=0.25)
 
 
-def test_failed_runs_are_reported_not_hidden(tmp_path, models_on_path, capsys):
+def test_failed_runs_are_reported_not_hidden(tmp_path, capsys):
     path = tmp_path / "f.toml"
-    path.write_text("[study]\nkind = 'sobol'\nmodel = '_uq_models:failing'\nrepetitions = 2\n" + AB + "[sobol]\nn = 32\n")
+    path.write_text("[study]\nkind = 'sobol'\nmodel = 'uq.test_functions:failing'\nrepetitions = 2\n" + AB + "[sobol]\nn = 32\n")
     assert main(["sobol", str(path), "--out", str(tmp_path / "o"), "--quiet", "--jobs", "1", "--no-figures"]) == 0
     err = capsys.readouterr().err
     assert "runs failed" in err and "not analysed" in err and "no finite run" in err
