@@ -148,3 +148,36 @@ def test_reproduce_unreachable_scheduler_fails_before_the_calibration(tmp_path, 
     err = capsys.readouterr().err
     assert "cannot reach the Dask scheduler" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_reproduce_calibrates_in_process(tmp_path, monkeypatch, capsys):
+    """Without --calibration FILE the front door's calibration (bem_contact.cli.calibrate_default, the shipped
+    crater) runs in this process; its JSON is kept in OUT/calibration.json and bounds k_H."""
+    import uq.commands as reproduce
+    from uq.space import K_H_STAR
+
+    tiny = tmp_path / "tiny.toml"
+    tiny.write_text("[study]\nkind = 'interval'\nrepetitions = 1\n[parameters.k_H]\n[excitation]\nlevels = [7.4]\n"
+                    "eta = { start = 0.975, stop = 0.98, n = 2 }\nwait = 0.1\nhold = 0.1\n[interval]\ninterior = 0\n"
+                    "designs = ['joint']\n")
+    monkeypatch.setattr(reproduce, "study_file", lambda figure, quick: tiny)
+    out = tmp_path / "o"
+    assert main(["reproduce", "fig8", "--out", str(out), "--quiet", "--jobs", "1"]) == 0
+    calibration = json.loads((out / "calibration.json").read_text())
+    assert calibration["k_H_ratio"] == pytest.approx(1.521051, abs=1e-6)  # `ies calibrate` in the README
+    assert f"= {calibration['k_H'] / K_H_STAR:.3f} k_H* (upper bound of k_H)" in capsys.readouterr().out
+    meta = json.loads((out / "fig8" / "study.json").read_text())
+    assert meta["study"]["parameters"]["k_H"]["max"] == pytest.approx(calibration["k_H"])
+
+
+def test_a_failed_calibration_is_one_warning_and_keeps_table_2(tmp_path, capsys):
+    from scans.errors import ScanError
+    from uq.commands import run_calibration
+
+    def broken():
+        raise ScanError("paper_crater.ply: the file is empty")
+
+    assert run_calibration(broken, tmp_path) is None
+    err = capsys.readouterr().err
+    assert err == "warning: the calibration failed (ScanError: paper_crater.ply: the file is empty); using Table 2's k_H bounds\n"
+    assert not list(tmp_path.iterdir())
