@@ -111,16 +111,21 @@ def test_calibrated_k_H_becomes_the_upper_bound():
     assert low.fix["k_H"] == pytest.approx(1.05 * K_H_STAR)
 
 
-def test_reproduce_uses_the_calibrated_k_H(tmp_path, monkeypatch, capsys):
-    """`ies reproduce` end to end on a tiny simulator study: calibrated k_H bound, data, figures, trends."""
+def tiny_reproduction(tmp_path, monkeypatch, extra=""):
+    """`ies reproduce` on a tiny simulator study (k_H varied, one level, two frequencies) instead of the shipped ones."""
     import uq.commands as reproduce
-    from uq.space import K_H_STAR
 
     tiny = tmp_path / "tiny.toml"
     tiny.write_text("[study]\nkind = 'interval'\nrepetitions = 1\n[parameters.k_H]\n[excitation]\nlevels = [7.4]\n"
-                    "eta = { start = 0.975, stop = 0.98, n = 2 }\nwait = 0.1\nhold = 0.1\nintegrator = 'ode3'\n"
-                    "[interval]\ninterior = 0\n")
+                    "eta = { start = 0.975, stop = 0.98, n = 2 }\nwait = 0.1\nhold = 0.1\n" + extra)
     monkeypatch.setattr(reproduce, "study_file", lambda figure, quick: tiny)
+
+
+def test_reproduce_uses_the_calibrated_k_H(tmp_path, monkeypatch, capsys):
+    """`ies reproduce` end to end on a tiny simulator study: calibrated k_H bound, data, figures, trends."""
+    from uq.space import K_H_STAR
+
+    tiny_reproduction(tmp_path, monkeypatch, "integrator = 'ode3'\n[interval]\ninterior = 0\n")
     calib = tmp_path / "calib.json"
     calib.write_text(json.dumps({"k_H": 1.5 * K_H_STAR}))
     out = tmp_path / "o"
@@ -153,14 +158,9 @@ def test_reproduce_unreachable_scheduler_fails_before_the_calibration(tmp_path, 
 def test_reproduce_calibrates_in_process(tmp_path, monkeypatch, capsys):
     """Without --calibration FILE the front door's calibration (bem_contact.cli.calibrate_default, the shipped
     crater) runs in this process; its JSON is kept in OUT/calibration.json and bounds k_H."""
-    import uq.commands as reproduce
     from uq.space import K_H_STAR
 
-    tiny = tmp_path / "tiny.toml"
-    tiny.write_text("[study]\nkind = 'interval'\nrepetitions = 1\n[parameters.k_H]\n[excitation]\nlevels = [7.4]\n"
-                    "eta = { start = 0.975, stop = 0.98, n = 2 }\nwait = 0.1\nhold = 0.1\n[interval]\ninterior = 0\n"
-                    "designs = ['joint']\n")
-    monkeypatch.setattr(reproduce, "study_file", lambda figure, quick: tiny)
+    tiny_reproduction(tmp_path, monkeypatch, "[interval]\ninterior = 0\ndesigns = ['joint']\n")
     out = tmp_path / "o"
     assert main(["reproduce", "fig8", "--out", str(out), "--quiet", "--jobs", "1"]) == 0
     calibration = json.loads((out / "calibration.json").read_text())
