@@ -90,7 +90,7 @@ class SteppedSine:
     hold: float = 5.0
     perturbation: float = 5e-4
     repetition: str = "leg"
-    integrator: str = "exact"  # issue 5: exact free flight; "ode3" keeps the paper's fixed-step scheme
+    integrator: str = "exact"  # exact free flight (sim.exact); "ode3" is the paper's fixed-step scheme
     dt_scale: float = 1.0
     start: str = "base-velocity"
 

@@ -1,4 +1,4 @@
-"""k_H calibration: the fit, the grid-refinement error bar, any gap map (Sect. 4.1, Fig. 3c; acceptance of issue 2)."""
+"""k_H calibration: the fit, the grid-refinement error bar, any gap map (Sect. 4.1, Fig. 3c)."""
 import numpy as np
 import pytest
 

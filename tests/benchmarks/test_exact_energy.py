@@ -1,5 +1,5 @@
-"""Energy conservation of the exact integrator at its defaults (issue 5, Acceptance: within 1e-6 over 1000
-impacts without damping or excitation), next to the earlier fall-back tolerance (rtol 1e-10) and to every
+"""Energy conservation of the exact integrator at its defaults (within 1e-6 over 1000 impacts without damping
+or excitation), next to a looser fall-back tolerance (rtol 1e-10) and to every
 contact by Dormand-Prince at rtol 1e-7.
 
 Run: pytest -m benchmark tests/benchmarks/test_exact_energy.py -s
