@@ -353,10 +353,8 @@ def run(args: argparse.Namespace) -> int:
 def calibrate_default() -> dict[str, Any]:
     """`ies calibrate --json` with every default (the shipped paper-like crater, Sect. 4.1), in process: the
     JSON object as plain data (SI units; k_H in N/m^1.5). Raises the stages' errors as `ies calibrate` does."""
-    import json
-
-    from sim.files import dumps
+    from sim.files import to_jsonable
 
     parser = argparse.ArgumentParser()
     add_arguments(parser)
-    return json.loads(dumps(summary(*calibrate(parser.parse_args([])))))
+    return to_jsonable(summary(*calibrate(parser.parse_args([]))))

@@ -248,9 +248,10 @@ def output_folder(path: str | None) -> Iterator[Path | None]:
 
 
 @contextmanager
-def simulation(args: argparse.Namespace, levels: Sequence[float], *, progress: bool = False) -> Iterator[tuple]:
+def simulation(args: argparse.Namespace, levels: Sequence[float], *, progress: str | None = None) -> Iterator[tuple]:
     """(--out folder or None, protocol, model, impactor, one `sim.protocol.sweep` result per level) of the
-    options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder."""
+    options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder;
+    `progress`: the label of a progress bar over the levels (on a terminal), None for none."""
     from tqdm import tqdm
 
     from sim.protocol import sweep
@@ -259,7 +260,7 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, progress: b
     model, impactor = build_system(args)
     with output_folder(args.out) as folder:
         results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed)
-                   for level in tqdm(levels, desc="overview", unit="level", disable=None if progress else True, leave=False)]
+                   for level in tqdm(levels, desc=progress, unit="level", disable=None if progress else True, leave=False)]
         yield folder, protocol, model, impactor, results
 
 
@@ -329,7 +330,7 @@ def overview_command(args: argparse.Namespace) -> int:
 
     started = time.perf_counter()
     levels = parse_levels(args.levels)
-    with simulation(args, levels, progress=True) as (folder, protocol, model, _, results):
+    with simulation(args, levels, progress="overview") as (folder, protocol, model, _, results):
         data = {
             "levels": levels,
             "resonant_mean": [r.resonant_mean for r in results],
