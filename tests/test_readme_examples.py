@@ -69,7 +69,7 @@ def test_the_readme_has_the_examples_that_are_checked():
 @pytest.mark.parametrize("command, expected", DETERMINISTIC, ids=[c for c, _ in DETERMINISTIC])
 def test_deterministic_example(command, expected, tmp_path, monkeypatch, capsys):
     out = run(command, tmp_path, monkeypatch, capsys)
-    assert re.fullmatch(pattern(expected), out), f"README:\n" + "\n".join(expected) + f"\nprinted:\n{out}"
+    assert re.fullmatch(pattern(expected), out), "README:\n" + "\n".join(expected) + f"\nprinted:\n{out}"
 
 
 def test_the_pattern_of_an_example():
