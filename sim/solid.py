@@ -429,7 +429,7 @@ def _point_matrix(solid: SolidMesh, points: np.ndarray, component: int) -> scipy
     cells = np.array(cells)
     ref = basis.mapping.invF(points.T[:, :, None], tind=cells)
     n_fun = basis.Nbfun
-    values = np.array([basis.elem.gbasis(basis.mapping, ref, k, tind=cells)[0].value[component, :, 0]
+    values = np.array([np.asarray(basis.elem.gbasis(basis.mapping, ref, k, tind=cells)[0])[component, :, 0]
                        for k in range(n_fun)])  # (n_fun, n_points)
     position = np.full(solid.n_dofs, -1)
     position[solid.free] = np.arange(solid.n_free)
@@ -610,3 +610,125 @@ def solve_solid_modes(solid: SolidMesh, n_modes: int = 9) -> SolidModes:
     modes.kinetic_x_share = np.einsum("ij,ij->j", ux, solid.M @ ux)
     modes.solve_time_s = time.perf_counter() - start
     return modes
+
+
+# ---------------------------------------------------------------------------------------------------------
+# The modal model of the rig, with provenance and mesh convergence
+
+
+def solid_modal_model(modes: SolidModes, patch_radius: float = 0.0,
+                      wall_points: tuple[Sequence[float], Sequence[float]] | None = None) -> ModalModel:
+    """The modal model of Eq. 7 from solid modes: frequencies, damping (sim.rig.damping_ratios), wall values (see
+    SolidModes.wall_values), tip values and x-participation, each mode signed so its mean wall value is positive."""
+    left, right = modes.wall_values(patch_radius=patch_radius, points=wall_points)
+    sign = np.where(left + right < 0, -1.0, 1.0)
+    s = modes.solid
+    return ModalModel(
+        frequencies_hz=modes.frequencies_hz, damping_ratios=damping_ratios(modes.n_modes),
+        phi_wall_left=sign * left, phi_wall_right=sign * right, phi_tip=sign * modes.tip_values,
+        participation=sign * modes.participation[:, 0],
+        source=f"3D solid model (sim.solid, {s.element}, element size {1e3 * s.element_size:g} mm, "
+               f"{s.n_free} free DOFs, E = {s.material.E / 1e9:g} GPa)")
+
+
+@dataclass(frozen=True)
+class SolidResult:
+    """What `ies modes --solid` shows and saves: the modal model, the modes on this mesh and on the coarser
+    convergence partner (None when not computed), provenance (plain data for the modal file's [provenance] table)
+    and the report lines to print."""
+
+    model: ModalModel
+    modes: SolidModes
+    coarser_model: ModalModel | None
+    provenance: dict
+    report: list[str]
+
+
+def _plain(value):
+    """numpy scalars and arrays to Python floats, ints and lists (for TOML)."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def modulus_for_frequencies(frequencies_hz: np.ndarray, E: float, targets_hz: Sequence[float]) -> np.ndarray:
+    """The modulus (Pa) that would move each frequency onto its target: f ~ sqrt(E) at fixed geometry and density."""
+    f = np.asarray(frequencies_hz, float)[: len(targets_hz)]
+    return E * (np.asarray(targets_hz, float)[: f.size] / f) ** 2
+
+
+def _convergence(model: ModalModel, coarser: ModalModel, size: float, coarse_size: float) -> dict:
+    table = {"element_size_m": [coarse_size, size]}
+    changes = {}
+    for key in ("frequencies_hz", "phi_wall_left", "phi_wall_right", "phi_tip", "participation"):
+        fine, coarse = getattr(model, key), getattr(coarser, key)
+        table[key] = [coarse.tolist(), fine.tolist()]
+        changes[key] = (fine / coarse - 1.0).tolist()
+    table["relative_change"] = changes
+    return table
+
+
+def solid_rig_model(mesh: str = "coarse", geometry: SolidGeometry = SolidGeometry(),
+                    material: SolidMaterial = SolidMaterial(), element: str = "hex20", n_modes: int = 9,
+                    patch_radius: float = 0.0, wall_points: tuple[Sequence[float], Sequence[float]] | None = None,
+                    convergence: bool = True) -> SolidResult:
+    """The rig's modal model from the 3D solid model (Sect. 3.1, Eq. 7; `ies modes --solid`): mesh level "coarse",
+    "medium" or "fine" (MESH_LEVELS) or an element size in m; with convergence, the same model on a mesh
+    CONVERGENCE_RATIO times coarser too, for the provenance's convergence table. Coarse: about 1 min, 1 GB."""
+    if isinstance(mesh, str):
+        if mesh not in MESH_LEVELS:
+            raise SimulationInputError(f"unknown mesh level {mesh!r}; choose one of {', '.join(MESH_LEVELS)}")
+        size = MESH_LEVELS[mesh]
+    else:
+        size = float(mesh)
+    solid = solid_mesh(geometry, material, size, element)
+    modes = solve_solid_modes(solid, n_modes)
+    model = solid_modal_model(modes, patch_radius, wall_points)
+    coarser = None
+    if convergence:
+        partner = solve_solid_modes(solid_mesh(geometry, material, size * CONVERGENCE_RATIO, element), n_modes)
+        coarser = solid_modal_model(partner, patch_radius, wall_points)
+    g = geometry
+    left, right = (wall_points if wall_points is not None else (g.wall_point("left"), g.wall_point("right")))
+    from sim.rig import F_MEASURED_HZ, F9_PAPER_HZ
+
+    E_wanted = modulus_for_frequencies(model.frequencies_hz, material.E, F_MEASURED_HZ)
+    E_f9 = modulus_for_frequencies(model.frequencies_hz[8:9], material.E, [F9_PAPER_HZ]) if n_modes >= 9 else []
+    provenance = {
+        "model": "3D solid finite elements (sim.solid)",
+        "element": {"hex20": "hex20 (20-node serendipity, CalculiX C3D20)", "hex27": "hex27 (27-node Lagrange)"}[element],
+        "mesh_level": mesh if isinstance(mesh, str) else "custom", "element_size_m": size,
+        "elements": int(solid.mesh.t.shape[1]), "free_dofs": solid.n_free, "solve_time_s": modes.solve_time_s,
+        "clamp": g.clamp if g.block_edge > 0 else "root section", "geometry": asdict(g),
+        "material": asdict(material), "total_mass_kg": solid.total_mass,
+        "beam_mass_kg": material.rho * g.beam_volume,
+        "wall_left_m": np.asarray(left, float), "wall_right_m": np.asarray(right, float),
+        "patch_radius_m": patch_radius, "tip_m": g.measurement_point,
+        "selected_modes": modes.selected + 1, "rejected_modes": modes.rejected,
+        "kinetic_x_share": modes.kinetic_x_share,
+        "E_for_measured_f1_f4_Pa": E_wanted, "E_for_paper_f9_Pa": E_f9,
+    }
+    if coarser is not None:
+        provenance["convergence"] = _convergence(model, coarser, size, size * CONVERGENCE_RATIO)
+    report = [
+        f"solid model: {provenance['element']}, element size {1e3 * size:g} mm, {provenance['elements']} elements, "
+        f"{solid.n_free} free DOFs, clamp {provenance['clamp']}, E = {material.E / 1e9:g} GPa; "
+        f"assembly + modes {modes.solve_time_s:.0f} s",
+        f"beam mass {provenance['beam_mass_kg']:.3f} kg (free length), with the block {solid.total_mass:.3f} kg; "
+        f"{len(modes.rejected)} other modes below the 9th x-bending mode (y-bending, torsion, axial)",
+        "E the measured f1..f4 would want (Table A.1): " + ", ".join(f"{e / 1e9:.1f}" for e in E_wanted) + " GPa"
+        + (f"; the paper's f9 = 19.8 kHz: {E_f9[0] / 1e9:.1f} GPa" if len(E_f9) else ""),
+    ]
+    if coarser is not None:
+        ch = provenance["convergence"]["relative_change"]
+        worst = lambda key: 100 * max(abs(v) for v in ch[key])  # noqa: E731
+        report.append(f"mesh convergence against {1e3 * size * CONVERGENCE_RATIO:g} mm: max change f {worst('frequencies_hz'):.2f} %, "
+                      f"walls {max(worst('phi_wall_left'), worst('phi_wall_right')):.2f} %, tip {worst('phi_tip'):.2f} %, "
+                      f"participation {worst('participation'):.2f} %")
+    return SolidResult(model, modes, coarser, _plain(provenance), report)
