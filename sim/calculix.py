@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Sequence
@@ -153,14 +152,16 @@ def solid_nodes(solid) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     then edge mid-points), the 20 node indices of every element in C3D20 order (n_el, 20), and for every node its
     three global DOF numbers (n, 3) in the solid model."""
     if solid.element != "hex20":
-        raise SimulationInputError("CalculiX jobs need the 20-node element (C3D20); build the solid model with element='hex20'")
+        raise SimulationInputError("CalculiX jobs need the 20-node element (C3D20); build the solid model with "
+                                   "element='hex20'")
     mesh, dofs = solid.mesh, solid.basis.dofs
     coords = np.vstack([mesh.p.T, mesh.p[:, mesh.edges].mean(axis=1).T])
     n_vertices = mesh.p.shape[1]
     candidates = np.vstack([mesh.t, n_vertices + mesh.t2e])  # (20, n_el) node indices of each element
-    centre = mesh.p[:, mesh.t].mean(axis=1).T  # (n_el, 3)
-    signs = np.sign(np.round((coords[candidates] - centre[None]) / (coords[candidates] - centre[None]).__abs__().max(
-        axis=(0, 2), keepdims=True), 6)).astype(int)  # (20, n_el, 3)
+    corners = mesh.p[:, mesh.t]  # (3, 8, n_el)
+    centre = corners.mean(axis=1).T  # (n_el, 3)
+    half = 0.5 * (corners.max(axis=1) - corners.min(axis=1)).T
+    signs = np.rint((coords[candidates] - centre[None]) / half[None]).astype(int)  # (20, n_el, 3): -1, 0, 1
     codes = lambda s: (s[..., 0] + 1) * 9 + (s[..., 1] + 1) * 3 + (s[..., 2] + 1)  # noqa: E731
     lookup = codes(signs)  # (20, n_el)
     wanted = codes(_C3D20_SIGNS)  # (20,)
@@ -378,9 +379,10 @@ def calculix_modal_model(frd: str | os.PathLike, inp: str | os.PathLike, wall_le
         raise SimulationInputError(f"the frequencies in {dat} and {frd} differ; give the .dat and .frd of the same job")
     participation = table.participation[rows]
     if np.isnan(participation).any():
-        raise SimulationInputError(f"{dat}: no participation factors for every mode; run a *FREQUENCY step with ccx >= 2.15")
+        raise SimulationInputError(f"{dat}: participation factors missing for some modes; give the .dat of a "
+                                   "*FREQUENCY step")
     gm = result.generalized_mass
-    scale = np.where(np.isnan(gm), 1.0, 1.0 / np.sqrt(np.where(np.isnan(gm), 1.0, gm)))
+    scale = 1.0 / np.sqrt(np.nan_to_num(gm, nan=1.0))
     checks = []
     if not np.isnan(gm).all():
         checks.append(f"phi^T M phi from the .frd: max |GM - 1| = {np.nanmax(np.abs(gm - 1.0)):.1e}")
@@ -405,8 +407,8 @@ def calculix_modal_model(frd: str | os.PathLike, inp: str | os.PathLike, wall_le
     else:
         chosen, rejected = select_x_bending(participation, None, n_modes)
         if chosen.size < n_modes:
-            raise SimulationInputError(f"{frd}: only {chosen.size} x-bending modes among its {result.mode_numbers.size}; "
-                                       f"ask ccx for more modes (*FREQUENCY) or give fewer")
+            raise SimulationInputError(f"{frd}: only {chosen.size} x-bending modes among its "
+                                       f"{result.mode_numbers.size}; ask ccx for more modes (*FREQUENCY) or give fewer")
     position = {node: k for k, node in enumerate(result.node_ids)}
     values = {}
     for role, ids in sets.items():

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass
 from typing import Sequence
 
 import numpy as np
@@ -49,7 +49,7 @@ import scipy.sparse.linalg
 
 from sim.errors import SimulationInputError
 from sim.rig import JOINT_SPRING_PARAMETERS, NU_STEEL, RHO_STEEL, RigGeometry, damping_ratios
-from sim.system import SPHERE_MASS, ModalModel
+from sim.system import ModalModel
 
 INSTALL_HINT = "the 3D solid model needs scikit-fem: pip install '.[solid]'"
 
@@ -61,7 +61,8 @@ MESH_LEVELS = {"coarse": 0.008, "medium": 0.0055, "fine": 0.004}
 # The convergence partner of a level: the same mesh with elements this much longer
 CONVERGENCE_RATIO = 1.5
 BLOCK_GROWTH = 1.5  # element length ratio of neighbouring boxes in the block (away from the beam)
-ELEMENTS = ("hex20", "hex27")
+ELEMENT_NAMES = {"hex20": "hex20 (20-node serendipity, CalculiX C3D20)", "hex27": "hex27 (27-node Lagrange)"}
+ELEMENTS = tuple(ELEMENT_NAMES)
 CLAMPS = ("block-faces", "lower-face")
 _RIG = RigGeometry()
 
@@ -103,8 +104,9 @@ class SolidGeometry:
         if self.clamp not in CLAMPS:
             raise SimulationInputError(f"solid geometry: clamp must be one of {', '.join(CLAMPS)}, got {self.clamp!r}")
         for name, value in asdict(self).items():
-            if name not in ("measurement_on_face", "clamp") and not (isinstance(value, (int, float)) and math.isfinite(value)
-                                                       and value >= 0):
+            if name in ("measurement_on_face", "clamp"):
+                continue
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
                 raise SimulationInputError(f"solid geometry: {name} must be a non-negative length in m, got {value!r}")
         for name in ("free_length", "section_x", "section_y"):
             if getattr(self, name) <= 0:
@@ -202,7 +204,8 @@ class SolidGeometry:
         on = np.abs(points[2] + self.block_edge) < tol
         if self.clamp == "block-faces":
             half = 0.5 * self.block_edge
-            on |= (points[2] < tol) & ((np.abs(np.abs(points[0]) - half) < tol) | (np.abs(np.abs(points[1]) - half) < tol))
+            side = (np.abs(np.abs(points[0]) - half) < tol) | (np.abs(np.abs(points[1]) - half) < tol)
+            on |= (points[2] < tol) & side
         return on
 
     @property
@@ -401,8 +404,6 @@ def solid_mesh(geometry: SolidGeometry = SolidGeometry(), material: SolidMateria
     unit[np.arange(basis.N), comp] = 1.0
     load_full = M_full @ unit
     scale = max(g.free_length, g.block_edge)
-    position = np.full(basis.N, -1)
-    position[free] = np.arange(free.size)
     mirrors = []
     for axis in (0, 1):
         m = _mirror(locs[:, free], comp[free], axis, scale)
@@ -702,7 +703,7 @@ def solid_rig_model(mesh: str = "coarse", geometry: SolidGeometry = SolidGeometr
     E_f9 = modulus_for_frequencies(model.frequencies_hz[8:9], material.E, [F9_PAPER_HZ]) if n_modes >= 9 else []
     provenance = {
         "model": "3D solid finite elements (sim.solid)",
-        "element": {"hex20": "hex20 (20-node serendipity, CalculiX C3D20)", "hex27": "hex27 (27-node Lagrange)"}[element],
+        "element": ELEMENT_NAMES[element],
         "mesh_level": mesh if isinstance(mesh, str) else "custom", "element_size_m": size,
         "elements": int(solid.mesh.t.shape[1]), "free_dofs": solid.n_free, "solve_time_s": modes.solve_time_s,
         "clamp": g.clamp if g.block_edge > 0 else "root section", "geometry": asdict(g),
@@ -721,14 +722,15 @@ def solid_rig_model(mesh: str = "coarse", geometry: SolidGeometry = SolidGeometr
         f"{solid.n_free} free DOFs, clamp {provenance['clamp']}, E = {material.E / 1e9:g} GPa; "
         f"assembly + modes {modes.solve_time_s:.0f} s",
         f"beam mass {provenance['beam_mass_kg']:.3f} kg (free length), with the block {solid.total_mass:.3f} kg; "
-        f"{len(modes.rejected)} other modes below the 9th x-bending mode (y-bending, torsion, axial)",
+        f"{len(modes.rejected)} other modes below the last x-bending mode (listed in the provenance)",
         "E the measured f1..f4 would want (Table A.1): " + ", ".join(f"{e / 1e9:.1f}" for e in E_wanted) + " GPa"
         + (f"; the paper's f9 = 19.8 kHz: {E_f9[0] / 1e9:.1f} GPa" if len(E_f9) else ""),
     ]
     if coarser is not None:
         ch = provenance["convergence"]["relative_change"]
         worst = lambda key: 100 * max(abs(v) for v in ch[key])  # noqa: E731
-        report.append(f"mesh convergence against {1e3 * size * CONVERGENCE_RATIO:g} mm: max change f {worst('frequencies_hz'):.2f} %, "
-                      f"walls {max(worst('phi_wall_left'), worst('phi_wall_right')):.2f} %, tip {worst('phi_tip'):.2f} %, "
+        walls = max(worst("phi_wall_left"), worst("phi_wall_right"))
+        report.append(f"mesh convergence against {1e3 * size * CONVERGENCE_RATIO:g} mm: max change "
+                      f"f {worst('frequencies_hz'):.2f} %, walls {walls:.2f} %, tip {worst('phi_tip'):.2f} %, "
                       f"participation {worst('participation'):.2f} %")
     return SolidResult(model, modes, coarser, _plain(provenance), report)
