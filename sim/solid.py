@@ -147,7 +147,8 @@ class SolidGeometry:
         """Depth of the sphere centre below the free end (m): the sphere rests on the groove's edges."""
         if self.cavity_z == 0:
             return 0.0
-        return self.cavity_z - math.sqrt(max(self.sphere_radius**2 - (0.5 * self.groove_width) ** 2, 0.0))
+        return RigGeometry(cavity_z=self.cavity_z, groove_width=self.groove_width,
+                           sphere_radius=self.sphere_radius).contact_below_top
 
     @property
     def contact_height(self) -> float:
@@ -237,11 +238,11 @@ def _unique_lines(points: Sequence[float]) -> np.ndarray:
     return p[keep]
 
 
-def _subdivide(lines: np.ndarray, size: np.ndarray) -> np.ndarray:
+def _subdivide(lines: np.ndarray, size: float) -> np.ndarray:
     """Split every interval between consecutive lines into ceil(length / size) equal parts."""
     out = [lines[:1]]
-    for a, b, h in zip(lines[:-1], lines[1:], size):
-        n = max(1, math.ceil((b - a) / h - 1e-9))
+    for a, b in zip(lines[:-1], lines[1:]):
+        n = max(1, math.ceil((b - a) / size - 1e-9))
         out.append(np.linspace(a, b, n + 1)[1:])
     return np.concatenate(out)
 
@@ -250,9 +251,8 @@ def _grid_axis(breaks: Sequence[float], beam: tuple[float, float], element_size:
     """Grid lines along one axis: the breakpoints, intervals inside `beam` (lo, hi) split to element_size, those
     outside to a size growing by BLOCK_GROWTH per element away from the beam."""
     lines = _unique_lines(breaks)
-    inner = _subdivide(lines[(lines >= beam[0] - 1e-12) & (lines <= beam[1] + 1e-12)],
-                       np.full(lines.size, element_size))
-    out = [inner]
+    inner = _subdivide(lines[(lines >= beam[0] - 1e-12) & (lines <= beam[1] + 1e-12)], element_size)
+    out = [lines, inner]
     for direction, edge in ((-1, lines[0]), (1, lines[-1])):
         start = inner[0] if direction < 0 else inner[-1]
         if abs(edge - start) < 1e-12:
@@ -675,7 +675,7 @@ def _convergence(model: ModalModel, coarser: ModalModel, size: float, coarse_siz
     return table
 
 
-def solid_rig_model(mesh: str = "coarse", geometry: SolidGeometry = SolidGeometry(),
+def solid_rig_model(mesh: str | float = "coarse", geometry: SolidGeometry = SolidGeometry(),
                     material: SolidMaterial = SolidMaterial(), element: str = "hex20", n_modes: int = 9,
                     patch_radius: float = 0.0, wall_points: tuple[Sequence[float], Sequence[float]] | None = None,
                     convergence: bool = True) -> SolidResult:
