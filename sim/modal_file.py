@@ -18,6 +18,10 @@ Format (TOML, UTF-8). Arrays have one value per retained mode, in ascending freq
     phi = "1/sqrt(kg)"
     participation = "sqrt(kg)"
 
+    [provenance]                     # optional, free-form: how the modes were made (written by sim.solid and
+    model = "3D solid ..."           # sim.calculix: geometry, material, mesh, DOF count, solve time, and a
+    [provenance.convergence]         # mesh-convergence table); readers ignore it
+
 Signs follow sim/system.py: the wall directions w_l, w_r are both +x, so phi_wall_* are the x-components of
 the mass-normalised modes (phi_j^T M phi_j = 1 kg^0). A mode's overall sign is free, but phi_wall_*, phi_tip
 and participation of that mode must use the same sign.
@@ -104,20 +108,30 @@ def load_modal_model(path: str | os.PathLike) -> ModalModel:
         raise SimulationInputError(f"{path}: {exc}") from None
 
 
-def modal_model_document(model: ModalModel) -> dict:
-    """The file content of a model as plain data (what save_modal_model writes)."""
+def modal_model_document(model: ModalModel, provenance: dict | None = None) -> dict:
+    """The file content of a model as plain data (what save_modal_model writes), with an optional [provenance]
+    table (plain TOML data: strings, numbers, booleans, lists and tables)."""
     doc: dict = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "source": model.source}
     for key in ARRAY_KEYS:
         doc[key] = [float(v) for v in getattr(model, key)]
     doc["units"] = dict(UNITS)
+    if provenance:
+        doc["provenance"] = provenance
     return doc
 
 
-def save_modal_model(model: ModalModel, path: str | os.PathLike) -> Path:
-    """Write `model` as a modal-model file (format in this module's docstring), atomically (`sim.files`)."""
+def load_provenance(path: str | os.PathLike) -> dict:
+    """The [provenance] table of a modal-model file ({} when it has none); call load_modal_model first to check
+    the file."""
+    return dict(tomllib.loads(Path(path).read_text(encoding="utf-8")).get("provenance", {}))
+
+
+def save_modal_model(model: ModalModel, path: str | os.PathLike, provenance: dict | None = None) -> Path:
+    """Write `model` (and an optional [provenance] table) as a modal-model file (format in this module's
+    docstring), atomically (`sim.files`)."""
     import tomli_w
 
     try:
-        return write_text(path, _HEADER + tomli_w.dumps(modal_model_document(model)))
+        return write_text(path, _HEADER + tomli_w.dumps(modal_model_document(model, provenance)))
     except (FileNotFoundError, IsADirectoryError) as exc:  # a missing folder, or a folder named as the file
         raise SimulationInputError(exc.strerror) from None
