@@ -35,9 +35,31 @@ def add_modes_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies modes`."""
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
     parser.add_argument("--save", metavar="FILE", help="write the model as a modal-model file (.toml)")
-    parser.add_argument("--model", metavar="FILE", help="read a modal-model file instead of the built-in seed rig")
+    source = parser.add_mutually_exclusive_group()
+    source.add_argument("--model", metavar="FILE", help="read a modal-model file instead of the built-in seed rig")
+    source.add_argument("--solid", action="store_true",
+                        help="the rig as a 3D solid finite-element model (sim.solid; needs pip install '.[solid]')")
+    source.add_argument("--from-calculix", dest="from_calculix", metavar="JOB.frd",
+                        help="mode shapes of a CalculiX *FREQUENCY job (ASCII .frd; with --mesh JOB.inp and the node "
+                             "sets --wall-left, --wall-right, --tip; participation from JOB.dat)")
     parser.add_argument("--variant", default=None, metavar="NAME",
                         help="updating variant of the built-in rig: joint-spring (default) or effective-modulus")
+    parser.add_argument("--n-modes", dest="n_modes", type=int, default=9, metavar="N",
+                        help="x-bending modes to keep (default 9, as the paper; built-in rig, --solid, --from-calculix)")
+    solid = parser.add_argument_group("3D solid model (--solid) and CalculiX (--from-calculix)")
+    solid.add_argument("--mesh", metavar="LEVEL|JOB.inp",
+                       help="--solid: mesh level coarse (default, ~1 min), medium or fine; --from-calculix: the job's .inp")
+    solid.add_argument("--geometry", metavar="FILE",
+                       help="--solid: TOML file with [geometry] (sim.solid.SolidGeometry fields, m) and [material] "
+                            "(E in Pa, nu, rho in kg/m^3) tables; missing keys keep the rig's defaults")
+    solid.add_argument("--patch-radius", dest="patch_radius", type=float, default=0.0, metavar="M",
+                       help="--solid: average the wall values over a circle of this radius (m) on each wall face")
+    solid.add_argument("--wall-left", dest="wall_left", metavar="NSET", help="--from-calculix: node set of the left wall")
+    solid.add_argument("--wall-right", dest="wall_right", metavar="NSET", help="--from-calculix: node set of the right wall")
+    solid.add_argument("--tip", metavar="NSET", help="--from-calculix: node set of the measurement point")
+    solid.add_argument("--dat", metavar="JOB.dat", help="--from-calculix: the job's .dat (default: beside the .frd)")
+    solid.add_argument("--units", default="m-kg-s", choices=("m-kg-s", "mm-t-s"),
+                       help="--from-calculix: the job's consistent units (default m-kg-s)")
 
 
 def describe_modes(model: Any, rig: Any = None) -> dict:
@@ -96,25 +118,96 @@ def modes_table(data: dict) -> str:
     return "\n".join(lines)
 
 
+def _solid_geometry(path: str | None) -> tuple[Any, Any]:
+    """(SolidGeometry, SolidMaterial) of a --geometry TOML file (the rig's defaults without one)."""
+    import dataclasses
+    import tomllib
+
+    from sim.solid import SolidGeometry, SolidMaterial
+
+    if path is None:
+        return SolidGeometry(), SolidMaterial()
+    try:
+        doc = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise SimulationInputError(f"{path}: not valid TOML ({exc})") from None
+    unknown = set(doc) - {"geometry", "material"}
+    if unknown:
+        raise SimulationInputError(f"{path}: unknown table(s) {', '.join(sorted(unknown))}; use [geometry] and [material]")
+    built = []
+    for table, cls in (("geometry", SolidGeometry), ("material", SolidMaterial)):
+        values = doc.get(table, {})
+        fields = {f.name for f in dataclasses.fields(cls)}
+        wrong = set(values) - fields
+        if wrong:
+            raise SimulationInputError(f"{path}: unknown key(s) {', '.join(sorted(wrong))} in [{table}]; "
+                                       f"known: {', '.join(sorted(fields))}")
+        built.append(cls(**values))
+    return tuple(built)
+
+
+def _external_model(args: argparse.Namespace) -> tuple[Any, dict | None, list[str]]:
+    """(model, provenance, report lines) of --solid or --from-calculix."""
+    import sys
+
+    if args.variant is not None:
+        raise SimulationInputError("--variant selects a built-in rig model; it cannot be used with --solid or "
+                                   "--from-calculix")
+    if args.solid:
+        from sim.solid import MESH_LEVELS, solid_rig_model
+
+        level = args.mesh or "coarse"
+        if level not in MESH_LEVELS:
+            raise SimulationInputError(f"--mesh {level!r}: with --solid give a mesh level ({', '.join(MESH_LEVELS)})")
+        if not (args.patch_radius >= 0):
+            raise SimulationInputError(f"--patch-radius must be >= 0 (m), got {args.patch_radius!r}")
+        geometry, material = _solid_geometry(args.geometry)
+        sys.stderr.write(f"solving the 3D solid model ({level} mesh and a coarser one for the convergence check; "
+                         "about 1-3 min) ...\n")
+        result = solid_rig_model(level, geometry, material, n_modes=args.n_modes, patch_radius=args.patch_radius)
+        return result.model, result.provenance, result.report
+    from sim.calculix import calculix_modal_model
+
+    missing = [o for o, v in (("--mesh JOB.inp", args.mesh), ("--wall-left", args.wall_left),
+                              ("--wall-right", args.wall_right), ("--tip", args.tip)) if not v]
+    if missing:
+        raise SimulationInputError(f"--from-calculix also needs {', '.join(missing)}")
+    result = calculix_modal_model(args.from_calculix, args.mesh, args.wall_left, args.wall_right, args.tip,
+                                  dat=args.dat, units=args.units, n_modes=args.n_modes)
+    return result.model, result.provenance, result.report
+
+
 def modes_command(args: argparse.Namespace) -> int:
-    """`ies modes`: show (and with --save write) the built-in rig's model or a modal-model file."""
+    """`ies modes`: show (and with --save write) the built-in rig's model, a modal-model file, the 3D solid
+    model or the modes of a CalculiX job."""
     from sim.files import dumps
     from sim.modal_file import load_modal_model, save_modal_model
 
-    if args.model:
+    rig = provenance = None
+    report: list[str] = []
+    if not 1 <= args.n_modes <= 30:
+        raise SimulationInputError(f"--n-modes must lie in 1..30, got {args.n_modes}")
+    if args.solid or args.from_calculix:
+        model, provenance, report = _external_model(args)
+    elif args.mesh or args.geometry or args.wall_left or args.wall_right or args.tip or args.dat:
+        raise SimulationInputError("--mesh, --geometry, --wall-left, --wall-right, --tip and --dat belong to --solid "
+                                   "or --from-calculix")
+    elif args.model:
         if args.variant is not None:
             raise SimulationInputError("--variant selects a built-in rig model; it cannot be used with --model")
-        model, rig = load_modal_model(args.model), None
+        model = load_modal_model(args.model)
     else:
         from sim.rig import DEFAULT_VARIANT, rig_modes, seed_rig_model, variant_parameters
 
         variant = args.variant or DEFAULT_VARIANT
-        model = seed_rig_model(n_modes=9, variant=variant)
-        rig = rig_modes(variant_parameters(variant), n_modes=9)
+        model = seed_rig_model(n_modes=args.n_modes, variant=variant)
+        rig = rig_modes(variant_parameters(variant), n_modes=max(args.n_modes, 9))  # its updating summary needs f1..f9
     data = describe_modes(model, rig)
+    if provenance is not None:
+        data["provenance"] = provenance
     if args.save:
-        data["saved_to"] = str(save_modal_model(model, args.save))
-    print(dumps(data) if args.json else modes_table(data))
+        data["saved_to"] = str(save_modal_model(model, args.save, provenance))
+    print(dumps(data) if args.json else "\n".join([*report, modes_table(data)]))
     return 0
 
 
