@@ -36,7 +36,6 @@ from functools import cached_property, lru_cache
 from typing import Callable
 
 import numpy as np
-from scipy import optimize
 
 from bem_contact.errors import ContactInputError, ConvergenceError
 from bem_contact.influence import ConvolutionOperator, love_kernel
@@ -504,6 +503,8 @@ def _solve_force_by_search(h, dx, E_star, W, solver, tol, x0, maxiter, workers, 
         low = delta
         delta *= max((W / F) ** (2.0 / 3.0), 1.0 + 1e-3) if F > 0 else 2.0
     if math.isfinite(high):
+        from scipy import optimize  # here, not at the top: `ies --help` lists the solvers without loading scipy
+
         try:
             delta = optimize.brentq(lambda d: solve_at(d)[3] - W, low, high, xtol=0.5 * tol * low if low > 0 else 1e-300,
                                     rtol=max(tol, 4 * np.finfo(float).eps), maxiter=200)

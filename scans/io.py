@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import io
 import os
-import tempfile
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from scans.errors import ScanError
+from sim.files import write_bytes
 
 #: length units a scan file may be written in, as metres per unit
 UNITS: dict[str, float] = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": 0.0254}
@@ -243,21 +243,7 @@ def write_scan(path: str | os.PathLike, vertices: np.ndarray, faces: np.ndarray 
         payload = (header + "\n".join(sep.join(f"{v:.9g}" for v in row) for row in coords) + "\n").encode()
     else:
         raise ScanError(f"{path.name}: cannot write format {suffix!r}; use one of {' '.join(sorted(MESH_SUFFIXES) + sorted(POINT_SUFFIXES))}")
-    _atomic_write_bytes(path, payload)
-    return path
-
-
-def _atomic_write_bytes(path: Path, payload: bytes) -> None:
-    # scans must not import uq (dependencies point uq -> scans), hence this small twin of uq.output.atomic_path
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent if str(path.parent) else ".")
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(payload)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    return write_bytes(path, payload)
 
 
 def _short(exc: BaseException) -> str:

@@ -1,4 +1,4 @@
-"""Batch API for the uncertainty layer (issue 5): many independent stepped-sine runs in one call.
+"""Batch API for the uncertainty layer: many independent stepped-sine runs in one call.
 
 A *job* is one stepped-sine run (`sim.protocol.run_sweep`, Sect. 5.1) of one parameter set (D, g, k_H of
 Table 2), one excitation level a_base/a_base* and one repetition index. Every job calls `run_sweep` with

@@ -18,6 +18,10 @@ Format (TOML, UTF-8). Arrays have one value per retained mode, in ascending freq
     phi = "1/sqrt(kg)"
     participation = "sqrt(kg)"
 
+    [provenance]                     # optional, free-form: how the modes were made (written by sim.solid and
+    model = "3D solid ..."           # sim.calculix: geometry, material, mesh, DOF count, solve time, and a
+    [provenance.convergence]         # mesh-convergence table); readers ignore it
+
 Signs follow sim/system.py: the wall directions w_l, w_r are both +x, so phi_wall_* are the x-components of
 the mass-normalised modes (phi_j^T M phi_j = 1 kg^0). A mode's overall sign is free, but phi_wall_*, phi_tip
 and participation of that mode must use the same sign.
@@ -26,13 +30,13 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 import tomllib
 from pathlib import Path
 
 import numpy as np
 
 from sim.errors import SimulationInputError
+from sim.files import write_text
 from sim.system import ModalModel
 
 FORMAT_NAME = "ies-modal-model"
@@ -104,33 +108,30 @@ def load_modal_model(path: str | os.PathLike) -> ModalModel:
         raise SimulationInputError(f"{path}: {exc}") from None
 
 
-def modal_model_document(model: ModalModel) -> dict:
-    """The file content of a model as plain data (what save_modal_model writes)."""
+def modal_model_document(model: ModalModel, provenance: dict | None = None) -> dict:
+    """The file content of a model as plain data (what save_modal_model writes), with an optional [provenance]
+    table (plain TOML data: strings, numbers, booleans, lists and tables)."""
     doc: dict = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "source": model.source}
     for key in ARRAY_KEYS:
         doc[key] = [float(v) for v in getattr(model, key)]
     doc["units"] = dict(UNITS)
+    if provenance:
+        doc["provenance"] = provenance
     return doc
 
 
-def save_modal_model(model: ModalModel, path: str | os.PathLike) -> Path:
-    """Write `model` as a modal-model file, atomically (a temporary file renamed onto `path`)."""
+def load_provenance(path: str | os.PathLike) -> dict:
+    """The [provenance] table of a modal-model file ({} when it has none); call load_modal_model first to check
+    the file."""
+    return dict(tomllib.loads(Path(path).read_text(encoding="utf-8")).get("provenance", {}))
+
+
+def save_modal_model(model: ModalModel, path: str | os.PathLike, provenance: dict | None = None) -> Path:
+    """Write `model` (and an optional [provenance] table) as a modal-model file (format in this module's
+    docstring), atomically (`sim.files`)."""
     import tomli_w
 
-    target = Path(path)
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise SimulationInputError(f"cannot write {target}: folder {folder} does not exist; create it or choose another path")
-    if target.is_dir():
-        raise SimulationInputError(f"cannot write {target}: it is a folder; give a file name such as modes.toml")
-    text = _HEADER + tomli_w.dumps(modal_model_document(model))
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=".toml", dir=folder)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return target
+        return write_text(path, _HEADER + tomli_w.dumps(modal_model_document(model, provenance)))
+    except (FileNotFoundError, IsADirectoryError) as exc:  # a missing folder, or a folder named as the file
+        raise SimulationInputError(exc.strerror) from None

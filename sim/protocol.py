@@ -90,7 +90,7 @@ class SteppedSine:
     hold: float = 5.0
     perturbation: float = 5e-4
     repetition: str = "leg"
-    integrator: str = "exact"  # issue 5: exact free flight; "ode3" keeps the paper's fixed-step scheme
+    integrator: str = "exact"  # exact free flight (sim.exact); "ode3" is the paper's fixed-step scheme
     dt_scale: float = 1.0
     start: str = "base-velocity"
 
@@ -223,7 +223,7 @@ class SweepResult:
     extra: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
-        """Plain data for JSON (see `uq.output.dumps`)."""
+        """Plain data for JSON (see `sim.files.dumps`)."""
         out = {k: getattr(self, k) for k in (
             "level", "a_base", "a_noabs", "eta", "mean", "max", "mean_lo", "mean_hi", "mean_std", "max_lo",
             "max_hi", "max_std", "cv", "impacts_per_period", "regime_per_eta", "resonant_mean", "resonant_max",

@@ -15,7 +15,7 @@ Idealisation (the paper used a 3D CalculiX model, Fig. 2c; its geometry is only 
   enters it (and of the bolted clamping behind it) as massless springs from the beam's root to the block: a
   translational spring (updated) and a rotational one (rigid: the updating drives it to its stiff bound). The
   massless springs keep the nine modes bending modes of the beam, unlike a heavy flexible block. The variant
-  "effective-modulus" (the first default) has a rigid joint.
+  "effective-modulus" has a rigid joint.
 * Neck near the clamping (dimensions not published): a rectangular segment starting at the block. Default: cut
   only in y (the paper's reason for it is to put the y-bending modes below the x-bending ones), its length and
   y-width updated with E and the joint spring; "effective-modulus": cut in x and y.
@@ -423,7 +423,7 @@ ELEMENT_SIZE = 0.005
 # joint; weighted least squares on f1..f4 (Table A.1) and the paper's f9 = 19.8 kHz.
 JOINT_SPRING_PARAMETERS = RigParameters(E=215e9, neck_length=0.14557562, neck_width_x=0.028,
                                         neck_width_y=0.011977802, joint_translational_stiffness=1.6147241e9)
-# Previous default, "effective-modulus": rigid joint, neck cut in x and y, E free (150-260 GPa): f1..f4 exact but
+# Variant "effective-modulus": rigid joint, neck cut in x and y, E free (150-260 GPa): f1..f4 exact but
 # only with an effective E = 240.8 GPa, and f9 = 21.26 kHz.
 EFFECTIVE_MODULUS_PARAMETERS = RigParameters(E=240.78788e9, neck_length=0.070351765, neck_width_x=0.022271304,
                                              neck_width_y=0.016548213)

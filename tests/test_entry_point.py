@@ -1,4 +1,4 @@
-"""The `ies` entry point: subcommands are discovered, user mistakes end in one line and exit 2."""
+"""The `ies` entry point: every stage's subcommands are registered, user mistakes end in one line and exit 2."""
 import subprocess
 import sys
 

@@ -1,9 +1,11 @@
-"""The `ies` command line: one entry point, one subcommand per job.
+"""The `ies` front door: one entry point that dispatches to the stages' own command modules.
 
-Each module in `uq/commands/` is one subcommand. It defines
-``NAME`` (the subcommand), ``HELP`` (one line), ``add_arguments(parser)`` and
-``run(args) -> int``. Heavy imports (numba, scipy) belong inside ``run`` so that
-``ies --help`` stays fast.
+Each stage owns its words of the command line (`add_commands(subparsers)`, SALib's habit):
+`bem_contact.cli` (calibrate), `sim.cli` (modes, sweep, overview) and `uq.commands` (interval, sobol,
+reproduce). Each subcommand parser sets ``_run(args) -> exit code``. This module only builds the parser from
+the dispatch table `STAGES`, hands `ies reproduce` the calibration as a callable (so that the uq stage never
+imports the contact stage), and turns the stages' errors into exit codes. It is the one module of uq that
+imports scans and bem_contact (their error classes and the calibration).
 
 User mistakes end with one line on stderr, ``ies <command>: error: <what and how to fix>``,
 and exit code 2; numerical failures exit with code 3. No traceback for either.
@@ -11,12 +13,12 @@ and exit code 2; numerical failures exit with code 3. No traceback for either.
 from __future__ import annotations
 
 import argparse
-import importlib
 import os
-import pkgutil
 import sys
 from typing import Sequence
 
+import bem_contact.cli
+import sim.cli
 import uq.commands
 from bem_contact.errors import ContactInputError, ConvergenceError
 from scans.errors import ScanError
@@ -25,6 +27,14 @@ from uq.errors import StudyError
 
 USER_ERRORS = (ContactInputError, ScanError, SimulationInputError, StudyError)
 NUMERICAL_FAILURES = (ConvergenceError, SimulationDiverged)
+
+#: the dispatch table, in the pipeline's order: (stage command module, what it is handed); each module's
+#: add_commands(subparsers, **handed) registers its own subcommands
+STAGES = (
+    (bem_contact.cli, {}),
+    (sim.cli, {}),
+    (uq.commands, {"calibrate": bem_contact.cli.calibrate_default}),
+)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -36,17 +46,12 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """Parser with every subcommand found in `uq.commands`."""
+    """Parser with the subcommands of every stage in `STAGES`."""
     parser = _Parser(prog="ies", description="Impact Energy Scatterer workbench: contact, simulation, uncertainty.")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for info in sorted(pkgutil.iter_modules(uq.commands.__path__), key=lambda m: m.name):
-        if info.name.startswith("_"):
-            continue
-        module = importlib.import_module(f"uq.commands.{info.name}")
-        command = sub.add_parser(module.NAME, help=module.HELP, description=module.HELP)
-        module.add_arguments(command)
-        command.set_defaults(_run=module.run)
+    for module, handed in STAGES:
+        module.add_commands(sub, **handed)
     return parser
 
 

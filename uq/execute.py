@@ -7,8 +7,6 @@ CSV files hold no timings, so reruns (serial, parallel, Dask, resumed) can be co
 """
 from __future__ import annotations
 
-import csv
-import io
 import sys
 import time
 from dataclasses import dataclass, field
@@ -17,9 +15,9 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from sim.files import dumps, write_csv, write_text
 from uq.errors import StudyError
 from uq.interval import Band, Design, DesignPoint, axis_design, band, box_design
-from uq.output import dumps, write_text
 from uq.runner import ResultStore, Task, dask_client, prepare_output, run_tasks
 from uq.study import Study
 
@@ -32,24 +30,6 @@ class StudyResult:
     files: list[Path] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     summary: dict = field(default_factory=dict)
-
-
-def _fmt(v: Any) -> str:
-    if isinstance(v, (np.integer, np.bool_)):
-        return str(int(v))
-    if isinstance(v, (float, np.floating)):
-        return repr(float(v)) if np.isfinite(v) else "nan"
-    return str(v)
-
-
-def _write_csv(path: Path, header: Sequence[str], rows: Sequence[Sequence[Any]]) -> Path:
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(header)
-    for row in rows:
-        writer.writerow([_fmt(v) for v in row])
-    write_text(path, buf.getvalue())
-    return path
 
 
 def _warn(result: StudyResult, message: str) -> None:
@@ -175,11 +155,11 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
             for j, level in enumerate(study.levels):
                 band_rows.append([d.name, o, level, bd.lower[j], bd.upper[j], bd.corner_lower[j], bd.corner_upper[j],
                                   int(bd.flagged[j]), bd.violation[j]])
-    result.files.append(_write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
+    result.files.append(write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
                                    _runs_rows(results, points, study, model.outputs, names)))
-    result.files.append(_write_csv(folder / "points.csv", ["design", "point", "role", *names, "level", "output",
+    result.files.append(write_csv(folder / "points.csv", ["design", "point", "role", *names, "level", "output",
                                                            "mean", "se", "n_samples"], point_rows))
-    result.files.append(_write_csv(folder / "bands.csv", ["design", "output", "level", "lower", "upper",
+    result.files.append(write_csv(folder / "bands.csv", ["design", "output", "level", "lower", "upper",
                                                           "corner_lower", "corner_upper", "flagged", "violation"],
                                    band_rows))
     monotone = {f"{d}/{o}": bd.monotone for (d, o), bd in bands.items()}
@@ -249,11 +229,11 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
             summary_rows.append([o, level, res.variance, res.noise_variance, res.noise_share, res.failed_runs,
                                  res.message])
             per_level[f"{o}@{level:g}"] = {"noise_share": res.noise_share, "failed_runs": res.failed_runs}
-    result.files.append(_write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
+    result.files.append(write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
                                    _runs_rows(results, points, study, model.outputs, names)))
-    result.files.append(_write_csv(folder / "sobol.csv", ["output", "level", "parameter", "S1", "S1_conf", "ST",
+    result.files.append(write_csv(folder / "sobol.csv", ["output", "level", "parameter", "S1", "S1_conf", "ST",
                                                           "ST_conf"], rows))
-    result.files.append(_write_csv(folder / "variance.csv", ["output", "level", "variance", "noise_variance",
+    result.files.append(write_csv(folder / "variance.csv", ["output", "level", "variance", "noise_variance",
                                                              "noise_share", "failed_runs", "message"], summary_rows))
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
                       "base_sample": n, "points": len(points),

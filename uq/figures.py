@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from uq.output import save_figure
+from sim.files import save_figure
 
 _YLABEL = {"mean": "mean resonant level  a / a_noabs*", "max": "max resonant level  a / a_noabs*",
            "value": "response"}

@@ -23,8 +23,8 @@ from dataclasses import asdict, dataclass, is_dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
+from sim.files import write_text
 from uq.errors import StudyError
-from uq.output import write_text
 
 
 @dataclass(frozen=True)

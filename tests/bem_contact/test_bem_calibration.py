@@ -1,10 +1,9 @@
-"""k_H calibration: the fit, the grid-refinement error bar, any gap map (Sect. 4.1, Fig. 3c; acceptance of issue 2)."""
+"""k_H calibration: the fit, the grid-refinement error bar, any gap map (Sect. 4.1, Fig. 3c)."""
 import numpy as np
 import pytest
 
 from bem_contact import BRASS, STEEL, ContactInputError, calibrate_k_H, contact_modulus, fit_k_H, k_H_star, sphere_gap
-
-from test_bem_hertz import elliptical_hertz_force
+from bem_contact.references import elliptical_hertz_force
 
 R = 7.92e-3
 E_STAR = contact_modulus(STEEL, BRASS)

@@ -1,4 +1,4 @@
-"""`ies calibrate`: JSON, summary, plot, and one-line errors with nothing half-written (issue 2, acceptance)."""
+"""`ies calibrate`: JSON, summary, plot, and one-line errors with nothing half-written."""
 import json
 import subprocess
 import sys

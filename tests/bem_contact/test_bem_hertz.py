@@ -3,10 +3,10 @@
 Both references are analytic; the BEM is only ever compared with them, never with itself."""
 import numpy as np
 import pytest
-from scipy import optimize, special
 
 from bem_contact import BRASS, STEEL, contact_modulus, hertz_force, hertz_pressure, hertz_radius, solve_contact, sphere_gap
 from bem_contact.hertz import hertz_indentation_from_force
+from bem_contact.references import elliptical_hertz_force
 
 R = 7.92e-3
 E_STAR = contact_modulus(STEEL, BRASS)
@@ -56,22 +56,6 @@ def test_error_falls_with_refinement_like_dx_squared():
         errors.append(abs(solve_contact(gap, dx, E_STAR, indentation=delta).force / hertz_force(delta, R, E_STAR) - 1))
     order = np.polyfit(np.log([64, 128, 256]), np.log(errors), 1)[0]
     assert order < -1.5, errors
-
-
-def elliptical_hertz_force(delta, R1, R2, E_star):
-    """Hertz's elliptical contact (Johnson 1985, Eqs. 4.39-4.41): force for the gap x^2/(2 R1) + y^2/(2 R2), R1 > R2."""
-    A, B = 1 / (2 * R1), 1 / (2 * R2)
-
-    def ratio(m):  # B/A as a function of the eccentricity parameter m = e^2
-        K, E = special.ellipk(m), special.ellipe(m)
-        return (E / (1 - m) - K) / (K - E) - B / A
-
-    m = optimize.brentq(ratio, 1e-12, 1 - 1e-12, xtol=1e-15)
-    K, E = special.ellipk(m), special.ellipe(m)
-    a = np.sqrt(delta * (K - E) / (K * m * A))
-    b = a * np.sqrt(1 - m)
-    p0 = delta * E_star / (K * b)
-    return 2 / 3 * np.pi * a * b * p0
 
 
 def test_elliptical_contact_of_a_non_spherical_gap():

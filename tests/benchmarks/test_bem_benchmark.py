@@ -1,4 +1,4 @@
-"""Benchmarks of the contact solver against Hertz and the peers Tamaas and ContactMechanics (issue 2).
+"""Benchmarks of the contact solver against Hertz and the peers Tamaas and ContactMechanics.
 
 Run on demand:  /work/venv/bin/pytest -m benchmark tests/benchmarks/test_bem_benchmark.py -s
 Set IES_BENCH_PEER_CURVES=1 to also time the peers' 20-point curves on 512x512 (several minutes).

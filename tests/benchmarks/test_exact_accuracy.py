@@ -1,19 +1,14 @@
-"""Accuracy table of issue 5: per-impact error of the sphere's rebound velocity against scipy DOP853
+"""Accuracy table: per-impact error of the sphere's rebound velocity against scipy DOP853
 (rtol 1e-12, restarted at the contact events) for the exact integrator (default tolerance and tighter)
 and for the paper's ode3 at dt, dt/2, dt/4, dt/8 (dt = 2 pi/(15 omega_9)), on a 9-mode beam-like model
 (f1 = 117.4 Hz ... f9 = 19.8 kHz) with the beam at rest and the sphere closing at v0.
 
 Run: pytest -m benchmark tests/benchmarks/test_exact_accuracy.py -s
 """
-import sys
-from pathlib import Path
-
 import pytest
 
 from sim import exact, ode3
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sim"))
-from test_exact import per_impact_errors  # noqa: E402
+from tests.sim.test_exact import per_impact_errors
 
 pytestmark = pytest.mark.benchmark
 

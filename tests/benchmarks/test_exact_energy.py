@@ -1,16 +1,12 @@
-"""Energy conservation of the exact integrator at its defaults (issue 5, Acceptance: within 1e-6 over 1000
-impacts without damping or excitation), next to the earlier fall-back tolerance (rtol 1e-10) and to every
+"""Energy conservation of the exact integrator at its defaults (within 1e-6 over 1000 impacts without damping
+or excitation), next to a looser fall-back tolerance (rtol 1e-10) and to every
 contact by Dormand-Prince at rtol 1e-7.
 
 Run: pytest -m benchmark tests/benchmarks/test_exact_energy.py -s
 """
-import sys
-from pathlib import Path
-
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sim"))
-from test_exact_reference import ringing_energy_drift  # noqa: E402
+from sim.references import ringing_energy_drift
 
 pytestmark = pytest.mark.benchmark
 

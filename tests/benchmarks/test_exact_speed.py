@@ -1,8 +1,8 @@
-"""Speed of the exact free-flight integrator against the paper's ode3 (issue 5, Benchmark): one stepped-sine
+"""Speed of the exact free-flight integrator against the paper's ode3: one stepped-sine
 point (3 s wait + 5 s hold, 9 modes of the built-in rig, nominal parameters) at a strongly modulated and at
 an almost periodic operating point, both integrators measured in the same run from the same state.
 
-The almost periodic branch at a_base/a_base* = 7.4 is not reached from rest (issue 4): its start state is
+The almost periodic branch at a_base/a_base* = 7.4 is not reached from rest: its start state is
 prepared by a down-sweep 0.99 -> 0.978 with the exact integrator. CPU time of this thread is the figure
 (the machine is shared); wall time is printed too.
 
@@ -67,7 +67,7 @@ def test_exact_vs_ode3_one_stepped_sine_point(rig, eta, prepare, label):
                   ("exact, dopri5 contacts", functools.partial(exact.run_step, contacts="dopri5", rtol=1e-7)),
                   ("exact, dopri5 rtol 1e-10", functools.partial(exact.run_step, contacts="dopri5", rtol=1e-10)),
                   ("ode3", ode3.run_step),
-                  ("ode3 dt/8", functools.partial(ode3.run_step, dt_scale=1 / 8)))  # the accuracy bar of issue 5
+                  ("ode3 dt/8", functools.partial(ode3.run_step, dt_scale=1 / 8)))  # the per-impact accuracy bar
     collocation._CACHE.clear()
     first = _one_point(exact.run_step, y0, rig, sys, eta)[0]  # builds the collocation tables (once per system)
     for _, run_step in candidates:

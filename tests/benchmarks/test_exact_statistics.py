@@ -1,4 +1,4 @@
-"""Statistics of the exact integrator against the paper's ode3 (issue 5, Acceptance): over 8 repetitions
+"""Statistics of the exact integrator against the paper's ode3: over 8 repetitions
 (run_sweep's seeded frequency perturbations, rep = 0..7) at a strongly modulated point (a_base/a_base* = 7.4,
 eta = 0.99, from rest) and at an almost periodic point (7.4, eta = 0.978, reached by a down-sweep from
 0.99 in steps of 0.004), on the built-in rig (9 modes, nominal parameters, 3 s wait + 5 s hold).

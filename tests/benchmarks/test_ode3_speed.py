@@ -1,4 +1,4 @@
-"""Speed of the paper's ode3 (issue 4, Performance): ns per step (warm, one core) and s per stepped-sine
+"""Speed of the paper's ode3: ns per step (warm, one core) and s per stepped-sine
 point at the paper's wait and hold (3 s + 5 s) on the built-in rig model (9 modes, nominal parameters).
 
 Run: pytest -m benchmark tests/benchmarks/test_ode3_speed.py -s

@@ -1,4 +1,4 @@
-"""`ies calibrate [SCAN]`: output on good scans; one line, exit 2 and nothing written on bad ones (issue 3)."""
+"""`ies calibrate [SCAN]`: output on good scans; one line, exit 2 and nothing written on bad ones."""
 from __future__ import annotations
 
 import json
@@ -54,8 +54,8 @@ def test_imprint_without_the_flag_is_warned_about(tmp_path, capsys):
 
 
 def test_indentation_reference_is_reported_and_the_raw_scan_stays_available(tmp_path, capsys):
-    """Default: the wall denoised over 90 um, said in the text and the JSON; --denoise 0 is the raw scan
-    (the earlier behaviour), warned about when the scan is noisy; a bad --denoise is one line, exit 2."""
+    """Default: the wall denoised over 90 um, said in the text and the JSON; --denoise 0 is the raw scan,
+    warned about when the scan is noisy; a bad --denoise is one line, exit 2."""
     scan = synthetic_scan(PAPER_CRATER, side=4e-3, triangle=50e-6, noise=0.5e-6, seed=4)
     path = write_scan(tmp_path / "noisy.ply", scan.vertices, scan.faces)
     assert main(["calibrate", str(path), *FAST]) == 0
@@ -72,7 +72,7 @@ def test_indentation_reference_is_reported_and_the_raw_scan_stays_available(tmp_
     captured = capsys.readouterr()
     assert captured.out == "" and captured.err.count("\n") == 1 and "--denoise -3" in captured.err
     from scans import DEFAULT_DENOISE
-    from uq.commands.calibrate import DEFAULT_DENOISE_UM
+    from bem_contact.cli import DEFAULT_DENOISE_UM
 
     assert DEFAULT_DENOISE_UM * 1e-6 == pytest.approx(DEFAULT_DENOISE, rel=1e-12)  # the CLI's copy of the default
     assert main(["calibrate", str(path), "--denoise", "400", "--json", *FAST]) == 0

@@ -103,7 +103,7 @@ def test_shipped_crater_is_about_as_stiff_as_the_papers():
     assert imprint == pytest.approx(crater, rel=0.01)
 
 
-# one synthetic crater seen by different scans; k_H must not change by 1 % or more (issue 3)
+# one synthetic crater seen by different scans; k_H must not change by 1 % or more
 BASE = dict(side=4e-3, triangle=30e-6, seed=21)
 VARIANTS = {
     "tilted 5 deg": dict(tilt_deg=5.0, tilt_azimuth_deg=35.0),
@@ -175,7 +175,7 @@ def test_denoising_leaves_a_noise_free_crater_as_it_was(base_ratio, base_ratio_r
 
 @pytest.mark.parametrize("noise", [0.2e-6, 0.5e-6, 1e-6])
 def test_default_k_H_is_within_one_percent_for_scanner_noise_up_to_half_a_micrometre(base_ratio, noise):
-    """Issue 3: k_H changes by < 1 % with noise well below the 12 um crater depth (at 1 um the spread over
+    """k_H changes by < 1 % with noise well below the 12 um crater depth (at 1 um the spread over
     noise samples is about +-1.3 %, see the benchmark). The raw scan (denoise = 0) shows the bias the
     default removes: its first touch sits on a noise peak (-6 % at 1 um)."""
     scan = synthetic_scan(PAPER_CRATER, noise=noise, **BASE)

@@ -11,7 +11,7 @@ from sim import exact
 from sim.errors import SimulationInputError
 from sim.system import Impactor, system_arrays
 
-from test_exact_reference import cantilever_like_model, reference_run
+from sim.references import cantilever_like_model, reference_run
 
 N9 = 9
 OMEGA = 2 * math.pi * 1000.0

@@ -11,7 +11,7 @@ from sim import exact, ode3
 from sim.errors import SimulationInputError
 from sim.system import Impactor, system_arrays
 
-from test_exact_reference import cantilever_like_model, reference_run, ringing_energy_drift
+from sim.references import cantilever_like_model, reference_run, ringing_energy_drift
 
 N9 = 9
 

@@ -18,7 +18,7 @@ def test_single_mode_resonance_is_a_noabs_star():
 
 
 def test_without_impactor_resonant_level_is_one_and_response_is_the_analytic_frf(three_mode_model):
-    """Acceptance (issue 4): stepped sine without impactor, paper's 15 s wait: resonant mean = 1 within
+    """Stepped sine without impactor, paper's 15 s wait: resonant mean = 1 within
     0.5 %, and every point on the analytic frequency response of the modal model."""
     nominal = Nominal(D1=float(three_mode_model.damping_ratios[0]))
     protocol = SteppedSine(eta_start=0.996, eta_stop=1.004, n_eta=5, wait=15.0, hold=0.5, perturbation=0.0)

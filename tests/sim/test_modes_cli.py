@@ -105,3 +105,68 @@ def test_subprocess_has_no_traceback(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "uq", "modes", "--model", str(bad)], capture_output=True, text=True)
     assert proc.returncode == 2
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
+# ---- --from-calculix and --solid ------------------------------------------------------------------------------
+
+CALCULIX = os.path.join(os.path.dirname(__file__), "data", "calculix")
+JOB = ["--from-calculix", os.path.join(CALCULIX, "beam.frd"), "--mesh", os.path.join(CALCULIX, "beam.inp"),
+       "--wall-left", "WALL_LEFT", "--wall-right", "WALL_RIGHT", "--tip", "TIP", "--n-modes", "2"]
+
+
+def test_from_calculix_saves_the_same_model_with_its_provenance(tmp_path, capsys):
+    from sim.calculix import calculix_modal_model
+    from sim.modal_file import load_modal_model, load_provenance
+
+    data = run_json(capsys, *JOB, "--save", str(tmp_path / "ccx.toml"))
+    direct = calculix_modal_model(JOB[1], JOB[3], "WALL_LEFT", "WALL_RIGHT", "TIP", n_modes=2).model
+    assert data["frequencies_hz"] == pytest.approx(direct.frequencies_hz.tolist(), rel=1e-12)
+    assert data["source"].startswith("CalculiX job beam.frd")
+    saved = load_modal_model(tmp_path / "ccx.toml")
+    assert np.allclose(saved.phi_wall_left, direct.phi_wall_left, rtol=1e-12)
+    assert load_provenance(tmp_path / "ccx.toml") == data["provenance"]
+
+
+def test_solid_model_of_a_small_beam_through_the_cli(tmp_path, capsys):
+    pytest.importorskip("skfem")
+    geometry = tmp_path / "short.toml"
+    geometry.write_text("[geometry]\nfree_length = 0.12\nneck_length = 0.0\nblock_edge = 0.0\n")
+    assert main(["modes", "--solid", "--geometry", str(geometry), "--n-modes", "2", "--save",
+                 str(tmp_path / "short-rig.toml")]) == 0
+    out = capsys.readouterr().out
+    assert "solid model: hex20" in out and "mesh convergence against 12 mm" in out
+    assert "modal model: 3D solid model (sim.solid" in out
+    assert (tmp_path / "short-rig.toml").is_file()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--from-calculix", "missing.frd", *JOB[2:]], "missing.frd"),
+    ([*JOB[:5], "NOPE", *JOB[6:]], "node set 'NOPE' is not defined"),
+    (JOB[:2], "--from-calculix also needs --mesh JOB.inp, --wall-left, --wall-right, --tip"),
+    (["--solid", "--mesh", "huge"], "with --solid give a mesh level"),
+    (["--mesh", "coarse"], "belong to --solid or --from-calculix"),
+    (["--solid", "--variant", "joint-spring"], "cannot be used with --solid"),
+    (["--n-modes", "0"], "--n-modes must lie in 1..30"),
+])
+def test_bad_solid_and_calculix_input_one_line_exit_2_nothing_written(tmp_path, capsys, args, message):
+    assert main(["modes", *args, "--save", str(tmp_path / "out.toml")]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("content, message", [
+    ("[geometry]\ncavity_x = 0.03\n", "the cavity (30 x 16.4 mm) must be narrower than the section"),
+    ("[geometry]\nneck_length = -0.01\n", "neck_length must be a non-negative length"),
+    ("[geometry]\nwidth = 1\n", "unknown key(s) width in [geometry]"),
+    ("[shape]\nx = 1\n", "unknown table(s) shape"),
+    ("[geometry\n", "not valid TOML"),
+])
+def test_solid_geometry_that_does_not_fit_one_line_exit_2_nothing_written(tmp_path, capsys, content, message):
+    pytest.importorskip("skfem")
+    geometry = tmp_path / "geometry.toml"
+    geometry.write_text(content)
+    assert main(["modes", "--solid", "--geometry", str(geometry), "--save", str(tmp_path / "out.toml")]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["geometry.toml"]

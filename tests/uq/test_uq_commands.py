@@ -1,14 +1,12 @@
 """`ies sobol`, `ies interval` and `ies reproduce` end to end on analytic and noisy models."""
 import csv
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from uq.cli import main
 
-HERE = Path(__file__).parent
 AB = """
 [parameters.a]
 nominal = 0.5
@@ -24,11 +22,6 @@ max = 1.0
 def rows(path):
     with open(path, newline="") as fh:
         return list(csv.DictReader(fh))
-
-
-@pytest.fixture
-def models_on_path(monkeypatch):
-    monkeypatch.syspath_prepend(str(HERE))
 
 
 def test_sobol_command_on_ishigami(tmp_path, capsys):
@@ -55,11 +48,11 @@ def test_sobol_bad_sample_size_writes_nothing(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
-def test_noisy_model_noise_share_and_no_false_flags(tmp_path, models_on_path):
+def test_noisy_model_noise_share_and_no_false_flags(tmp_path):
     from uq.study import load_study
     from uq.execute import run_interval_study, run_sobol_study
 
-    text = "[study]\nkind = '{kind}'\nmodel = '_uq_models:noisy_linear'\nrepetitions = {reps}\nseed = 3\n" + AB
+    text = "[study]\nkind = '{kind}'\nmodel = 'uq.test_functions:noisy_linear'\nrepetitions = {reps}\nseed = 3\n" + AB
     path = tmp_path / "i.toml"
     path.write_text(text.format(kind="interval", reps=8) + "[interval]\ndesigns = ['individual', 'joint']\ninterior = 3\n")
     res = run_interval_study(load_study(path), out=tmp_path / "i", progress=False)
@@ -74,9 +67,9 @@ def test_noisy_model_noise_share_and_no_false_flags(tmp_path, models_on_path):
     assert share == pytest.approx(0.01 / (5 / 12 + 0.01), rel=0.25)
 
 
-def test_failed_runs_are_reported_not_hidden(tmp_path, models_on_path, capsys):
+def test_failed_runs_are_reported_not_hidden(tmp_path, capsys):
     path = tmp_path / "f.toml"
-    path.write_text("[study]\nkind = 'sobol'\nmodel = '_uq_models:failing'\nrepetitions = 2\n" + AB + "[sobol]\nn = 32\n")
+    path.write_text("[study]\nkind = 'sobol'\nmodel = 'uq.test_functions:failing'\nrepetitions = 2\n" + AB + "[sobol]\nn = 32\n")
     assert main(["sobol", str(path), "--out", str(tmp_path / "o"), "--quiet", "--jobs", "1", "--no-figures"]) == 0
     err = capsys.readouterr().err
     assert "runs failed" in err and "not analysed" in err and "no finite run" in err
@@ -106,7 +99,7 @@ def test_reproduce_rejects_bad_calibration(tmp_path, capsys):
 
 
 def test_calibrated_k_H_becomes_the_upper_bound():
-    from uq.commands.reproduce import study_file, with_calibration
+    from uq.commands import study_file, with_calibration
     from uq.space import K_H_STAR
     from uq.study import load_study
 
@@ -118,16 +111,21 @@ def test_calibrated_k_H_becomes_the_upper_bound():
     assert low.fix["k_H"] == pytest.approx(1.05 * K_H_STAR)
 
 
-def test_reproduce_uses_the_calibrated_k_H(tmp_path, monkeypatch, capsys):
-    """`ies reproduce` end to end on a tiny simulator study: calibrated k_H bound, data, figures, trends."""
-    import uq.commands.reproduce as reproduce
-    from uq.space import K_H_STAR
+def tiny_reproduction(tmp_path, monkeypatch, extra=""):
+    """`ies reproduce` on a tiny simulator study (k_H varied, one level, two frequencies) instead of the shipped ones."""
+    import uq.commands as reproduce
 
     tiny = tmp_path / "tiny.toml"
     tiny.write_text("[study]\nkind = 'interval'\nrepetitions = 1\n[parameters.k_H]\n[excitation]\nlevels = [7.4]\n"
-                    "eta = { start = 0.975, stop = 0.98, n = 2 }\nwait = 0.1\nhold = 0.1\nintegrator = 'ode3'\n"
-                    "[interval]\ninterior = 0\n")
+                    "eta = { start = 0.975, stop = 0.98, n = 2 }\nwait = 0.1\nhold = 0.1\n" + extra)
     monkeypatch.setattr(reproduce, "study_file", lambda figure, quick: tiny)
+
+
+def test_reproduce_uses_the_calibrated_k_H(tmp_path, monkeypatch, capsys):
+    """`ies reproduce` end to end on a tiny simulator study: calibrated k_H bound, data, figures, trends."""
+    from uq.space import K_H_STAR
+
+    tiny_reproduction(tmp_path, monkeypatch, "integrator = 'ode3'\n[interval]\ninterior = 0\n")
     calib = tmp_path / "calib.json"
     calib.write_text(json.dumps({"k_H": 1.5 * K_H_STAR}))
     out = tmp_path / "o"
@@ -155,3 +153,31 @@ def test_reproduce_unreachable_scheduler_fails_before_the_calibration(tmp_path, 
     err = capsys.readouterr().err
     assert "cannot reach the Dask scheduler" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_reproduce_calibrates_in_process(tmp_path, monkeypatch, capsys):
+    """Without --calibration FILE the front door's calibration (bem_contact.cli.calibrate_default, the shipped
+    crater) runs in this process; its JSON is kept in OUT/calibration.json and bounds k_H."""
+    from uq.space import K_H_STAR
+
+    tiny_reproduction(tmp_path, monkeypatch, "[interval]\ninterior = 0\ndesigns = ['joint']\n")
+    out = tmp_path / "o"
+    assert main(["reproduce", "fig8", "--out", str(out), "--quiet", "--jobs", "1"]) == 0
+    calibration = json.loads((out / "calibration.json").read_text())
+    assert calibration["k_H_ratio"] == pytest.approx(1.521051, abs=1e-6)  # `ies calibrate` in the README
+    assert f"= {calibration['k_H'] / K_H_STAR:.3f} k_H* (upper bound of k_H)" in capsys.readouterr().out
+    meta = json.loads((out / "fig8" / "study.json").read_text())
+    assert meta["study"]["parameters"]["k_H"]["max"] == pytest.approx(calibration["k_H"])
+
+
+def test_a_failed_calibration_is_one_warning_and_keeps_table_2(tmp_path, capsys):
+    from scans.errors import ScanError
+    from uq.commands import run_calibration
+
+    def broken():
+        raise ScanError("paper_crater.ply: the file is empty")
+
+    assert run_calibration(broken, tmp_path) is None
+    err = capsys.readouterr().err
+    assert err == "warning: the calibration failed (ScanError: paper_crater.ply: the file is empty); using Table 2's k_H bounds\n"
+    assert not list(tmp_path.iterdir())

@@ -1,5 +1,5 @@
-"""`ies calibrate`: the Hertzian spring constant k_H from a boundary-element force-indentation curve
-(seed paper, Sect. 4.1, Eq. 8, Fig. 3).
+"""The contact stage's word of the `ies` command line: `calibrate`, the Hertzian spring constant k_H from a
+boundary-element force-indentation curve (seed paper, Sect. 4.1, Eq. 8, Fig. 3).
 
 `ies calibrate [SCAN]` reads a scanned crater (or, with --imprint, its resin imprint, as in the paper),
 levels it on the flat wall, places the sphere above the crater and calibrates k_H on the gap map
@@ -10,17 +10,21 @@ Both compute the force at 20 indentations from 2 to 40 um, fit f = k_H delta^1.5
 of Eq. 8; the error bar comes from repeating the curve on a grid half as fine. The indentation is
 measured from the first touch; on a scan, from the first touch on the wall denoised by a second-order
 Gaussian filter (--denoise, default 90 um; 0 = the raw scan, whose noise peaks bias k_H low; see
-`scans.contact`). The libraries
-(`scans`, `bem_contact.calibration.calibrate_k_H`) do the work; this module only chooses the gap map
-(see `gap_source`), prints and plots.
+`scans.contact`). The libraries (`scans`, `bem_contact.calibration.calibrate_k_H`) do the work; this
+module only chooses the gap map (see `gap_source`), prints and plots.
+
+`add_commands(subparsers)` registers the command with the front door (`uq.cli`); `calibrate_default`
+gives `ies reproduce` the calibration in process. The scans stage is imported here because reading a scan
+and pressing on it is the pipeline's arrow scans -> bem_contact. Heavy imports stay inside the functions,
+so that `ies --help` stays fast.
 """
 from __future__ import annotations
 
 import argparse
+import sys
 from dataclasses import dataclass
 from typing import Any, Callable
 
-NAME = "calibrate"
 HELP = "calibrate the Hertzian spring constant k_H by BEM contact on a scanned crater or the flat wall (Sect. 4.1, Eq. 8, Fig. 3)"
 
 SPHERE_RADIUS = 7.92e-3  # m, Sect. 2
@@ -31,7 +35,15 @@ DEFAULT_DENOISE_UM = 90.0  # = scans.contact.DEFAULT_DENOISE (not imported here:
 NOISY_RAW = 0.1e-6  # m: raw-scan noise beyond which k_H is biased by more than about half a percent
 
 
+def add_commands(subparsers: Any) -> None:
+    """Register `calibrate` on the front door's subparsers (argparse)."""
+    parser = subparsers.add_parser("calibrate", help=HELP, description=HELP)
+    add_arguments(parser)
+    parser.set_defaults(_run=run)
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies calibrate`."""
     from bem_contact.geometry import SHAPES
     from bem_contact.solvers import solver_names
 
@@ -62,7 +74,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                       help=f"width (standard deviation, um) of the second-order Gaussian filter that removes scanner noise "
                            f"before the BEM and so fixes the indentation reference (first touch) on the crater, not on a "
                            f"noise peak; exact for quadratic surfaces (default {DEFAULT_DENOISE_UM:g}; 0 = the raw scan, "
-                           "the previous behaviour, k_H low by about 6 %% per um of noise)")
+                           "k_H low by about 6 %% per um of noise)")
     scan.add_argument("--smooth", type=float, default=0.0, metavar="UM",
                       help="extra plain Gaussian filter (standard deviation, um) of the wall; rounds the crater "
                            "(default 0: none)")
@@ -230,8 +242,6 @@ def calibrate(args: argparse.Namespace):
     source = gap_source(args)
     E_star = contact_modulus(STEEL, BRASS)
     deltas = np.round(np.linspace(args.delta_min_um, args.delta_max_um, args.points) * 1e-6, 13)  # m, no float noise
-    import sys
-
     from tqdm import tqdm
 
     # progress on stderr for long runs (fine grids); silent when stderr is not a terminal
@@ -299,35 +309,27 @@ def _text(data: dict[str, Any], label: str) -> str:
 
 def plot(data: dict[str, Any], label: str, path: str) -> None:
     """Force-indentation curve, the fit and Eq. 8 (Fig. 3c style), written atomically."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     import numpy as np
 
-    from uq.output import save_figure
+    from sim.files import plot_to
 
     d = np.asarray(data["deltas"])
     fine = np.linspace(0.0, d[-1], 200)
-    fig, ax = plt.subplots(figsize=(5.0, 3.8))
-    ax.plot(d * 1e3, data["forces"], "o", ms=4, label="BEM")
-    ax.plot(fine * 1e3, data["k_H"] * fine**1.5, "-", label=f"fit $k_H\\delta^{{1.5}}$, $k_H/k_H^*$ = {data['k_H_ratio']:.4f}")
-    ax.plot(fine * 1e3, data["k_H_star"] * fine**1.5, "--", label="Hertz, Eq. 8")
-    ax.set_xlabel("indentation $\\delta$ in mm")
-    ax.set_ylabel("normal contact force $f_c$ in N")
-    ax.set_title(label, fontsize=9)
-    ax.legend()
-    ax.grid(alpha=0.3)
-    try:
-        save_figure(fig, path)
-    finally:
-        plt.close(fig)
+    with plot_to(path, figsize=(5.0, 3.8)) as (fig, ax):
+        ax.plot(d * 1e3, data["forces"], "o", ms=4, label="BEM")
+        ax.plot(fine * 1e3, data["k_H"] * fine**1.5, "-", label=f"fit $k_H\\delta^{{1.5}}$, $k_H/k_H^*$ = {data['k_H_ratio']:.4f}")
+        ax.plot(fine * 1e3, data["k_H_star"] * fine**1.5, "--", label="Hertz, Eq. 8")
+        ax.set_xlabel("indentation $\\delta$ in mm")
+        ax.set_ylabel("normal contact force $f_c$ in N")
+        ax.set_title(label, fontsize=9)
+        ax.legend()
+        ax.grid(alpha=0.3)
 
 
 def scan_plot(data: dict[str, Any], source: GapSource, path: str) -> None:
     """Levelled crater map beside the force-indentation curve, its fit and Eq. 8 (Fig. 3b, 3c), atomically."""
     from scans.figures import calibration_figure
-    from uq.output import save_figure
+    from sim.files import save_figure
 
     fig = calibration_figure(source.facts["_contact"], source.facts["_metrics"], data["deltas"], data["forces"],
                              data["k_H"], data["k_H_star"])
@@ -335,7 +337,8 @@ def scan_plot(data: dict[str, Any], source: GapSource, path: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from uq.output import dumps
+    """`ies calibrate`: calibrate, plot on request, print the summary (text or JSON)."""
+    from sim.files import dumps
 
     result, source, E_star = calibrate(args)
     data = summary(result, source, E_star)
@@ -345,3 +348,13 @@ def run(args: argparse.Namespace) -> int:
         plot(data, source.label, args.plot)
     print(dumps(data) if args.json else _text(data, source.label))
     return 0
+
+
+def calibrate_default() -> dict[str, Any]:
+    """`ies calibrate --json` with every default (the shipped paper-like crater, Sect. 4.1), in process: the
+    JSON object as plain data (SI units; k_H in N/m^1.5). Raises the stages' errors as `ies calibrate` does."""
+    from sim.files import to_jsonable
+
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    return to_jsonable(summary(*calibrate(parser.parse_args([]))))

@@ -1,0 +1,469 @@
+"""The simulation stage's words of the `ies` command line: `modes`, `sweep`, `overview`.
+
+* `ies modes`: the modal model of the host structure (seed paper Sect. 3.1, Eq. 7, Appendix A), the built-in
+  model of the seed rig (`sim.rig`) or a modal-model file (`sim.modal_file`); --save writes it as a file.
+* `ies sweep`: a stepped-sine frequency response like Fig. 5 (Sects. 5.1, 5.2).
+* `ies overview`: the resonant response level against the excitation level, like Fig. 6 (Sect. 5.3).
+
+`add_commands(subparsers)` (at the end) registers them with the front door (`uq.cli`), which only dispatches. Heavy
+imports (numpy, numba) stay inside the functions, so that `ies --help` stays fast. Every bad value ends in
+one `SimulationInputError` line.
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, Iterator, Sequence
+
+from sim.errors import SimulationInputError
+
+MODES_HELP = "modal model of the host structure: frequencies, damping, mode values, participation (built-in rig or file)"
+SWEEP_HELP = "stepped-sine frequency response (mean and max amplitude per eta, spread over repetitions; Fig. 5)"
+OVERVIEW_HELP = "resonant response level (largest mean and max over eta) vs excitation level a_base/a_base* (Fig. 6)"
+
+SEQUENCE_CHOICES = ("up", "down", "up-down-up", "up-down-up-down-up")
+SWEEP_COLUMNS = ("eta", "mean", "mean_lo", "mean_hi", "max", "max_lo", "max_hi", "cv", "impacts_per_period", "regime")
+OVERVIEW_COLUMNS = ("level", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "resonant_max", "resonant_max_lo",
+                    "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max", "impacts_per_period", "regime")
+
+
+# ---- ies modes ----------------------------------------------------------------------------------------------
+
+def add_modes_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies modes`."""
+    parser.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
+    parser.add_argument("--save", metavar="FILE", help="write the model as a modal-model file (.toml)")
+    source = parser.add_mutually_exclusive_group()
+    source.add_argument("--model", metavar="FILE", help="read a modal-model file instead of the built-in seed rig")
+    source.add_argument("--solid", action="store_true",
+                        help="the rig as a 3D solid finite-element model (sim.solid; needs pip install '.[solid]')")
+    source.add_argument("--from-calculix", dest="from_calculix", metavar="JOB.frd",
+                        help="mode shapes of a CalculiX *FREQUENCY job (ASCII .frd; with --mesh JOB.inp and the node "
+                             "sets --wall-left, --wall-right, --tip; participation from JOB.dat)")
+    parser.add_argument("--variant", default=None, metavar="NAME",
+                        help="updating variant of the built-in rig: joint-spring (default) or effective-modulus")
+    parser.add_argument("--n-modes", dest="n_modes", type=int, default=9, metavar="N",
+                        help="x-bending modes to keep (default 9, as the paper; built-in rig, --solid, --from-calculix)")
+    solid = parser.add_argument_group("3D solid model (--solid) and CalculiX (--from-calculix)")
+    solid.add_argument("--mesh", metavar="LEVEL|JOB.inp",
+                       help="--solid: mesh level coarse (default, ~1 min), medium or fine; --from-calculix: the job's .inp")
+    solid.add_argument("--geometry", metavar="FILE",
+                       help="--solid: TOML file with [geometry] (sim.solid.SolidGeometry fields, m) and [material] "
+                            "(E in Pa, nu, rho in kg/m^3) tables; missing keys keep the rig's defaults")
+    solid.add_argument("--patch-radius", dest="patch_radius", type=float, default=0.0, metavar="M",
+                       help="--solid: average the wall values over a circle of this radius (m) on each wall face")
+    solid.add_argument("--wall-left", dest="wall_left", metavar="NSET", help="--from-calculix: node set of the left wall")
+    solid.add_argument("--wall-right", dest="wall_right", metavar="NSET", help="--from-calculix: node set of the right wall")
+    solid.add_argument("--tip", metavar="NSET", help="--from-calculix: node set of the measurement point")
+    solid.add_argument("--dat", metavar="JOB.dat", help="--from-calculix: the job's .dat (default: beside the .frd)")
+    solid.add_argument("--units", default="m-kg-s", choices=("m-kg-s", "mm-t-s"),
+                       help="--from-calculix: the job's consistent units (default m-kg-s)")
+
+
+def describe_modes(model: Any, rig: Any = None) -> dict:
+    """The JSON object of `ies modes --json` (Sect. 3.1, Eq. 7; Sect. 5 for a_base*; SI units): the model's
+    arrays, the modal mass ratio, a_base*, the paper's ode3 step dt = 2 pi/(15 omega_n), and with the
+    built-in rig (`sim.rig.RigModes`) its updating summary (Appendix A)."""
+    import numpy as np
+
+    from sim.system import SPHERE_MASS, a_base_star
+
+    phi_c = model.phi_contact
+    data = {
+        "source": model.source,
+        "n_modes": model.n_modes,
+        "frequencies_hz": model.frequencies_hz,
+        "damping_ratios": model.damping_ratios,
+        "phi_wall_left": model.phi_wall_left,
+        "phi_wall_right": model.phi_wall_right,
+        "phi_tip": model.phi_tip,
+        "participation": model.participation,
+        "modal_mass_ratio": SPHERE_MASS * phi_c**2,
+        "phi_tip_over_phi_c": float(model.phi_tip[0] / phi_c),
+        "a_base_star": a_base_star(model),
+        "dt": 2.0 * np.pi / (15.0 * float(model.omega[-1])),
+        "units": {"frequencies_hz": "Hz", "damping_ratios": "1", "phi": "1/sqrt(kg)", "participation": "sqrt(kg)",
+                  "a_base_star": "m", "dt": "s", "modal_mass_ratio": "1 (sphere mass m_a = %g kg)" % SPHERE_MASS},
+    }
+    if rig is not None:
+        data["rig"] = rig.summary()
+    return data
+
+
+def modes_table(data: dict) -> str:
+    """The table `ies modes` prints, from `describe_modes`."""
+    lines = [f"modal model: {data['source']}",
+             f"{'mode':>4} {'f (Hz)':>11} {'D (%)':>7} {'phi_l':>9} {'phi_r':>9} {'phi_tip':>9} {'phi^T M b':>10}"]
+    for j in range(data["n_modes"]):
+        lines.append(f"{j + 1:>4} {data['frequencies_hz'][j]:>11.2f} {100 * data['damping_ratios'][j]:>7.3f} "
+                     f"{data['phi_wall_left'][j]:>9.4f} {data['phi_wall_right'][j]:>9.4f} {data['phi_tip'][j]:>9.4f} "
+                     f"{data['participation'][j]:>10.4f}")
+    lines.append("mode values in 1/sqrt(kg), participation in sqrt(kg)")
+    lines.append(f"modal mass ratio m_a phi_c^2 = {100 * data['modal_mass_ratio']:.2f} %   "
+                 f"phi_tip/phi_c = {data['phi_tip_over_phi_c']:.4f}")
+    lines.append(f"a_base* = {data['a_base_star']:.4e} m   ode3 step dt = 2 pi/(15 omega_{data['n_modes']}) = {data['dt']:.4e} s")
+    rig = data.get("rig")
+    if rig:
+        errors = ", ".join(f"{round(100 * e, 4) + 0.0:+.4f} %" for e in rig["f_model_error"])
+        p = rig["updated_parameters"]
+        joint = p.get("joint_translational_stiffness_N_per_m")
+        lines.append(f"updated: E = {p['E_Pa'] / 1e9:.2f} GPa, neck {1e3 * p['neck_length_m']:.2f} mm long, "
+                     f"{1e3 * p['neck_width_x_m']:.2f} x {1e3 * p['neck_width_y_m']:.2f} mm (x, y), joint "
+                     + ("rigid" if joint is None else f"spring {joint:.4g} N/m"))
+        lines.append(f"f1..f4 vs Table A.1: {errors}")
+        if "f9_hz" in rig:
+            lines.append(f"f9 = {rig['f9_hz']:.0f} Hz (paper's 3D model: {rig['f9_paper_hz']:.0f} Hz)")
+    return "\n".join(lines)
+
+
+def _solid_geometry(path: str | None) -> tuple[Any, Any]:
+    """(SolidGeometry, SolidMaterial) of a --geometry TOML file (the rig's defaults without one)."""
+    import dataclasses
+    import tomllib
+
+    from sim.solid import SolidGeometry, SolidMaterial
+
+    if path is None:
+        return SolidGeometry(), SolidMaterial()
+    try:
+        doc = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise SimulationInputError(f"{path}: not valid TOML ({exc})") from None
+    unknown = set(doc) - {"geometry", "material"}
+    if unknown:
+        raise SimulationInputError(f"{path}: unknown table(s) {', '.join(sorted(unknown))}; use [geometry] and [material]")
+    built = []
+    for table, cls in (("geometry", SolidGeometry), ("material", SolidMaterial)):
+        values = doc.get(table, {})
+        fields = {f.name for f in dataclasses.fields(cls)}
+        wrong = set(values) - fields
+        if wrong:
+            raise SimulationInputError(f"{path}: unknown key(s) {', '.join(sorted(wrong))} in [{table}]; "
+                                       f"known: {', '.join(sorted(fields))}")
+        built.append(cls(**values))
+    return tuple(built)
+
+
+def _external_model(args: argparse.Namespace) -> tuple[Any, dict | None, list[str]]:
+    """(model, provenance, report lines) of --solid or --from-calculix."""
+    import sys
+
+    if args.variant is not None:
+        raise SimulationInputError("--variant selects a built-in rig model; it cannot be used with --solid or "
+                                   "--from-calculix")
+    if args.solid:
+        from sim.solid import MESH_LEVELS, solid_rig_model
+
+        level = args.mesh or "coarse"
+        if level not in MESH_LEVELS:
+            raise SimulationInputError(f"--mesh {level!r}: with --solid give a mesh level ({', '.join(MESH_LEVELS)})")
+        if not (args.patch_radius >= 0):
+            raise SimulationInputError(f"--patch-radius must be >= 0 (m), got {args.patch_radius!r}")
+        geometry, material = _solid_geometry(args.geometry)
+        sys.stderr.write(f"solving the 3D solid model ({level} mesh and a coarser one for the convergence check; "
+                         "about 1-3 min) ...\n")
+        result = solid_rig_model(level, geometry, material, n_modes=args.n_modes, patch_radius=args.patch_radius)
+        return result.model, result.provenance, result.report
+    from sim.calculix import calculix_modal_model
+
+    missing = [o for o, v in (("--mesh JOB.inp", args.mesh), ("--wall-left", args.wall_left),
+                              ("--wall-right", args.wall_right), ("--tip", args.tip)) if not v]
+    if missing:
+        raise SimulationInputError(f"--from-calculix also needs {', '.join(missing)}")
+    result = calculix_modal_model(args.from_calculix, args.mesh, args.wall_left, args.wall_right, args.tip,
+                                  dat=args.dat, units=args.units, n_modes=args.n_modes)
+    return result.model, result.provenance, result.report
+
+
+def modes_command(args: argparse.Namespace) -> int:
+    """`ies modes`: show (and with --save write) the built-in rig's model, a modal-model file, the 3D solid
+    model or the modes of a CalculiX job."""
+    from sim.files import dumps
+    from sim.modal_file import load_modal_model, save_modal_model
+
+    rig = provenance = None
+    report: list[str] = []
+    if not 1 <= args.n_modes <= 30:
+        raise SimulationInputError(f"--n-modes must lie in 1..30, got {args.n_modes}")
+    if args.solid or args.from_calculix:
+        model, provenance, report = _external_model(args)
+    elif args.mesh or args.geometry or args.wall_left or args.wall_right or args.tip or args.dat:
+        raise SimulationInputError("--mesh, --geometry, --wall-left, --wall-right, --tip and --dat belong to --solid "
+                                   "or --from-calculix")
+    elif args.model:
+        if args.variant is not None:
+            raise SimulationInputError("--variant selects a built-in rig model; it cannot be used with --model")
+        model = load_modal_model(args.model)
+    else:
+        from sim.rig import DEFAULT_VARIANT, rig_modes, seed_rig_model, variant_parameters
+
+        variant = args.variant or DEFAULT_VARIANT
+        model = seed_rig_model(n_modes=args.n_modes, variant=variant)
+        rig = rig_modes(variant_parameters(variant), n_modes=max(args.n_modes, 9))  # its updating summary needs f1..f9
+    data = describe_modes(model, rig)
+    if provenance is not None:
+        data["provenance"] = provenance
+    if args.save:
+        data["saved_to"] = str(save_modal_model(model, args.save, provenance))
+    print(dumps(data) if args.json else "\n".join([*report, modes_table(data)]))
+    return 0
+
+
+# ---- the system and the protocol, shared by ies sweep and ies overview ---------------------------------------
+
+def add_system_arguments(parser: argparse.ArgumentParser) -> None:
+    """Model and impactor options (Table 2 parameters)."""
+    parser.add_argument("--model", metavar="FILE", help="modal-model file (default: the built-in model of the seed rig)")
+    parser.add_argument("--D", type=float, metavar="D1", help="modal damping ratio of mode 1 (-), default the model's (0.00085)")
+    parser.add_argument("--g", type=float, metavar="M", help="clearance g in m (default 0.58e-3 m)")
+    parser.add_argument("--k-H", dest="k_H", type=float, metavar="N/M^1.5",
+                        help="Hertz constant k_H in N/m^1.5 (default 282e3 N/mm^1.5 = 8.918e9 N/m^1.5)")
+    parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
+
+
+def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int) -> None:
+    """Stepped-sine options (Sect. 5.1)."""
+    parser.add_argument("--eta", default="0.96:1.02:31", metavar="START:STOP:N",
+                        help="grid of eta = Omega/omega_1 (default 0.96:1.02:31)")
+    parser.add_argument("--sequence", default="up", choices=SEQUENCE_CHOICES, help="sweep legs per run (default up)")
+    parser.add_argument("--repetition", default="leg", choices=("leg", "run"),
+                        help="what counts as one repetition: each leg (the experiment's counting, default) or each run from rest")
+    parser.add_argument("--start", default="base-velocity", choices=("base-velocity", "rest"),
+                        help="initial conditions of each run: homogeneous relative ICs under the sine excitation, "
+                             "the sphere starting with the base's peak velocity so it rattles from the first point "
+                             "(default; reproduces Figs. 5-6), or at rest (the sphere stays idle until the response "
+                             "exceeds the clearance: an up-sweep then stays linear far into the resonance)")
+    parser.add_argument("--wait", type=float, default=None, metavar="S",
+                        help="wait time per frequency in s (default 3, or 15 with --no-impactor, Sect. 5.1)")
+    parser.add_argument("--hold", type=float, default=5.0, metavar="S", help="hold time per frequency in s (default 5)")
+    parser.add_argument("--reps", type=int, default=default_reps, metavar="N",
+                        help=f"runs from rest, each with its own random frequency offsets (default {default_reps})")
+    parser.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
+    parser.add_argument("--perturbation", type=float, default=5e-4, metavar="REL",
+                        help="half-width of the uniform relative frequency offset per point (default 5e-4)")
+    parser.add_argument("--integrator", default="exact", metavar="NAME",
+                        help="time integrator: exact (default; closed-form free flight, located contacts) or ode3 (the paper's fixed step)")
+    parser.add_argument("--dt-scale", dest="dt_scale", type=float, default=1.0, metavar="X",
+                        help="ode3 step as a multiple of the paper's 2 pi/(15 omega_9) (default 1)")
+
+
+def add_simulation_arguments(parser: argparse.ArgumentParser, *, default_reps: int, figure: str, stem: str) -> None:
+    """Protocol, system and output options of `ies sweep` and `ies overview` (plot: `figure`; --out: STEM.*)."""
+    add_protocol_arguments(parser, default_reps=default_reps)
+    add_system_arguments(parser)
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--plot", metavar="FILE", help=f"write a {figure}-like plot (PNG/PDF by suffix)")
+    parser.add_argument("--out", metavar="DIR", help=f"write {stem}.csv (data) and {stem}.json (data + metadata)")
+
+
+def parse_grid(text: str, option: str) -> tuple[float, float, int]:
+    """'START:STOP:N' -> (start, stop, n); one value 'X' -> (X, X, 1). One-line error otherwise."""
+    parts = text.split(":")
+    try:
+        if len(parts) == 1:
+            value = float(parts[0])
+            return value, value, 1
+        if len(parts) == 3:
+            return float(parts[0]), float(parts[1]), int(parts[2])
+    except ValueError:
+        pass
+    raise SimulationInputError(f"{option} must look like START:STOP:N (e.g. 0.96:1.02:31), got {text!r}")
+
+
+def parse_levels(text: str) -> list[float]:
+    """Excitation levels a_base/a_base* (Sect. 5.3) from '1.26,5.3' or 'START:STOP:N'; each must be positive."""
+    import numpy as np
+
+    from sim.protocol import check_level
+
+    if ":" in text:
+        start, stop, n = parse_grid(text, "--levels")
+        if n < 1 or (n > 1 and stop <= start):
+            raise SimulationInputError(f"--levels {text!r} is empty or reversed; give START < STOP and N >= 1")
+        values = list(np.linspace(start, stop, n))
+    else:
+        try:
+            values = [float(v) for v in text.split(",") if v.strip()]
+        except ValueError:
+            raise SimulationInputError(
+                f"--levels must be numbers like 1.26,5.3,6.7 or a grid START:STOP:N, got {text!r}") from None
+    if not values:
+        raise SimulationInputError("--levels is empty; give at least one excitation level")
+    return [check_level(v) for v in values]
+
+
+def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
+    """(modal model, impactor or None) of the system and impactor options (Eqs. 3-7, Table 2)."""
+    from sim.modal_file import load_modal_model
+    from sim.rig import seed_rig_model
+    from sim.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor
+
+    model = load_modal_model(args.model) if args.model else seed_rig_model(n_modes=9)
+    if args.D is not None:
+        model = model.with_damping(args.D)
+    clearance = CLEARANCE_NOMINAL if args.g is None else args.g
+    k_H = K_H_NOMINAL if args.k_H is None else args.k_H
+    impactor = Impactor(SPHERE_MASS, clearance, k_H)  # validates g and k_H even with --no-impactor
+    return model, (None if args.no_impactor else impactor)
+
+
+def build_protocol(args: argparse.Namespace) -> Any:
+    """The `sim.protocol.SteppedSine` of the protocol options (Sect. 5.1; 15 s wait without impactor)."""
+    from sim.protocol import SteppedSine
+
+    start, stop, n = parse_grid(args.eta, "--eta")
+    wait = args.wait if args.wait is not None else (15.0 if args.no_impactor else 3.0)
+    return SteppedSine(eta_start=start, eta_stop=stop, n_eta=n, sequence=args.sequence, wait=wait,
+                       hold=args.hold, perturbation=args.perturbation, repetition=args.repetition,
+                       integrator=args.integrator, dt_scale=args.dt_scale, start=args.start)
+
+
+@contextmanager
+def output_folder(path: str | None) -> Iterator[Path | None]:
+    """--out DIR, created up front (a clear error if it cannot be a folder) and removed again if the command
+    fails before writing anything into it (no empty result folders after a bad input)."""
+    if path is None:
+        yield None
+        return
+    folder = Path(path)
+    if folder.exists() and not folder.is_dir():
+        raise SimulationInputError(f"--out {folder} exists and is not a folder; choose another path")
+    created = not folder.exists()
+    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        yield folder
+    except BaseException:
+        if created and not any(folder.iterdir()):
+            folder.rmdir()
+        raise
+
+
+@contextmanager
+def simulation(args: argparse.Namespace, levels: Sequence[float], *, progress: str | None = None) -> Iterator[tuple]:
+    """(--out folder or None, protocol, model, impactor, one `sim.protocol.sweep` result per level) of the
+    options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder;
+    `progress`: the label of a progress bar over the levels (on a terminal), None for none."""
+    from tqdm import tqdm
+
+    from sim.protocol import sweep
+
+    protocol = build_protocol(args)
+    model, impactor = build_system(args)
+    with output_folder(args.out) as folder:
+        results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed)
+                   for level in tqdm(levels, desc=progress, unit="level", disable=None if progress else True, leave=False)]
+        yield folder, protocol, model, impactor, results
+
+
+def write_results(folder: Path | None, stem: str, header: Sequence[str], rows: Any, data: dict) -> None:
+    """With --out: the table as STEM.csv (data) and `data` as STEM.json (data + metadata)."""
+    from sim.files import dumps, write_csv, write_text
+
+    if folder is not None:
+        write_csv(folder / f"{stem}.csv", header, rows)
+        write_text(folder / f"{stem}.json", dumps(data) + "\n")
+
+
+# ---- ies sweep ----------------------------------------------------------------------------------------------
+
+def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies sweep`."""
+    parser.add_argument("--level", type=float, required=True, metavar="L",
+                        help="excitation level a_base/a_base* (-), a_base* = 2 D* g*/(phi_c phi^T M b)")
+    add_simulation_arguments(parser, default_reps=5, figure="Fig. 5", stem="sweep")
+
+
+def sweep_command(args: argparse.Namespace) -> int:
+    """`ies sweep`: one stepped-sine frequency response (Sects. 5.1, 5.2; Fig. 5)."""
+    from sim.figures import plot_sweep
+    from sim.files import dumps
+    from sim.protocol import check_level
+
+    started = time.perf_counter()
+    level = check_level(args.level)
+    with simulation(args, [level]) as (folder, protocol, model, impactor, (result,)):
+        data = result.to_dict()
+        data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps, model=model.source,
+                    impactor=None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
+                                                            "k_H_N_per_m1p5": impactor.k_H},
+                    D1=float(model.damping_ratios[0]))
+        columns = [result.regime_per_eta if name == "regime" else getattr(result, name) for name in SWEEP_COLUMNS]
+        write_results(folder, "sweep", SWEEP_COLUMNS, zip(*columns), data)
+    if args.plot:
+        plot_sweep(result, args.plot, f"a_base/a_base* = {level:g}, {result.n_samples} samples ({protocol.integrator})")
+    if args.json:
+        print(dumps(data))
+        return 0
+    print(f"# a_base/a_base* = {level:g}: {result.n_runs} runs, {result.n_samples} samples, {protocol.integrator}, "
+          f"{data['wall_time_s']:.1f} s")
+    print(f"{'eta':>7} {'mean':>8} {'max':>8} {'cv':>6} {'imp/T':>6}  regime")
+    for i, eta in enumerate(result.eta):
+        print(f"{eta:7.4f} {result.mean[i]:8.4f} {result.max[i]:8.4f} {result.cv[i]:6.3f} "
+              f"{result.impacts_per_period[i]:6.2f}  {result.regime_per_eta[i]}")
+    print(f"resonant mean {result.resonant_mean:.4f} at eta {result.eta_resonant_mean:.4f} ({result.regime}); "
+          f"resonant max {result.resonant_max:.4f} at eta {result.eta_resonant_max:.4f}")
+    return 0
+
+
+# ---- ies overview -------------------------------------------------------------------------------------------
+
+def add_overview_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies overview`."""
+    parser.add_argument("--levels", required=True, metavar="L1,L2,..|START:STOP:N",
+                        help="excitation levels a_base/a_base* (-), a list like 1.26,5.3,6.7,7.4 or a grid 2:8:13")
+    add_simulation_arguments(parser, default_reps=3, figure="Fig. 6", stem="overview")
+
+
+def overview_command(args: argparse.Namespace) -> int:
+    """`ies overview`: the resonant level at each excitation level (Sect. 5.3; Fig. 6)."""
+    from sim.figures import plot_overview
+    from sim.files import dumps
+
+    started = time.perf_counter()
+    levels = parse_levels(args.levels)
+    with simulation(args, levels, progress="overview") as (folder, protocol, model, _, results):
+        data = {
+            "levels": levels,
+            "resonant_mean": [r.resonant_mean for r in results],
+            "resonant_max": [r.resonant_max for r in results],
+            "resonant_mean_lo": [float(r.resonant_mean_samples.min()) for r in results],
+            "resonant_mean_hi": [float(r.resonant_mean_samples.max()) for r in results],
+            "resonant_max_lo": [float(r.resonant_max_samples.min()) for r in results],
+            "resonant_max_hi": [float(r.resonant_max_samples.max()) for r in results],
+            "eta_resonant_mean": [r.eta_resonant_mean for r in results],
+            "eta_resonant_max": [r.eta_resonant_max for r in results],
+            "regime": [r.regime for r in results],
+            "impacts_per_period": [float(r.impacts_per_period[r.eta == r.eta_resonant_mean][0]) for r in results],
+            "sweeps": [r.to_dict() for r in results],
+            "reps": args.reps, "seed": args.seed, "model": model.source,
+            "wall_time_s": time.perf_counter() - started,
+        }
+        columns = [data["levels" if name == "level" else name] for name in OVERVIEW_COLUMNS]
+        write_results(folder, "overview", OVERVIEW_COLUMNS, zip(*columns), data)
+    if args.plot:
+        plot_overview(levels, results, args.plot, f"{protocol.sequence}, {args.reps} runs ({protocol.integrator})")
+    if args.json:
+        print(dumps(data))
+        return 0
+    print(f"{'level':>7} {'res.mean':>9} {'res.max':>9} {'eta(mean)':>9} {'imp/T':>6}  regime")
+    for i, level in enumerate(levels):
+        print(f"{level:7.3f} {data['resonant_mean'][i]:9.4f} {data['resonant_max'][i]:9.4f} "
+              f"{data['eta_resonant_mean'][i]:9.4f} {data['impacts_per_period'][i]:6.2f}  {data['regime'][i]}")
+    return 0
+
+
+# ---- registration with the front door -------------------------------------------------------------------------
+
+COMMANDS = (("modes", MODES_HELP, add_modes_arguments, modes_command),
+            ("sweep", SWEEP_HELP, add_sweep_arguments, sweep_command),
+            ("overview", OVERVIEW_HELP, add_overview_arguments, overview_command))
+
+
+def add_commands(subparsers: Any) -> None:
+    """Register `modes`, `sweep` and `overview` (COMMANDS) on the front door's subparsers (argparse)."""
+    for name, help_text, add_arguments, run in COMMANDS:
+        parser = subparsers.add_parser(name, help=help_text, description=help_text)
+        add_arguments(parser)
+        parser.set_defaults(_run=run)

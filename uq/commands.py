@@ -1,0 +1,246 @@
+"""The uncertainty stage's words of the `ies` command line: `interval`, `sobol`, `reproduce` (seed paper
+Sect. 5.4, Figs. 7 and 8).
+
+* `ies interval STUDY.toml`: interval (vertex) bands of the resonant response, Figs. 7 and 8.
+* `ies sobol STUDY.toml [--n N]`: Sobol' indices (S1, ST) of the resonant response levels.
+* `ies reproduce fig7|fig8|all [--quick] [--out DIR]`: the paper's uncertainty studies, run from the shipped
+  study files (uq/studies/fig7.toml, fig8.toml, or their -quick variants) into DIR/fig7 and DIR/fig8.
+  Before that it calibrates k_H on the shipped crater (the calibration `ies calibrate --json` prints, kept in
+  DIR/calibration.json) and uses the calibrated k_H as the upper bound of k_H, as the paper does with its BEM
+  result 1.52 k_H* (Sect. 4.1); the best estimate stays 1.25 k_H* unless the calibration falls below it (then
+  the midpoint of k_H* and the calibrated value). A failed calibration is one warning line, and Table 2's
+  bounds are kept.
+
+`add_commands(subparsers, calibrate=...)` registers them with the front door (`uq.cli`), which hands over
+the calibration as a callable: this stage never imports the contact stage itself. Heavy imports stay
+inside the functions, so that `ies --help` stays fast.
+"""
+from __future__ import annotations
+
+import argparse
+import functools
+import os
+import sys
+from dataclasses import replace
+from pathlib import Path
+from typing import Any, Callable
+
+#: the calibration `ies reproduce` runs: no arguments, returns the JSON object of `ies calibrate --json`
+Calibrate = Callable[[], dict]
+
+INTERVAL_HELP = "interval bands of the resonant response level for D, g, k_H (paper Sect. 5.4, Figs. 7-8)"
+SOBOL_HELP = "Sobol' sensitivity indices of the resonant response level per excitation level (SALib)"
+REPRODUCE_HELP = "reproduce the paper's Figs. 7 and 8 (uncertainty of D, g, k_H) with the shipped studies"
+
+
+def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
+    """Register `interval`, `sobol` and `reproduce` on the front door's subparsers (argparse); `calibrate` is
+    the calibration `reproduce` runs unless told otherwise."""
+    reproduce = functools.partial(reproduce_command, calibrate=calibrate)
+    for name, help_text, add_arguments, run in (("interval", INTERVAL_HELP, add_interval_arguments, interval_command),
+                                                ("sobol", SOBOL_HELP, add_sobol_arguments, sobol_command),
+                                                ("reproduce", REPRODUCE_HELP, add_reproduce_arguments, reproduce)):
+        parser = subparsers.add_parser(name, help=help_text, description=help_text)
+        add_arguments(parser)
+        parser.set_defaults(_run=run)
+
+
+# ---- ies interval, ies sobol --------------------------------------------------------------------------------
+
+def add_run_arguments(parser: argparse.ArgumentParser) -> None:
+    """--out, --jobs, --scheduler, --resume, --no-figures, --quiet."""
+    parser.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: the study's [study] output)")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, metavar="N",
+                        help="local worker processes (default: the number of CPU cores; 1 runs in this process)")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="run on a Dask cluster, e.g. tcp://host:8786 (needs dask.distributed)")
+    parser.add_argument("--resume", action="store_true",
+                        help="continue a study in --out: reuse finished tasks, run only the missing ones")
+    parser.add_argument("--no-figures", action="store_true", help="write the data only")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def add_interval_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies interval`."""
+    parser.add_argument("study", type=Path, metavar="STUDY.toml", help="study file ([study] kind = \"interval\")")
+    add_run_arguments(parser)
+
+
+def add_sobol_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies sobol`."""
+    parser.add_argument("study", type=Path, metavar="STUDY.toml", help="study file ([study] kind = \"sobol\")")
+    parser.add_argument("--n", type=int, metavar="N", help="base sample size, a power of two (default: [sobol] n)")
+    add_run_arguments(parser)
+
+
+def interval_command(args: argparse.Namespace) -> int:
+    """`ies interval`: the study's interval bands (Sect. 5.4), then Figs. 6-8."""
+    from uq.execute import run_interval_study
+    from uq.figures import interval_figures
+
+    study = _load_study(args.study, "interval")
+    result = run_interval_study(study, out=args.out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
+                                progress=not args.quiet)
+    _report(result, [] if args.no_figures else interval_figures(result.folder))
+    return 0
+
+
+def sobol_command(args: argparse.Namespace) -> int:
+    """`ies sobol`: the study's Sobol' indices (SALib), then their figure."""
+    from uq.execute import run_sobol_study
+    from uq.figures import sobol_figure
+
+    study = _load_study(args.study, "sobol")
+    result = run_sobol_study(study, out=args.out, n=args.n, jobs=args.jobs, scheduler=args.scheduler,
+                             resume=args.resume, progress=not args.quiet)
+    _report(result, [] if args.no_figures else sobol_figure(result.folder))
+    return 0
+
+
+def _load_study(path: Path, kind: str) -> Any:
+    """The study file, refused (one line) when it is of the other kind."""
+    from uq.errors import StudyError
+    from uq.study import load_study
+
+    study = load_study(path)
+    if study.kind != kind:
+        raise StudyError(f"{path} is a '{study.kind}' study; run it with `ies {study.kind}`")
+    return study
+
+
+def _report(result: Any, figures: list[Path]) -> None:
+    """Short human summary on stdout."""
+    print(f"results in {result.folder}/")
+    for path in [*result.files, *figures]:
+        print(f"  {path.name}")
+    s = result.summary
+    print(f"{s['tasks']} runs ({s['ran']} run now, {s['reused']} reused), {s['failed_runs']} failed, "
+          f"{s['wall_time_s']:.1f} s")
+    if result.warnings:
+        print(f"{len(result.warnings)} warning(s), listed in study.json", file=sys.stderr)
+
+
+# ---- ies reproduce ------------------------------------------------------------------------------------------
+
+def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies reproduce`."""
+    parser.add_argument("figure", choices=("fig7", "fig8", "all"), help="which figure(s)")
+    parser.add_argument("--quick", action="store_true",
+                        help="reduced protocol (fewer levels, frequencies, repetitions, shorter holds); same trends")
+    parser.add_argument("--out", type=Path, default=Path("ies-out/reproduce"), metavar="DIR",
+                        help="output folder (default ies-out/reproduce)")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, metavar="N",
+                        help="local worker processes (default: the number of CPU cores)")
+    parser.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://host:8786")
+    parser.add_argument("--resume", action="store_true", help="continue an interrupted reproduction in --out")
+    calib = parser.add_mutually_exclusive_group()
+    calib.add_argument("--calibration", type=Path, metavar="FILE",
+                       help="use this `ies calibrate --json` output instead of running the calibration")
+    calib.add_argument("--no-calibration", action="store_true", help="keep Table 2's k_H bounds")
+    parser.add_argument("--model", type=Path, metavar="FILE",
+                        help="run the studies on this modal-model file (`ies modes --save`) instead of the built-in rig")
+    parser.add_argument("--integrator", metavar="NAME",
+                        help="override the study files' integrator (ode3 = the paper's scheme, exact = free flight)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def study_file(figure: str, quick: bool) -> Path:
+    """The shipped study file of a figure."""
+    from importlib.resources import files
+
+    return Path(str(files("uq") / "studies" / f"{figure}{'-quick' if quick else ''}.toml"))
+
+
+def run_calibration(calibrate: Calibrate, out: Path) -> dict | None:
+    """Run the calibration and keep its JSON object in out/calibration.json (Sect. 4.1).
+
+    Returns None after one warning line when it fails: the calibration is optional, and whatever stops it
+    (a bad scan, a solver that does not converge, ...) leaves the studies on Table 2's k_H bounds.
+    """
+    from sim.files import dumps, write_text
+
+    try:
+        data = calibrate()
+    except Exception as exc:  # noqa: BLE001 - any failure falls back to Table 2, named in the warning
+        sys.stderr.write(f"warning: the calibration failed ({type(exc).__name__}: {exc}); using Table 2's k_H bounds\n")
+        return None
+    write_text(out / "calibration.json", dumps(data))
+    return data
+
+
+def with_calibration(study: Any, k_H_cal: float) -> Any:
+    """The study with k_H's upper bound at the calibrated value (and the best estimate kept below it)."""
+    from uq.space import K_H_STAR, ParameterSpace
+
+    space = study.space
+    k = space["k_H"]
+    best = space.extras.get("k_H_best_estimate", 1.25 * K_H_STAR)
+    if best > k_H_cal:
+        best = 0.5 * (k.min + k_H_cal)
+    params = tuple(replace(p, max=max(k_H_cal, p.min)) if p.name == "k_H" else p for p in space.parameters)
+    new_space = ParameterSpace(params, {**space.extras, "k_H_best_estimate": best, "k_H_calibrated": k_H_cal})
+    fix = {**study.fix, "k_H": best} if "k_H" in study.fix else dict(study.fix)
+    return replace(study, space=new_space, fix=fix)
+
+
+def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
+    """`ies reproduce`: check every study first, connect to the cluster once, then calibrate (with
+    `calibrate` unless --calibration FILE or --no-calibration) and run."""
+    from uq.runner import check_writable, dask_client
+    from uq.study import load_study
+
+    figures = ("fig7", "fig8") if args.figure == "all" else (args.figure,)
+    studies = [load_study(study_file(f, args.quick)) for f in figures]
+    if args.integrator:
+        studies = [replace(s, protocol={**s.protocol, "integrator": args.integrator}) for s in studies]
+    if args.model is not None:
+        studies = [replace(s, modal_model=args.model) for s in studies]
+    for s in studies:
+        s.make_model().check()  # bad settings (e.g. an unknown integrator) fail here, before anything is written
+    with dask_client(args.scheduler) as client:  # connected once, first: a bad address leaves nothing behind
+        check_writable(args.out)
+        return _reproduce(args, figures, studies, client, calibrate)
+
+
+def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list, client: Any,
+               calibrate: Calibrate) -> int:
+    """Calibration (unless disabled), then each figure's interval study, its figures and its summary."""
+    from uq.errors import StudyError
+    from uq.execute import run_interval_study
+    from uq.figures import interval_figures
+    from uq.results import band_table, influence_line, trend_table
+    from uq.space import K_H_STAR, calibrated_k_H
+
+    out = args.out
+    calibration = None
+    if args.calibration is not None:
+        calibration = {"k_H": calibrated_k_H(args.calibration), "source": str(args.calibration)}
+    elif not args.no_calibration:
+        calibration = run_calibration(calibrate, out)
+    if calibration is not None:
+        k_cal = calibrated_k_H(calibration)
+        if k_cal < K_H_STAR:
+            raise StudyError(f"the calibrated k_H = {k_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; "
+                             "a crater should stiffen the contact: check the calibration or use --no-calibration")
+        print(f"calibrated k_H = {k_cal:.4g} N/m^1.5 = {k_cal / K_H_STAR:.3f} k_H* (upper bound of k_H)")
+        studies = [with_calibration(s, k_cal) for s in studies]
+    for figure, study in zip(figures, studies):
+        folder = out / figure
+        print(f"{figure}: {study.source} -> {folder}/")
+        result = run_interval_study(study, out=folder, jobs=args.jobs, client=client, resume=args.resume,
+                                    progress=not args.quiet)
+        paths = interval_figures(result.folder)
+        s = result.summary
+        print(f"{figure}: {s['tasks']} runs ({s['ran']} run now), {s['failed_runs']} failed, "
+              f"{s['wall_time_s']:.1f} s; figures: {', '.join(p.name for p in paths)}")
+        for key, ok in s["monotone"].items():
+            if not ok:
+                print(f"{figure}: monotonicity check failed for {key} (band widened; see study.json)")
+        if any(d == "individual" for d in study.designs):
+            print(f"{figure}: change of the mean resonant level from each parameter's min to its max:")
+            print(trend_table(folder))
+            print(f"{figure}: {influence_line(folder)}")
+        else:
+            print(f"{figure}: bands of the mean resonant level (a / a_noabs*):")
+            print(band_table(folder))
+    return 0

@@ -1,1 +1,0 @@
-"""Subcommands of `ies`; every public module here is one subcommand (see `uq.cli`)."""
