@@ -12,6 +12,9 @@ front door) stays light (importing all of them takes 0.6-0.8 s more):
   rig:        seed_rig_model (the built-in Timoshenko beam model of the rig, Appendix A)
   modal_file: load_modal_model, save_modal_model (modes from any FE tool)
   protocol:   SteppedSine, SweepResult, run_sweep, sweep (Sects. 5.1-5.3)
+  signals:    Signal, read_signal, simulated_signal (measured or simulated time signals)
+  impacts:    detect_impacts, ImpactDetection (impact detection, Appendix D.1)
+  modal_fit:  fit_modes, ModalFit, plot_modal_fit (modal energies between impacts, Eq. 9, Figs. 9b/10b)
 """
 from __future__ import annotations
 
@@ -26,6 +29,9 @@ _MODULE_OF = {
     "seed_rig_model": "rig",
     "load_modal_model": "modal_file", "save_modal_model": "modal_file",
     "SteppedSine": "protocol", "SweepResult": "protocol", "run_sweep": "protocol", "sweep": "protocol",
+    "Signal": "signals", "read_signal": "signals", "simulated_signal": "signals",
+    "detect_impacts": "impacts", "ImpactDetection": "impacts",
+    "fit_modes": "modal_fit", "ModalFit": "modal_fit", "plot_modal_fit": "modal_fit",
 }
 __all__ = ["SimulationDiverged", "SimulationInputError", *_MODULE_OF]
 

@@ -46,13 +46,13 @@ not fitted at all.
 from __future__ import annotations
 
 import os
-import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from sim.errors import SimulationInputError
+from sim.files import save_figure
 from sim.impacts import LOWPASS_HZ, NOMINAL_THRESHOLD, detect_impacts, estimate_excitation_hz
 from sim.signals import Signal, as_signal
 from sim.system import ModalModel
@@ -320,7 +320,8 @@ def _fit_window(t: np.ndarray, v: np.ndarray, model: ModalModel, Omega: float, i
 
 def plot_modal_fit(fit: ModalFit, path: str | os.PathLike, *, t_range: tuple[float, float] | None = None,
                    velocity_scale: float | None = None) -> Path:
-    """Fig. 9b/10b: the tip velocity against its reconstruction from Eq. 9, impacts marked; saved to path.
+    """Fig. 9b/10b: the tip velocity against its reconstruction from Eq. 9, impacts marked; saved to path
+    atomically (`sim.files.save_figure`; a missing folder raises FileNotFoundError with one line).
 
     Top: the whole signal with the impacts, the section shaded; bottom: the section t_range (s; default the
     first two excitation periods after the first impact) with the reconstruction of each fitted window
@@ -331,6 +332,7 @@ def plot_modal_fit(fit: ModalFit, path: str | os.PathLike, *, t_range: tuple[flo
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.backend_bases import FigureCanvasBase
 
     t, v = fit.signal.t, fit.signal["v_tip"]
     scale = 1.0 if velocity_scale is None else float(velocity_scale)
@@ -342,6 +344,9 @@ def plot_modal_fit(fit: ModalFit, path: str | os.PathLike, *, t_range: tuple[flo
     lo, hi = float(t_range[0]), float(t_range[1])
     if not lo < hi:
         raise SimulationInputError(f"t_range must be (start, stop) with start < stop in s, got {t_range!r}")
+    kind = Path(path).suffix.lstrip(".").lower() or "png"
+    if kind not in FigureCanvasBase.get_supported_filetypes():
+        raise SimulationInputError(f"cannot write {path}: unknown figure format '.{kind}'; use .png, .pdf or .svg")
     unit = "m/s" if velocity_scale is None else r"$\Omega a^{\mathrm{noabs}*}$"
     fig, (overview, section) = plt.subplots(2, 1, figsize=(8.0, 6.0))
     try:
@@ -373,25 +378,3 @@ def plot_modal_fit(fit: ModalFit, path: str | os.PathLike, *, t_range: tuple[flo
     finally:
         plt.close(fig)
 
-
-def save_figure(fig, path: str | os.PathLike) -> Path:
-    """Save a matplotlib figure atomically (a temporary file beside the target, then renamed)."""
-    target = Path(path)
-    kind = target.suffix.lstrip(".").lower() or "png"
-    if kind not in fig.canvas.get_supported_filetypes():
-        raise SimulationInputError(f"cannot write {target}: unknown figure format '.{kind}'; use .png, .pdf or .svg")
-    if not target.parent.is_dir():
-        raise SimulationInputError(f"cannot write {target}: folder {target.parent} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=target.suffix, dir=target.parent)
-    os.close(fd)
-    umask = os.umask(0)
-    os.umask(umask)
-    try:
-        fig.savefig(tmp, format=kind, dpi=150)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; figures are ordinary files
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return target

@@ -1,6 +1,8 @@
 """Modal reconstruction between impacts, Eq. 9 (sim.modal_fit): exact recovery of known coefficients, the
 conditioning of the mode-1 split, the warnings, and the simulator's modal energies after impacts."""
 import json
+import os
+import stat
 
 import numpy as np
 import pytest
@@ -205,14 +207,19 @@ def test_plot_is_written_atomically(tmp_path, rig):
     impacts = np.array([0.002, 0.0061, 0.0105])
     signal, _ = synthetic_velocity(rig, Omega, impacts, 0.015)
     fit = fit_modes(signal, rig, impacts, excitation_hz=Omega / (2 * np.pi))
-    target = plot_modal_fit(fit, tmp_path / "fig9b.png", velocity_scale=0.5)
-    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    umask = os.umask(0o022)
+    try:
+        target = plot_modal_fit(fit, tmp_path / "fig9b.png", velocity_scale=0.5)
+    finally:
+        os.umask(umask)
+    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and stat.S_IMODE(target.stat().st_mode) == 0o644
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fig9b.png"]
-    for path, options, expected in ((tmp_path / "missing" / "f.png", {}, "does not exist"),
-                                    (tmp_path / "f.xyz", {}, "unknown figure format"),
-                                    (tmp_path / "f.png", {"velocity_scale": -1.0}, "velocity_scale"),
-                                    (tmp_path / "f.png", {"t_range": (0.01, 0.0)}, "t_range")):
-        with pytest.raises(SimulationInputError, match=expected):
+    for path, options, error, expected in (
+            (tmp_path / "missing" / "f.png", {}, FileNotFoundError, "does not exist"),
+            (tmp_path / "f.xyz", {}, SimulationInputError, "unknown figure format"),
+            (tmp_path / "f.png", {"velocity_scale": -1.0}, SimulationInputError, "velocity_scale"),
+            (tmp_path / "f.png", {"t_range": (0.01, 0.0)}, SimulationInputError, "t_range")):
+        with pytest.raises(error, match=expected):
             plot_modal_fit(fit, path, **options)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fig9b.png"]
 
