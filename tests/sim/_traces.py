@@ -1,5 +1,5 @@
 """Simulated traces of the built-in rig for the signal-analysis tests (tests/sim/test_impacts.py,
-test_modal_fit.py, test_signals.py): the states of the exact integrator recorded at ~51.2 kHz.
+test_modal_fit.py, test_sim_signals.py): the states of the exact integrator recorded at ~51.2 kHz.
 
 The almost periodic response at a_base/a_base* = 7.4, eta = 0.976 (Sect. 5.5, Figs. 4a-b and 9) is not
 reached from rest; it is prepared by a down-sweep from eta = 0.99 (8 s per step), as in
