@@ -208,6 +208,10 @@ def detect_impacts(source: Signal | str | os.PathLike, thresholds=DEFAULT_THRESH
                                    f"{highpass_hz:g} Hz, got {lowpass_hz!r}")
     if not np.isfinite(min_separation) or min_separation < 0:
         raise SimulationInputError(f"min_separation must be >= 0 s, got {min_separation!r}")
+    if signal.duration < 2.0 / lowpass_hz:
+        raise SimulationInputError(
+            f"{signal.source}: the signal lasts {signal.duration:.3g} s; the threshold (RMS of the tip acceleration "
+            f"low-passed at {lowpass_hz:g} Hz) needs at least two periods of the cut-off, {2.0 / lowpass_hz:.3g} s")
     tip = zero_phase_filter(signal["a_tip"], fs, lowpass_hz, "lowpass")
     reference_rms = float(np.sqrt(np.mean(tip**2)))
     if reference_rms <= 0:

@@ -60,7 +60,9 @@ from sim.system import ModalModel
 #: Time left out after each impact and before the next one (s): the contact (~80 us) and the detector's
 #: timing uncertainty.
 GUARD = 0.2e-3
-#: Condition number of the column-normalised window matrix above which the fit counts as ill-conditioned.
+#: Condition number of the column-normalised window matrix above which the fit counts as ill-conditioned:
+#: a relative error e of v_tip moves the normalised coefficients by up to about condition * e. Windows of
+#: at least one period of mode 2 on the rig's traces have 8 to 4.2e3.
 MAX_CONDITION = 1e4
 #: Relative rms misfit of a window above which it counts as not described by Eq. 9 (an impact the detector
 #: missed, a contact still going on): on traces of the rig model, windows without contacts fit to < 1e-6 and
@@ -79,9 +81,9 @@ class WindowFit:
     displacement, velocity: s_j(0), s_j'(0) of each mode at `start` (m sqrt(kg), m sqrt(kg)/s);
     excitation: P of the particular solutions (complex, m/s^2, module docstring); A, B: particular solution
     of mode 1 (m sqrt(kg), Eq. 9 with tau from `start`); alpha, beta: Eq. 9's homogeneous coefficients
-    (m sqrt(kg)); energies: E_j at `start` (J); condition: condition number of
-    the column-normalised matrix; residual: rms misfit / rms of the velocity in the window (-);
-    well_posed: False when flagged (module docstring).
+    (m sqrt(kg)); energies: E_j at `start` (J); condition: condition number of the column-normalised
+    matrix; residual: rms misfit / rms of the velocity in the window (-); well_posed: False when flagged
+    (module docstring).
     """
 
     impact: float
@@ -105,6 +107,7 @@ class WindowFit:
         return float(self.energies[1:].sum() / self.energies.sum())
 
     def to_dict(self) -> dict:
+        """Plain data for JSON (SI units; the complex P as base_acceleration |P| and base_phase arg P)."""
         return {
             "impact": self.impact, "start": self.start, "stop": self.stop,
             "energies": self.energies.tolist(), "higher_share": self.higher_share,
@@ -239,27 +242,28 @@ def fit_modes(source: Signal | str | os.PathLike, model: ModalModel | str | os.P
             warnings.append(f"{where}: {inside.size} samples for {n_unknowns} unknowns; not fitted")
             continue
         window = _fit_window(t[inside], v[inside], model, Omega, impact)
-        length = t[inside[-1]] - t[inside[0]]
-        if length < shortest:
-            warnings.append(f"{where}: {length * 1e3:.3g} ms is shorter than one period of mode 2 "
-                            f"({shortest * 1e3:.3g} ms); the modes cannot be separated, left out of the share")
-            window = _flagged(window)
-        elif window.condition > MAX_CONDITION:
-            warnings.append(f"{where}: condition number {window.condition:.3g} above {MAX_CONDITION:.0e}; "
-                            "ill-conditioned, left out of the share")
-            window = _flagged(window)
-        elif window.residual > max_residual:
-            warnings.append(f"{where}: relative misfit {window.residual:.2g} above {max_residual:.0e} (an undetected "
-                            "impact or a contact still going on?), left out of the share")
-            window = _flagged(window)
+        problem = _problem(window, shortest, max_residual)
+        if problem:
+            warnings.append(f"{where}: {problem}, left out of the share")
+            window = replace(window, well_posed=False)
         windows.append(window)
     if not windows:
         warnings.append("no window between impacts could be fitted")
     return ModalFit(tuple(windows), times, excitation, estimated, guard, model, tuple(warnings), signal)
 
 
-def _flagged(window: WindowFit) -> WindowFit:
-    return replace(window, well_posed=False)
+def _problem(window: WindowFit, shortest: float, max_residual: float) -> str | None:
+    """Why a fitted window cannot be trusted (module docstring), or None."""
+    length = window.stop - window.start
+    if length < shortest:
+        return (f"{length * 1e3:.3g} ms is shorter than one period of mode 2 ({shortest * 1e3:.3g} ms); "
+                "the modes cannot be separated")
+    if window.condition > MAX_CONDITION:
+        return f"condition number {window.condition:.3g} above {MAX_CONDITION:.0e}; ill-conditioned"
+    if window.residual > max_residual:
+        return (f"relative misfit {window.residual:.2g} above {max_residual:.0e} (an undetected impact or a contact "
+                "still going on?)")
+    return None
 
 
 def _harmonic_response(model: ModalModel, Omega: float) -> np.ndarray:

@@ -150,10 +150,11 @@ def test_detection_reads_a_file(tmp_path):
     ({"thresholds": [0.0]}, "thresholds"),
     ({"drop": "a_right"}, "missing column(s) a_right"),
     ({"flat_tip": True}, "tip acceleration is zero"),
+    ({"duration": 0.01}, "needs at least two periods of the cut-off"),
 ])
 def test_bad_settings_give_one_line(changes, expected):
     fs = changes.pop("fs", 51.2e3)
-    t = np.arange(int(0.2 * fs)) / fs
+    t = np.arange(int(changes.pop("duration", 0.2) * fs)) / fs
     columns = {name: np.cos(2 * np.pi * 117 * t) for name in ("a_left", "a_right", "a_tip")}
     if changes.pop("flat_tip", False):
         columns["a_tip"] = np.zeros(t.size)
