@@ -133,7 +133,9 @@ def parse_thresholds(text: str) -> np.ndarray:
 
 
 def check_thresholds(values) -> np.ndarray:
-    """Validate threshold factors (positive, finite) and return them as a sorted array."""
+    """Validate threshold factors (positive, finite; or the text of `parse_thresholds`) as a sorted array."""
+    if isinstance(values, str):
+        return parse_thresholds(values)
     values = np.atleast_1d(np.asarray(values, dtype=float))
     if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)) or np.any(values <= 0):
         raise SimulationInputError(f"thresholds must be positive factors of the reference RMS, got {values.tolist()}")
@@ -188,7 +190,8 @@ def detect_impacts(source: Signal | str | os.PathLike, thresholds=DEFAULT_THRESH
                    lowpass_hz: float = LOWPASS_HZ, min_separation: float = MIN_SEPARATION) -> ImpactDetection:
     """Detect impacts in a signal (a CSV path or a Signal with a_left, a_right, a_tip), Appendix D.1.
 
-    thresholds: factors of the RMS of the low-passed tip acceleration (one value or several); excitation_hz:
+    thresholds: factors of the RMS of the low-passed tip acceleration (one value, several, or the option text
+    'F', 'START:STOP[:N]' of `parse_thresholds`); excitation_hz:
     the excitation frequency (Hz) for the impacts per period, estimated from a_tip when None; highpass_hz,
     lowpass_hz: cut-offs (Hz) of the wall and tip filters; min_separation: shortest time between impacts (s).
     Raises SimulationInputError with one line for a bad signal or settings (e.g. fs <= 2 highpass_hz).

@@ -148,6 +148,7 @@ def test_detection_reads_a_file(tmp_path):
     ({"min_separation": -1.0}, "min_separation"),
     ({"excitation_hz": -5.0}, "excitation frequency"),
     ({"thresholds": [0.0]}, "thresholds"),
+    ({"thresholds": "1.0:0.8"}, "threshold must be"),
     ({"drop": "a_right"}, "missing column(s) a_right"),
     ({"flat_tip": True}, "tip acceleration is zero"),
     ({"duration": 0.01}, "needs at least two periods of the cut-off"),
@@ -167,7 +168,7 @@ def test_bad_settings_give_one_line(changes, expected):
 
 def test_impacts_per_period_with_a_given_excitation_frequency():
     synthetic = synthetic_impact_signal(3, seed=4)
-    found = detect_impacts(synthetic.signal, 1.0, excitation_hz=117.0)
+    found = detect_impacts(synthetic.signal, "1.0", excitation_hz=117.0)
     assert not found.excitation_estimated
     assert found.n_periods == pytest.approx(synthetic.signal.duration * 117.0)
     assert found.impacts_per_period[0] == pytest.approx(3.0, abs=0.1)
