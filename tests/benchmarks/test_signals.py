@@ -1,4 +1,4 @@
-"""Speed of the signal analyses (issue 15, item 4) on 50 excitation periods at 51.2 kHz: the impact detector
+"""Speed of the signal analyses (`ies impacts`, `ies modal-fit`) on 50 excitation periods at 51.2 kHz: the impact detector
 (Appendix D.1) on a synthetic measurement and on a simulated trace, and the modal fit (Eq. 9) on the
 simulated trace with detected and with the simulator's impacts. Target: well under a second each. Wall time
 (median of 5, the machine is shared) and the peak of Python-side allocations (tracemalloc) are printed.

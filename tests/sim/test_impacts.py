@@ -2,7 +2,7 @@
 envelope and the excitation frequency against known signals, and the detector against synthetic signals
 with known impacts and against the simulator's own contact list.
 
-Found and false counts (issue 15): detected and true impact times are matched one-to-one, greedily the
+Found and false counts: detected and true impact times are matched one-to-one, greedily the
 nearest pair first, never farther apart than 0.2 ms (`match_impacts`). found = matched true impacts /
 true impacts; false = unmatched detections / detections.
 """
@@ -103,7 +103,7 @@ CASES = [(1, False), (2, False), (3, False), (4, False), (1.5, True), (2.5, True
 @pytest.mark.parametrize("rate, irregular", CASES)
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_synthetic_impacts_are_found_at_the_nominal_threshold(rate, irregular, seed):
-    """Issue 15 acceptance: >= 95 % found within 0.2 ms, <= 5 % false, at the nominal threshold; walls right."""
+    """The acceptance bar: >= 95 % found within 0.2 ms, <= 5 % false, at the nominal threshold; walls right."""
     synthetic = synthetic_impact_signal(rate, irregular=irregular, seed=seed)
     found = detect_impacts(synthetic.signal, [1.0])
     pairs, found_share, false_share = found_and_false(found.times, synthetic.times)

@@ -139,7 +139,7 @@ def test_a_missed_impact_is_flagged_by_the_misfit(rig):
 @pytest.mark.parametrize("impacts", ["simulator", "detected"])
 @pytest.mark.parametrize("eta, down_from, windows", [(0.976, 0.99, (120, 40)), (0.99, None, (60, 20))])
 def test_simulated_modal_energies_after_impacts(impacts, eta, down_from, windows):
-    """Issue 15 acceptance (2 % for mode 1, 10 % for modes 2..9) and more: the simulator's modal energies
+    """Beyond the acceptance bar (2 % for mode 1, 10 % for modes 2..9): the simulator's modal energies
     after impacts are recovered to 1e-6 in every well-posed window, and P to the base motion's a_base Omega^2,
     at the almost periodic (eta = 0.976) and the strongly modulated (0.99) response of level 7.4, with the
     simulator's contact onsets or with the detector's impacts at its defaults (its false detections only
@@ -227,7 +227,7 @@ def test_plot_is_written_atomically(tmp_path, rig):
 @pytest.mark.timeout(600)
 def test_simulated_energies_with_the_estimated_excitation_frequency():
     """Without the excitation frequency (a measurement): the detector's estimate is 0.1 % off at the almost
-    periodic point, and the energies stay within the acceptance of issue 15."""
+    periodic point, and the energies stay within the acceptance bar (2 %, 10 %)."""
     from _traces import rig_trace
 
     trace = rig_trace()
