@@ -346,39 +346,37 @@ def _add_modes(step, Y, lay, out):
             out[i] += tab[off.P + j * r + i] * x + tab[off.Q + j * r + i] * v
 
 
+@kernel(inline="always")
+def _node_phase(ph, i, ct, st):
+    """cos, sin(Omega t) at node i of a step (node phases ph) that starts at cos, sin(Omega t_a) = ct, st."""
+    return ct * ph[0, i] - st * ph[1, i], st * ph[0, i] + ct * ph[1, i]
+
+
+@kernel(inline="always")
+def _wall(par, wall):
+    """(sign, Re W_w, Im W_w) of wall 0 (left, c = delta) or 1 (right, c = -delta) (Eqs. 4-6)."""
+    if wall == 0:
+        return 1.0, par.W_l_re, par.W_l_im
+    return -1.0, par.W_r_re, par.W_r_im
+
+
 @kernel
-def _free_closing(step, Y, ct, st, wall, cst, out):
-    """out[i] = c_w at node i (i = s: the step's end) of the free flight from Y at phase (ct, st) (Eqs. 4-6, 9)."""
+def _free_closing(step, Y, ct, st, wall, cst, out, rate):
+    """out[i] = c_w at node i (i = s: the step's end) of the free flight from Y at phase (ct, st) (Eqs. 4-6, 9).
+
+    rate: Y is instead dY/dt at the start, and out[i] the derivative of c_w(node i) by the start time (the
+    modes enter both alike)."""
     tab, ph, off = step.tab, step.ph, step.off
     par = cst.par
     lay = state_layout(cst.modes.size)
-    sgn = 1.0 if wall == 0 else -1.0
-    Wr = par.W_l_re if wall == 0 else par.W_r_re
-    Wi = par.W_l_im if wall == 0 else par.W_r_im
+    sgn, Wr, Wi = _wall(par, wall)
     for i in range(off.s + 1):
-        tau = tab[off.TAU + i]
-        c = ct * ph[0, i] - st * ph[1, i]
-        si = st * ph[0, i] + ct * ph[1, i]
-        out[i] = sgn * (Wr * c - Wi * si - Y[lay.z] - tau * Y[lay.zd]) - par.g
+        c, si = _node_phase(ph, i, ct, st)
+        if rate:
+            out[i] = -sgn * (par.Omega * (Wr * si + Wi * c) + Y[lay.z] + tab[off.TAU + i] * Y[lay.zd])
+        else:
+            out[i] = sgn * (Wr * c - Wi * si - Y[lay.z] - tab[off.TAU + i] * Y[lay.zd]) - par.g
     _add_modes(step, Y, lay, out)
-
-
-@kernel
-def _free_closing_rate(step, Yd, ct, st, wall, cst, out):
-    """out[i] = d c_w(node i) / d(start time) of `_free_closing` for a start state moving at Yd = dY/dt."""
-    tab, ph, off = step.tab, step.ph, step.off
-    par = cst.par
-    lay = state_layout(cst.modes.size)
-    sgn = 1.0 if wall == 0 else -1.0
-    Wr = par.W_l_re if wall == 0 else par.W_r_re
-    Wi = par.W_l_im if wall == 0 else par.W_r_im
-    Om = par.Omega
-    for i in range(off.s + 1):
-        tau = tab[off.TAU + i]
-        c = ct * ph[0, i] - st * ph[1, i]
-        si = st * ph[0, i] + ct * ph[1, i]
-        out[i] = -sgn * (Om * (Wr * si + Wi * c) + Yd[lay.z] + tau * Yd[lay.zd])
-    _add_modes(step, Yd, lay, out)
 
 
 @kernel(inline="always")
@@ -469,8 +467,7 @@ def _end_state(step, Y, Yout, F, ct, st, wall):
     for k in range(s):
         ze += tab[off.BZ + k] * F[k]
         zde += tab[off.BZD + k] * F[k]
-        c = ct * ph[0, k] - st * ph[1, k]
-        si = st * ph[0, k] + ct * ph[1, k]
+        c, si = _node_phase(ph, k, ct, st)
         wf = tab[off.WQ + k] * F[k]
         re += wf * c
         im -= wf * si
@@ -703,7 +700,7 @@ def _forward_step(step, Y, ct, st, wall, ratio, ws, cst):
     s = step.off.s
     chom = ws.rows[ROW.chom]
     delta = ws.rows[ROW.delta]
-    _free_closing(step, Y, ct, st, wall, cst, chom)
+    _free_closing(step, Y, ct, st, wall, cst, chom, False)
     for i in range(s):
         delta[i] = ratio[i] * chom[i]
     if _newton(step, ws, cst.par.k_H) < 0:
@@ -755,8 +752,8 @@ def _release_step(step, end, d, wall, ratio, ws, cst):
         Yd[lay.z] = Ys[lay.zd]
         Yd[lay.zd] = sgn * f * par.inv_m_a
         cb, sb = rotate(end.cos, end.sin, -Om * d)
-        _free_closing(step, Ys, cb, sb, wall, cst, chom)
-        _free_closing_rate(step, Yd, cb, sb, wall, cst, dchom)
+        _free_closing(step, Ys, cb, sb, wall, cst, chom, False)
+        _free_closing(step, Yd, cb, sb, wall, cst, dchom, True)
         _forces(delta, F, D, kH, s)
         # the collocation equations at the nodes, then c_w = 0 at the end, and the column of d (d/dd = -d/dt_start)
         scale = max(_collocation_equations(step, chom, delta, F, D, A, rhs), abs(chom[s]))
@@ -836,8 +833,7 @@ def contact(Y, t, t_stop, wall, ctx, cst):
               and _resolution(nodes.tail, F, s) <= _RESOLUTION_TOL)
         if ok:
             _end_state(step, Y, Ynew, F, ct, st, wall)
-            c1 = ct * step.ph[0, s] - st * step.ph[1, s]
-            s1 = st * step.ph[0, s] + ct * step.ph[1, s]
+            c1, s1 = _node_phase(step.ph, s, ct, st)
             c_e, cd_e = _active(Ynew, c1, s1, wall, cst)
             if c_e > 0.0:
                 R = _time_to_release(c_e, cd_e, par.m_a, kH)

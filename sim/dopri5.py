@@ -117,6 +117,13 @@ def _combine(Y, K, d, row, out):
 
 
 @kernel(inline="always", fastmath=_FAST)
+def _stage(Y, K, tmp, d, row, k, phase, cst):
+    """Stage k: its state Y + sum_j row[j] d[j] K[j] in tmp, and K[k] = F there, at cos, sin(Omega t) = phase."""
+    _combine(Y, K, d, row, tmp)
+    rhs(phase[0], phase[1], tmp, K[k], cst)
+
+
+@kernel(inline="always", fastmath=_FAST)
 def _error(K, d, i):
     """Component i of the embedded error estimate, sum_j b_err[j] d[j] K[j, i] left to right."""
     e = DOPRI5.b_err
@@ -148,21 +155,12 @@ def step(Y, ct0, st0, s, kind, work, cst):
     p5, d5 = _warp(kind, c[4], s)
     _, d6 = _warp(kind, c[5], s)
     d = (d1, d2, d3, d4, d5, d6, d6)
-    _combine(Y, K, d, a[1], tmp)
-    ct, st = flight.rotate(ct0, st0, Om * p2)
-    rhs(ct, st, tmp, K[1], cst)
-    _combine(Y, K, d, a[2], tmp)
-    ct, st = flight.rotate(ct0, st0, Om * p3)
-    rhs(ct, st, tmp, K[2], cst)
-    _combine(Y, K, d, a[3], tmp)
-    ct, st = flight.rotate(ct0, st0, Om * p4)
-    rhs(ct, st, tmp, K[3], cst)
-    _combine(Y, K, d, a[4], tmp)
-    ct, st = flight.rotate(ct0, st0, Om * p5)
-    rhs(ct, st, tmp, K[4], cst)
-    _combine(Y, K, d, a[5], tmp)
+    _stage(Y, K, tmp, d, a[1], 1, flight.rotate(ct0, st0, Om * p2), cst)
+    _stage(Y, K, tmp, d, a[2], 2, flight.rotate(ct0, st0, Om * p3), cst)
+    _stage(Y, K, tmp, d, a[3], 3, flight.rotate(ct0, st0, Om * p4), cst)
+    _stage(Y, K, tmp, d, a[4], 4, flight.rotate(ct0, st0, Om * p5), cst)
     ct, st = flight.rotate(ct0, st0, Om * s)
-    rhs(ct, st, tmp, K[5], cst)
+    _stage(Y, K, tmp, d, a[5], 5, (ct, st), cst)
     _combine(Y, K, d, DOPRI5.b, Ynew)
     rhs(ct, st, Ynew, K[6], cst)
     err = 0.0
