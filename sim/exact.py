@@ -57,8 +57,8 @@ import numpy as np
 
 from sim import collocation, dopri5, flight
 from sim.errors import SimulationDiverged, SimulationInputError
-from sim.flight import (COUNT, MODE, NONFINITE, OK, OVERLAP, STALLED, STALLED_SEARCH, Constants, Output, run_record,
-                        state_layout)
+from sim.flight import (COUNT, NONFINITE, OK, OVERLAP, STALLED, STALLED_SEARCH, Constants, Output, mode_records,
+                        run_record, state_layout)
 from sim.jit import kernel
 from sim.system import SystemArrays, check_run_step
 
@@ -453,20 +453,17 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
     atol = rtol * sys.g
     wpos = np.maximum(np.maximum(np.abs(sys.phi_l), np.abs(sys.phi_r)), np.abs(sys.phi_tip))
     wpos = np.where(wpos > 0, wpos, 1e-300)
-    md = np.zeros(n, dtype=MODE)
-    md["sig"], md["wd"], md["w2"] = sig, wd, omega**2
-    md["phi_l"], md["phi_r"] = sys.phi_l, sys.phi_r
-    md["abs_phi_l"], md["abs_phi_r"] = np.abs(sys.phi_l), np.abs(sys.phi_r)
-    md["sig_wd"], md["inv_wd"], md["w2_wd"] = sig / wd, 1.0 / wd, omega**2 / wd
-    md["S_re"], md["S_im"] = S.real, S.imag
     rho = sys.phi_tip / (omega**2 - Omega**2 + 2j * sig * Omega)  # phi_tip,j / Delta_j
-    md["rho_re"], md["rho_im"] = rho.real, rho.imag
-    # inverse error scales: x_j error -> displacement phi_j x_j (m); velocity error e_v -> amplitude e_v / omega_j
-    md["err_x"] = wpos / atol
-    md["err_v"] = wpos / (atol * omega)
     hg = 2.0 * math.pi / Omega / N
-    md["grid_decay"] = np.exp(-sig * hg)
-    md["grid_kappa"] = np.minimum(omega**2 * hg * hg / 8.0, 2.0)
+    unset = np.zeros(n)
+    md = mode_records(
+        sig=sig, wd=wd, w2=omega**2, phi_l=sys.phi_l, phi_r=sys.phi_r, abs_phi_l=np.abs(sys.phi_l),
+        abs_phi_r=np.abs(sys.phi_r), sig_wd=sig / wd, inv_wd=1.0 / wd, w2_wd=omega**2 / wd, S_re=S.real,
+        S_im=S.imag, rho_re=rho.real, rho_im=rho.imag,
+        # inverse error scales: x_j error -> displacement phi_j x_j (m); velocity error e_v -> amplitude e_v / omega_j
+        err_x=wpos / atol, err_v=wpos / (atol * omega),
+        grid_a=unset, grid_b=unset, grid_c=unset, grid_d=unset,  # below, from the records' transition
+        grid_decay=np.exp(-sig * hg), grid_kappa=np.minimum(omega**2 * hg * hg / 8.0, 2.0))
     par = run_record(Omega=Omega, a_base=a_base, m_a=sys.m_a, inv_m_a=1.0 / sys.m_a, k_H=sys.k_H, g=sys.g,
                      W_l_re=Wl.real, W_l_im=Wl.imag, W_r_re=Wr.real, W_r_im=Wr.imag, P_re=P.real, P_im=P.imag,
                      gap_tol=GAP_TOLERANCE * sys.g, v_min=MIN_APPROACH_SPEED, M_l0=abs(Wl) * Omega**2,

@@ -110,12 +110,23 @@ RUN = np.dtype([
 ], align=True)
 
 
+def mode_records(**columns: np.ndarray) -> np.ndarray:
+    """The `MODE` records of n modes from a float array of n values per field (every field by name, SI units)."""
+    missing = set(MODE.names) - set(columns)
+    if missing or len(columns) != len(MODE.names):
+        raise ValueError(f"mode_records needs exactly the fields of MODE; missing {sorted(missing)}")
+    table = np.empty((np.size(columns["sig"]), len(MODE.names)))
+    for i, name in enumerate(MODE.names):
+        table[:, i] = columns[name]
+    return table.view(MODE).reshape(-1)  # MODE has float64 fields only: a row of the table is a record
+
+
 def run_record(**values: float) -> np.void:
     """The `RUN` record with these values (every field by name, in SI units)."""
     missing = set(RUN.names) - set(values)
     if missing or len(values) != len(RUN.names):
         raise ValueError(f"run_record needs exactly the fields of RUN; missing {sorted(missing)}")
-    return np.array(tuple(float(values[name]) for name in RUN.names), dtype=RUN)[()]
+    return np.array([values[name] for name in RUN.names], dtype=np.float64).view(RUN)[0]
 
 
 class Constants(NamedTuple):
