@@ -195,6 +195,23 @@ def _search(Y, t0, tau_end, cst, scratch, counters):
 
 
 @kernel(inline="always")
+def _grid_bounds(A, h, cst):
+    """(B_l, B_r, M_l, M_r) of a grid step of h s for the mode envelopes A: the chord bounds' curvature terms
+    and the bounds of |c''| (module docstring)."""
+    md, par = cst.modes, cst.par
+    Bl = par.M_l0 * h * h * 0.125
+    Br = par.M_r0 * h * h * 0.125
+    Ml = par.M_l0
+    Mr = par.M_r0
+    for j in range(md.size):
+        Bl += md[j].abs_phi_l * md[j].grid_kappa * A[j]
+        Br += md[j].abs_phi_r * md[j].grid_kappa * A[j]
+        Ml += md[j].abs_phi_l * md[j].w2 * A[j]
+        Mr += md[j].abs_phi_r * md[j].w2 * A[j]
+    return Bl, Br, Ml, Mr
+
+
+@kernel(inline="always")
 def _max_bound(c0, c0d, c1, c1d, B, M, h):
     """Smallest of the chord and the two Taylor upper bounds of max c over a step of length h."""
     chord = max(c0, c1) + B
@@ -290,15 +307,7 @@ def _fly(p, t, released, onsets, cst, grid, work, record):
         else:
             c0l, c0ld, c0r, c0rd = flight.closing_at(Y, rot[0, k], rot[1, k], cst)
         c1l, c1ld, c1r, c1rd = flight.closing_at(Ynew, rot[0, k + 1], rot[1, k + 1], cst)
-        Bl = par.M_l0 * hg * hg * 0.125
-        Br = par.M_r0 * hg * hg * 0.125
-        Ml = par.M_l0
-        Mr = par.M_r0
-        for j in range(lay.n):
-            Bl += md[j].abs_phi_l * md[j].grid_kappa * A[j]
-            Br += md[j].abs_phi_r * md[j].grid_kappa * A[j]
-            Ml += md[j].abs_phi_l * md[j].w2 * A[j]
-            Mr += md[j].abs_phi_r * md[j].w2 * A[j]
+        Bl, Br, Ml, Mr = _grid_bounds(A, hg, cst)
         ok = no_contact or (_max_bound(c0l, c0ld, c1l, c1ld, Bl, Ml, hg) < 0.0
                             and _max_bound(c0r, c0rd, c1r, c1rd, Br, Mr, hg) < 0.0)
         if not ok:
