@@ -1,4 +1,4 @@
-"""Contacts by exponential Gauss collocation (issue 5): a whole Hertz impact in two or three steps.
+"""Contacts by exponential Gauss collocation: a whole Hertz impact (Eq. 4) in two or three steps.
 
 During a contact with wall w only the scalar contact force F(t) = k_H c_w(t)^1.5 is nonlinear; the modes
 and the sphere respond to it linearly (Eqs. 3-7). Over a step of length h from t_a (state Y_a) we write
@@ -7,8 +7,8 @@ the closing function exactly as (Duhamel)
     c_w(t_a + tau) = c_hom(tau) - int_0^tau K_w(tau - sigma) F(sigma) dsigma,
     K_w(t) = sum_j phi_w,j^2 exp(-sigma_j t) sin(omega_dj t) / omega_dj + t / m_a,
 
-c_hom being the free flight from Y_a (closed form, `sim.exact`). F is represented by its values at s Gauss
-nodes of a time map t = t_a + h w(u), u in [0, 1] (`sim.flight._time_map`: u^2 at an onset,
+c_hom being the free flight from Y_a (closed form, `sim.flight`). F is represented by its values at s Gauss
+nodes of a time map t = t_a + h w(u), u in [0, 1] (`sim.flight.time_map`: u^2 at an onset,
 u (2 - u) before a release, so that F ~ (time to the end)^1.5 becomes a smooth function of u), and the
 s nodal equations F_i = k_H c_w(t_i)^1.5 are solved by Newton's method. Everything linear is exact:
 the s x s weights of the convolution, the modal and sphere responses to each nodal force, and the
@@ -25,22 +25,18 @@ of a period or a record instant, a failed Newton iteration) fall back to the Dor
 Accuracy: the force is interpolated by a polynomial of degree s - 1 in u, so a step has the order of
 its interpolation (about s + 1 for the modal response, 2 s for the force impulse, Gauss quadrature);
 with s = 10 a whole impact has a rebound error near 1e-10 (tests/sim/test_collocation.py).
-
-Development note: `sim.exact`'s compiled period loop embeds these kernels, and numba's cache only tracks
-each function's own file: after editing this module, delete sim/__pycache__/*.nb* (installs are not
-affected: a new version brings new files).
 """
 from __future__ import annotations
 
 import math
 from collections import OrderedDict
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 from numpy.polynomial import legendre, polynomial
 
-from sim.flight import (ONSET, REGULAR, RELEASE, _G, _IMA, _KH, _MA, _OM, _PL, _PR, _SIG, _W2, _WD, _WLI, _WLR, _WRI,
-                        _WRR, _closing_at, _rotate, _time_map, _transition)
+from sim.flight import ONSET, REGULAR, RELEASE, Constants, closing_at, rotate, state_layout, time_map, transition
+from sim.jit import kernel
 
 #: Gauss nodes per collocation step.
 NODES = 10
@@ -60,62 +56,109 @@ TABLE_QUADRATURE = 32
 
 
 # ----------------------------------------------------------------------------------------------------------
-# tables: layout and construction
+# node data and tables
 # ----------------------------------------------------------------------------------------------------------
-def _offsets(s: int, n: int) -> np.ndarray:
-    """Offsets of P, Q (n x (s+1), mode by mode), W (s x (s+1), column by column), BX, BV (s x n), BZ, BZD
-    (s), TR (4 x n), TAU (s+1), WQ (s) in a table, and the table's size (int64 array, indexed by _P ... _SIZE).
-    The layouts put the inner loops of the kernels along contiguous memory."""
+class Nodes(NamedTuple):
+    """Universal data of the s-node collocation: nodes u and weights b on [0, 1], barycentric weights wb,
+    the quadrature (xq, bq) that builds the tables, the maps from nodal forces to the Taylor coefficients
+    (in the backward time sigma / h) of the force at the end of a regular / onset step, and the rows of
+    the two highest Legendre coefficients of the force polynomial (`tail`)."""
+
+    u: np.ndarray
+    b: np.ndarray
+    wb: np.ndarray
+    xq: np.ndarray
+    bq: np.ndarray
+    regular: np.ndarray
+    onset: np.ndarray
+    tail: np.ndarray
+
+
+def gauss_nodes(s: int = NODES, order: int = SERIES_ORDER, quadrature: int = TABLE_QUADRATURE) -> Nodes:
+    """The `Nodes` of s Gauss-Legendre nodes, Taylor series of `order` terms, tables by `quadrature` points."""
+    x, w = legendre.leggauss(s)
+    u = 0.5 * (x + 1.0)
+    b = 0.5 * w
+    wb = np.array([1.0 / np.prod(u[k] - np.delete(u, k)) for k in range(s)])
+    xq, wq = legendre.leggauss(quadrature)
+    # Taylor coefficients at u = 1 of the Lagrange basis, in eps = 1 - u: C[m, k]
+    C = np.zeros((order, s))
+    for k in range(s):
+        others = np.delete(u, k)
+        lk = polynomial.polyfromroots(others) / np.prod(u[k] - others)
+        # l_k(1 - eps) as a polynomial in eps
+        coeffs = np.zeros(s)
+        one_minus = np.array([1.0, -1.0])
+        power = np.array([1.0])
+        for c in lk:
+            coeffs[:power.size] += c * power
+            power = polynomial.polymul(power, one_minus)
+        C[:s, k] = coeffs[:s] if order >= s else coeffs[:order]
+    # onset map: u = sqrt(1 - x), eps = 1 - sqrt(1 - x), x = sigma / h
+    eps = np.zeros(order)
+    binom = 1.0
+    for q in range(1, order):
+        binom *= (0.5 - (q - 1)) / q
+        eps[q] = -binom * (-1.0) ** q
+    onset = np.zeros((order, s))
+    power = np.zeros(order)
+    power[0] = 1.0
+    for m in range(s):
+        onset += np.outer(power, C[m])
+        power = np.convolve(power, eps)[:order]
+    # the two highest Legendre coefficients of the force polynomial from its nodal values (Gauss quadrature)
+    z = 2.0 * u - 1.0
+    tail = np.array([(2 * m + 1) * b * legendre.legval(z, np.eye(s)[m]) for m in (s - 2, s - 1)])
+    return Nodes(u=u, b=b, wb=wb, xq=0.5 * (xq + 1.0), bq=0.5 * wq, regular=C, onset=onset, tail=tail)
+
+
+#: The node data of `contact` (NODES nodes), frozen into the kernels as constants.
+NODE_DATA = gauss_nodes()
+
+
+#: The blocks of a table, in their order: P, Q (n x (s+1), mode by mode), W (s x (s+1), column by column), BX,
+#: BV (s x n), BZ, BZD (s), TR (4 x n), TAU (s+1), WQ (s). The layouts put the inner loops of the kernels
+#: along contiguous memory.
+TABLE_BLOCKS = ("P", "Q", "W", "BX", "BV", "BZ", "BZD", "TR", "TAU", "WQ")
+
+
+class TableLayout(NamedTuple):
+    """Offsets of the blocks of a table (`TABLE_BLOCKS`), its size, and the nodes s and modes n it is for."""
+
+    P: int
+    Q: int
+    W: int
+    BX: int
+    BV: int
+    BZ: int
+    BZD: int
+    TR: int
+    TAU: int
+    WQ: int
+    size: int
+    s: int
+    n: int
+
+
+def table_layout(s: int, n: int) -> TableLayout:
+    """The `TableLayout` of s nodes and n modes."""
     r = s + 1
-    sizes = (r * n, r * n, r * s, s * n, s * n, s, s, 4 * n, r, s)
-    return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    sizes = {"P": r * n, "Q": r * n, "W": r * s, "BX": s * n, "BV": s * n, "BZ": s, "BZD": s, "TR": 4 * n,
+             "TAU": r, "WQ": s}
+    ends = np.cumsum([sizes[name] for name in TABLE_BLOCKS])
+    starts = [0, *ends[:-1].tolist()]
+    return TableLayout(**dict(zip(TABLE_BLOCKS, starts)), size=int(ends[-1]), s=s, n=n)
 
 
-class Nodes:
-    """Universal data of the s-node collocation: nodes, weights, and the maps from nodal forces to the
-    Taylor coefficients (in the backward time sigma / h) of the force at the end of a step."""
+class Step(NamedTuple):
+    """One step's table (layout `off`), with cos, sin(Omega tau_i) at its nodes and end (2 x (s + 1))."""
 
-    def __init__(self, s: int = NODES, order: int = SERIES_ORDER):
-        x, w = legendre.leggauss(s)
-        self.u = 0.5 * (x + 1.0)
-        self.b = 0.5 * w
-        self.wb = np.array([1.0 / np.prod(self.u[k] - np.delete(self.u, k)) for k in range(s)])
-        xq, wq = legendre.leggauss(TABLE_QUADRATURE)
-        self.xq = 0.5 * (xq + 1.0)
-        self.bq = 0.5 * wq
-        # Taylor coefficients at u = 1 of the Lagrange basis, in eps = 1 - u: C[m, k]
-        C = np.zeros((order, s))
-        for k in range(s):
-            others = np.delete(self.u, k)
-            lk = polynomial.polyfromroots(others) / np.prod(self.u[k] - others)
-            # l_k(1 - eps) as a polynomial in eps
-            coeffs = np.zeros(s)
-            one_minus = np.array([1.0, -1.0])
-            power = np.array([1.0])
-            for c in lk:
-                coeffs[:power.size] += c * power
-                power = polynomial.polymul(power, one_minus)
-            C[:s, k] = coeffs[:s] if order >= s else coeffs[:order]
-        self.regular = C  # sigma / h = eps
-        # onset map: u = sqrt(1 - x), eps = 1 - sqrt(1 - x), x = sigma / h
-        eps = np.zeros(order)
-        binom = 1.0
-        for q in range(1, order):
-            binom *= (0.5 - (q - 1)) / q
-            eps[q] = -binom * (-1.0) ** q
-        onset = np.zeros((order, s))
-        power = np.zeros(order)
-        power[0] = 1.0
-        for m in range(s):
-            onset += np.outer(power, C[m])
-            power = np.convolve(power, eps)[:order]
-        self.onset = onset
-        # the two highest Legendre coefficients of the force polynomial from its nodal values (Gauss quadrature)
-        z = 2.0 * self.u - 1.0
-        self.tail = np.array([(2 * m + 1) * self.b * legendre.legval(z, np.eye(s)[m]) for m in (s - 2, s - 1)])
+    tab: np.ndarray
+    ph: np.ndarray
+    off: TableLayout
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _lagrange(u, wb, v, out):
     """out[k] = l_k(v), the Lagrange basis on the nodes u (wb: 1 / prod_m!=k (u_k - u_m)), by prefix and
     suffix products (no divisions)."""
@@ -130,76 +173,128 @@ def _lagrange(u, wb, v, out):
         acc *= v - u[k]
 
 
-# table offsets: P, Q, W, BX, BV, BZ, BZD, TR, TAU, WQ, size
-_P, _Q, _W, _BX, _BV, _BZ, _BZD, _TR, _TAU, _WQ, _SIZE = range(11)
+@kernel(inline="always")
+def _phi(md, j, wall):
+    """phi_w,j: mode j at wall 0 (left) or 1 (right)."""
+    return md[j].phi_l if wall == 0 else md[j].phi_r
 
 
-@njit(cache=True)
-def _build(tab, off, kind, h, wall, u, wb, b, xq, bq, n, modes, par):
-    """Fill one table (layout of `_offsets`) for a step of length h with the time map `kind` at wall 0/1.
+@kernel
+def _build(tab, nodes, off, kind, h, wall, cst):
+    """Fill one table (layout `off`) for a step of length h with the time map `kind` at wall 0/1 (Eqs. 3-7).
 
     P, Q: c_hom at node i (row s: the step's end) = sum_j P_ij x_j + Q_ij v_j + (harmonic and sphere terms).
     W: c_w at node i drops by sum_k W_ik F_k. BX, BV, BZ, BZD: end-state response to the nodal force F_k.
     TR: mode transitions over h. TAU: node times. WQ: quadrature weights of int F dt over the step.
     The impulse responses are the transitions' entries: x(t) = b(t), x'(t) = d(t) per unit velocity.
     """
+    md = cst.modes
+    u, wb, b, xq, bq = nodes.u, nodes.wb, nodes.b, nodes.xq, nodes.bq
     s = u.size
+    n = off.n
     sgn = 1.0 if wall == 0 else -1.0
-    row = _PL if wall == 0 else _PR
-    inv_ma = par[_IMA]
+    inv_ma = cst.par.inv_m_a
     lag_k = np.empty(s)
     tab[:] = 0.0
     for i in range(s + 1):
         ui = u[i] if i < s else 1.0
-        wi, _ = _time_map(kind, ui)
+        wi, _ = time_map(kind, ui)
         tau = h * wi
-        tab[off[_TAU] + i] = tau
+        tab[off.TAU + i] = tau
         for j in range(n):
-            a, bb, c, d = _transition(tau, modes, j)
-            tab[off[_P] + j * (s + 1) + i] = sgn * modes[row, j] * a
-            tab[off[_Q] + j * (s + 1) + i] = sgn * modes[row, j] * bb
+            a, bb, c, d = transition(tau, md, j)
+            tab[off.P + j * (s + 1) + i] = sgn * _phi(md, j, wall) * a
+            tab[off.Q + j * (s + 1) + i] = sgn * _phi(md, j, wall) * bb
         # W[i, k] = int_0^ui K(tau - h w(v)) l_k(v) h w'(v) dv
         for q in range(xq.size):
             v = ui * xq[q]
-            wv, dv = _time_map(kind, v)
+            wv, dv = time_map(kind, v)
             lag = tau - h * wv
             K = lag * inv_ma
             for j in range(n):
-                K += modes[row, j] ** 2 * _transition(lag, modes, j)[1]
+                K += _phi(md, j, wall) ** 2 * transition(lag, md, j)[1]
             weight = ui * bq[q] * K * h * dv
             _lagrange(u, wb, v, lag_k)
             for k in range(s):
-                tab[off[_W] + k * (s + 1) + i] += weight * lag_k[k]
+                tab[off.W + k * (s + 1) + i] += weight * lag_k[k]
     for q in range(xq.size):
         v = xq[q]
-        wv, dv = _time_map(kind, v)
+        wv, dv = time_map(kind, v)
         lag = h - h * wv
         _lagrange(u, wb, v, lag_k)
         for j in range(n):
-            a, bb, c, d = _transition(lag, modes, j)
+            a, bb, c, d = transition(lag, md, j)
             for k in range(s):
                 lw = bq[q] * lag_k[k] * h * dv
-                tab[off[_BX] + k * n + j] -= sgn * modes[row, j] * bb * lw
-                tab[off[_BV] + k * n + j] -= sgn * modes[row, j] * d * lw
+                tab[off.BX + k * n + j] -= sgn * _phi(md, j, wall) * bb * lw
+                tab[off.BV + k * n + j] -= sgn * _phi(md, j, wall) * d * lw
         for k in range(s):
             lw = bq[q] * lag_k[k] * h * dv
-            tab[off[_BZ] + k] += sgn * lag * lw * inv_ma
-            tab[off[_BZD] + k] += sgn * lw * inv_ma
+            tab[off.BZ + k] += sgn * lag * lw * inv_ma
+            tab[off.BZD + k] += sgn * lw * inv_ma
     for j in range(n):
-        a, bb, c, d = _transition(h, modes, j)
-        tab[off[_TR] + j] = a
-        tab[off[_TR] + n + j] = bb
-        tab[off[_TR] + 2 * n + j] = c
-        tab[off[_TR] + 3 * n + j] = d
+        a, bb, c, d = transition(h, md, j)
+        tab[off.TR + j] = a
+        tab[off.TR + n + j] = bb
+        tab[off.TR + 2 * n + j] = c
+        tab[off.TR + 3 * n + j] = d
     for k in range(s):
-        _, dk = _time_map(kind, u[k])
-        tab[off[_WQ] + k] = b[k] * h * dk
+        _, dk = time_map(kind, u[k])
+        tab[off.WQ + k] = b[k] * h * dk
 
 
 # ----------------------------------------------------------------------------------------------------------
 # one step: the free closing function at the nodes, Newton on the nodal indentations, the end state
 # ----------------------------------------------------------------------------------------------------------
-@njit(cache=True)
+class WorkRows(NamedTuple):
+    """Rows of the workspace (`Workspace.rows`) of `contact`: at the nodes and the end (s + 1 entries) the free
+    closing function `chom`, its rate `dchom` and the right-hand side `rhs`; at the nodes the indentations
+    `delta`, forces `F` and dF/d delta `D`; the states `Ynew` (a step's end) and `Ys` (a release step's
+    start); the backward series `Fs` of the force."""
+
+    chom: int
+    dchom: int
+    rhs: int
+    delta: int
+    F: int
+    D: int
+    Ynew: int
+    Ys: int
+    Fs: int
+
+
+ROW = WorkRows(*range(len(WorkRows._fields)))
+
+
+class Workspace(NamedTuple):
+    """Scratch of `contact`: the vectors named by `ROW` (rows of one array, as long as the longest), the Newton
+    matrix A ((s + 1) x (s + 1), by columns) and the backward series S of the mechanical state (order x acc).
+    One array for the vectors: every array handed to a kernel costs a reference count."""
+
+    rows: np.ndarray
+    A: np.ndarray
+    S: np.ndarray
+
+
+def workspace(nodes: Nodes, n: int) -> Workspace:
+    """The `Workspace` of `contact` for n modes."""
+    s = nodes.u.size
+    order = nodes.onset.shape[0]
+    lay = state_layout(n)
+    return Workspace(rows=np.zeros((len(ROW), max(s + 1, lay.size, order))), A=np.zeros((s + 1, s + 1)),
+                     S=np.zeros((order, lay.acc)))
+
+
+def first_guesses(nodes: Nodes) -> np.ndarray:
+    """Indentations over their first guess for an onset / regular / release step (rows 0 / 1 / 2), at the nodes."""
+    guesses = np.empty((3, nodes.u.size))
+    guesses[0] = 0.85  # onset: indentation / free indentation (Hertz: ~0.7 at the half contact)
+    guesses[1] = 0.9
+    guesses[2] = (1.0 - nodes.u) ** 2  # release: indentation / indentation at the start, linear in time to the end
+    return guesses
+
+
+@kernel
 def _solve_in_place(AT, x, m):
     """x <- A^-1 x for the leading m x m block of A, given by columns (AT[k, i] = A[i, k]; destroyed):
     Gaussian elimination with partial pivoting, column-oriented so that the inner loops run along
@@ -239,40 +334,54 @@ def _solve_in_place(AT, x, m):
     return True
 
 
-@njit(cache=True)
-def _free_closing(tab, off, ph, Y, ct, st, wall, n, s, par, out, Yd=None, out_d=None):
-    """out[i] = c_w at node i (i = s: the step's end) of the free flight from Y at phase (ct, st) (ph: the
-    node phases of `_phases`); with Yd = dY/dt at the start, out_d[i] = d out[i] / d(start time)."""
-    sgn = 1.0 if wall == 0 else -1.0
-    Wr = par[_WLR] if wall == 0 else par[_WRR]
-    Wi = par[_WLI] if wall == 0 else par[_WRI]
-    Om = par[_OM]
-    oP = off[_P]
-    oQ = off[_Q]
-    r = s + 1
-    for i in range(r):
-        tau = tab[off[_TAU] + i]
-        c = ct * ph[0, i] - st * ph[1, i]
-        si = st * ph[0, i] + ct * ph[1, i]
-        out[i] = sgn * (Wr * c - Wi * si - Y[2 * n] - tau * Y[2 * n + 1]) - par[_G]
-        if Yd is not None:
-            out_d[i] = -sgn * (Om * (Wr * si + Wi * c) + Yd[2 * n] + tau * Yd[2 * n + 1])
-    # the modes, all nodes at once: P, Q are stored mode by mode
-    for j in range(n):
-        x = Y[j]
-        v = Y[n + j]
+@kernel(inline="always")
+def _add_modes(step, Y, lay, out):
+    """out[i] += sum_j P_ij x_j + Q_ij v_j over the nodes and the end (P, Q are stored mode by mode)."""
+    tab, off = step.tab, step.off
+    r = off.s + 1
+    for j in range(lay.n):
+        x = Y[lay.x + j]
+        v = Y[lay.v + j]
         for i in range(r):
-            out[i] += tab[oP + j * r + i] * x + tab[oQ + j * r + i] * v
-        if Yd is not None:
-            x = Yd[j]
-            v = Yd[n + j]
-            for i in range(r):
-                out_d[i] += tab[oP + j * r + i] * x + tab[oQ + j * r + i] * v
+            out[i] += tab[off.P + j * r + i] * x + tab[off.Q + j * r + i] * v
 
 
-@njit(cache=True, inline="always")
+@kernel(inline="always")
+def _node_phase(ph, i, ct, st):
+    """cos, sin(Omega t) at node i of a step (node phases ph) that starts at cos, sin(Omega t_a) = ct, st."""
+    return ct * ph[0, i] - st * ph[1, i], st * ph[0, i] + ct * ph[1, i]
+
+
+@kernel(inline="always")
+def _wall(par, wall):
+    """(sign, Re W_w, Im W_w) of wall 0 (left, c = delta) or 1 (right, c = -delta) (Eqs. 4-6)."""
+    if wall == 0:
+        return 1.0, par.W_l_re, par.W_l_im
+    return -1.0, par.W_r_re, par.W_r_im
+
+
+@kernel
+def _free_closing(step, Y, ct, st, wall, cst, out, rate):
+    """out[i] = c_w at node i (i = s: the step's end) of the free flight from Y at phase (ct, st) (Eqs. 4-6, 9).
+
+    rate: Y is instead dY/dt at the start, and out[i] the derivative of c_w(node i) by the start time (the
+    modes enter both alike)."""
+    tab, ph, off = step.tab, step.ph, step.off
+    par = cst.par
+    lay = state_layout(cst.modes.size)
+    sgn, Wr, Wi = _wall(par, wall)
+    for i in range(off.s + 1):
+        c, si = _node_phase(ph, i, ct, st)
+        if rate:
+            out[i] = -sgn * (par.Omega * (Wr * si + Wi * c) + Y[lay.z] + tab[off.TAU + i] * Y[lay.zd])
+        else:
+            out[i] = sgn * (Wr * c - Wi * si - Y[lay.z] - tab[off.TAU + i] * Y[lay.zd]) - par.g
+    _add_modes(step, Y, lay, out)
+
+
+@kernel(inline="always")
 def _forces(delta, F, D, kH, s):
-    """Hertz law at the nodes: F = k_H delta^1.5, D = dF/d delta."""
+    """Hertz law (Eq. 4) at the nodes: F = k_H delta^1.5, D = dF/d delta."""
     for k in range(s):
         d = delta[k]
         if d > 0.0:
@@ -284,11 +393,13 @@ def _forces(delta, F, D, kH, s):
             D[k] = 0.0
 
 
-@njit(cache=True, inline="always")
-def _collocation_equations(tab, off, chom, delta, F, D, A, rhs, s):
+@kernel(inline="always")
+def _collocation_equations(step, chom, delta, F, D, A, rhs):
     """The s collocation equations and their Jacobian: rhs[i] = delta_i - chom_i + sum_k W_ik F_k and
     A[k, i] = delta_ik + W_ik D_k (by columns, as W is stored). Returns max |chom_i| (the indentation scale)."""
-    oW = off[_W]
+    tab, off = step.tab, step.off
+    s = off.s
+    oW = off.W
     r = s + 1
     scale = 0.0
     for i in range(s):
@@ -304,14 +415,17 @@ def _collocation_equations(tab, off, chom, delta, F, D, A, rhs, s):
     return scale
 
 
-@njit(cache=True)
-def _newton(tab, off, chom, delta, F, D, A, rhs, s, kH):
-    """Solve delta_i = chom_i - sum_k W_ik F(delta_k) for the nodal indentations (delta holds the guess).
+@kernel
+def _newton(step, ws, kH):
+    """Solve delta_i = chom_i - sum_k W_ik F(delta_k) for the nodal indentations (row delta of ws holds the guess).
 
     Returns the number of iterations, or -1 if Newton's method did not converge."""
+    s = step.off.s
+    rows, A = ws.rows, ws.A
+    chom, delta, F, D, rhs = rows[ROW.chom], rows[ROW.delta], rows[ROW.F], rows[ROW.D], rows[ROW.rhs]
     for it in range(40):
         _forces(delta, F, D, kH, s)
-        scale = _collocation_equations(tab, off, chom, delta, F, D, A, rhs, s)
+        scale = _collocation_equations(step, chom, delta, F, D, A, rhs)
         if not _solve_in_place(A, rhs, s):
             return -1
         change = 0.0
@@ -326,40 +440,43 @@ def _newton(tab, off, chom, delta, F, D, A, rhs, s, kH):
     return -1
 
 
-@njit(cache=True)
-def _end_state(tab, off, ph, Y, Yout, F, ct, st, wall, n, s, par):
-    """Yout = the state at the step's end: transitions, responses to the nodal forces, and the Fourier
-    integral of the contact force over the step (Gauss quadrature; ph: the node phases of `_phases`)."""
-    oTR = off[_TR]
+@kernel
+def _end_state(step, Y, Yout, F, ct, st, wall):
+    """Yout = the state at the step's end (Eqs. 3-7): transitions, responses to the nodal forces F, and the
+    Fourier integral of the contact force over the step (Gauss quadrature at the node phases)."""
+    tab, ph, off = step.tab, step.ph, step.off
+    lay = state_layout(off.n)
+    n = lay.n
+    s = off.s
+    oTR = off.TR
     for j in range(n):
-        x = Y[j]
-        v = Y[n + j]
-        Yout[j] = tab[oTR + j] * x + tab[oTR + n + j] * v
-        Yout[n + j] = tab[oTR + 2 * n + j] * x + tab[oTR + 3 * n + j] * v
+        x = Y[lay.x + j]
+        v = Y[lay.v + j]
+        Yout[lay.x + j] = tab[oTR + j] * x + tab[oTR + n + j] * v
+        Yout[lay.v + j] = tab[oTR + 2 * n + j] * x + tab[oTR + 3 * n + j] * v
     for k in range(s):
         f = F[k]
         for j in range(n):
-            Yout[j] += tab[off[_BX] + k * n + j] * f
-            Yout[n + j] += tab[off[_BV] + k * n + j] * f
-    h = tab[off[_TAU] + s]
-    ze = Y[2 * n] + h * Y[2 * n + 1]
-    zde = Y[2 * n + 1]
+            Yout[lay.x + j] += tab[off.BX + k * n + j] * f
+            Yout[lay.v + j] += tab[off.BV + k * n + j] * f
+    h = tab[off.TAU + s]
+    ze = Y[lay.z] + h * Y[lay.zd]
+    zde = Y[lay.zd]
     re = 0.0
     im = 0.0
     for k in range(s):
-        ze += tab[off[_BZ] + k] * F[k]
-        zde += tab[off[_BZD] + k] * F[k]
-        c = ct * ph[0, k] - st * ph[1, k]
-        si = st * ph[0, k] + ct * ph[1, k]
-        wf = tab[off[_WQ] + k] * F[k]
+        ze += tab[off.BZ + k] * F[k]
+        zde += tab[off.BZD + k] * F[k]
+        c, si = _node_phase(ph, k, ct, st)
+        wf = tab[off.WQ + k] * F[k]
         re += wf * c
         im -= wf * si
-    Yout[2 * n] = ze
-    Yout[2 * n + 1] = zde
-    for i in range(2 * n + 2, Yout.size):
+    Yout[lay.z] = ze
+    Yout[lay.zd] = zde
+    for i in range(lay.acc, Yout.size):
         Yout[i] = Y[i]
     sgn = 1.0 if wall == 0 else -1.0
-    row = 2 * n + 2 if wall == 0 else 2 * n + 4
+    row = lay.F_l if wall == 0 else lay.F_r
     Yout[row] += sgn * re
     Yout[row + 1] += sgn * im
 
@@ -367,15 +484,16 @@ def _end_state(tab, off, ph, Y, Yout, F, ct, st, wall, n, s, par):
 # ----------------------------------------------------------------------------------------------------------
 # the state inside the previous step: Taylor series in the backward time sigma
 # ----------------------------------------------------------------------------------------------------------
-@njit(cache=True)
-def _series(Yend, F, M, h, wall, n, modes, par, S, Fs):
-    """S[q]: Taylor coefficients of the state [x, v, z, z'] at t_e - sigma, Fs[q] those of the force, for
-    the solution of the step that ended at t_e (length h, force polynomial with nodal values F; M maps
-    them to the force's coefficients in sigma / h, `Nodes.regular` or `Nodes.onset`)."""
+@kernel
+def _series(Yend, F, M, h, wall, cst, S, Fs):
+    """S[q]: Taylor coefficients of the mechanical state [x, v, z, z'] at t_e - sigma (Eqs. 3-7), Fs[q] those
+    of the force, for the solution of the step that ended at t_e (length h, force polynomial with nodal
+    values F; M maps them to the force's coefficients in sigma / h, `Nodes.regular` or `Nodes.onset`)."""
+    md = cst.modes
+    lay = state_layout(md.size)
     p = S.shape[0]
     s = F.size
     sgn = 1.0 if wall == 0 else -1.0
-    row = _PL if wall == 0 else _PR
     scale = 1.0
     inv_h = 1.0 / h
     for q in range(p):
@@ -384,19 +502,19 @@ def _series(Yend, F, M, h, wall, n, modes, par, S, Fs):
             acc += M[q, k] * F[k]
         Fs[q] = acc * scale
         scale *= inv_h
-    for i in range(2 * n + 2):
+    for i in range(lay.acc):
         S[0, i] = Yend[i]
     for q in range(p - 1):
         inv = 1.0 / (q + 1)
-        for j in range(n):
-            S[q + 1, j] = -S[q, n + j] * inv
-            S[q + 1, n + j] = (2.0 * modes[_SIG, j] * S[q, n + j] + modes[_W2, j] * S[q, j]
-                               + sgn * modes[row, j] * Fs[q]) * inv
-        S[q + 1, 2 * n] = -S[q, 2 * n + 1] * inv
-        S[q + 1, 2 * n + 1] = -sgn * Fs[q] * par[_IMA] * inv
+        for j in range(lay.n):
+            S[q + 1, lay.x + j] = -S[q, lay.v + j] * inv
+            S[q + 1, lay.v + j] = (2.0 * md[j].sig * S[q, lay.v + j] + md[j].w2 * S[q, lay.x + j]
+                                   + sgn * _phi(md, j, wall) * Fs[q]) * inv
+        S[q + 1, lay.z] = -S[q, lay.zd] * inv
+        S[q + 1, lay.zd] = -sgn * Fs[q] * cst.par.inv_m_a * inv
 
 
-@njit(cache=True)
+@kernel
 def _series_at(S, sigma, Y, m):
     """Y[:m] = the state at t_e - sigma from the series S of `_series` (Horner, all components at once)."""
     p = S.shape[0]
@@ -413,7 +531,7 @@ _INV = 1.0 / np.arange(1.0, 40.0)
 _OVERLAP_TERMS = 5
 
 
-@njit(cache=True)
+@kernel
 def _overlap_fourier(Fs, sigma, ct_e, st_e, Om):
     """int over [t_e - sigma, t_e] of F(t) exp(-i Omega t) dt from the force's series (Omega sigma << 1)."""
     jr = 0.0
@@ -460,9 +578,6 @@ _MAX_HALVINGS = 4
 _MAX_STEP_PERIODS = 1.0
 # outcome of `contact`
 RELEASED, FALLBACK = 0, 1
-# rows of the workspace `ws`
-_CHOM, _DCHOM, _DELTA, _F, _D, _RHS, _YNEW, _YS, _FS = range(9)
-_WS_ROWS = 9
 # 6-point Gauss-Legendre on [0, 1] for `_time_to_release`
 _GL6_X = np.array([0.033765242898423975, 0.16939530676686776, 0.3806904069584015, 0.6193095930415985,
                    0.8306046932331322, 0.966234757101576])
@@ -470,7 +585,7 @@ _GL6_W = np.array([0.08566224618958517, 0.1803807865240693, 0.23395696728634552,
                    0.1803807865240693, 0.08566224618958517])
 
 
-@njit(cache=True)
+@kernel
 def _time_to_release(c, cd, ma, kH):
     """Time left in a contact at indentation c > 0 and rate cd, for a Hertz impact of the sphere on a
     rigid wall with the same energy (a first guess for the release step)."""
@@ -491,7 +606,7 @@ def _time_to_release(c, cd, ma, kH):
     return dmax / ve * J
 
 
-@njit(cache=True)
+@kernel
 def _ladder(h, h_ref, up):
     """Index of the ladder step just below (up=False) or above (up=True) h; -1 if outside the ladder."""
     x = LADDER_PER_OCTAVE * math.log2(h / h_ref) + LADDER_CENTRE
@@ -499,38 +614,70 @@ def _ladder(h, h_ref, up):
     return k if 0 <= k < LADDER_SIZE else -1
 
 
-@njit(cache=True)
+@kernel
 def _ladder_h(k, h_ref):
+    """Length (s) of ladder step k."""
     return h_ref * 2.0 ** ((k - LADDER_CENTRE) / LADDER_PER_OCTAVE)
 
 
-@njit(cache=True)
-def _table(tabs, built, off, wall, kind, k, h_ref, u, wb, b, xq, bq, n, modes, par):
-    """The table of (wall, kind, ladder index k), built on first use."""
-    if not built[wall, kind, k]:
-        _build(tabs[wall, kind, k], off, kind, _ladder_h(k, h_ref), wall, u, wb, b, xq, bq, n, modes, par)
-        built[wall, kind, k] = True
-    return tabs[wall, kind, k]
+class Tables(NamedTuple):
+    """The ladder of tables of one system, `tabs[wall, kind, k]` (built on first use, then `built` is set),
+    their layout, and h_ref (the period of the highest mode, s) that scales the ladder."""
+
+    tabs: np.ndarray
+    built: np.ndarray
+    off: TableLayout
+    h_ref: float
 
 
-@njit(cache=True)
-def _phases(phases, phased, tab, off, kind, k, Om, s):
-    """cos, sin(Omega tau_i) at the nodes and the end (i = s) of table (kind, k), on first use in a run."""
+class Context(NamedTuple):
+    """What `contact` works with in one run_step call (the nodes are `NODE_DATA`): the system's `Tables`, the
+    first `guesses` (rows of `first_guesses`, updated from contact to contact), cos, sin(Omega tau_i) of each
+    table's nodes (`phases`, filled on first use, then `phased` is set) and the `Workspace`."""
+
+    tables: Tables
+    guesses: np.ndarray
+    phases: np.ndarray
+    phased: np.ndarray
+    work: Workspace
+
+
+class StepEnd(NamedTuple):
+    """The end of the last accepted step: cos, sin(Omega t) there, the step's length h (s), and c, c' of the
+    active wall there (m, m/s)."""
+
+    cos: float
+    sin: float
+    h: float
+    c: float
+    cd: float
+
+
+@kernel
+def _step_table(tables, phases, phased, wall, kind, k, cst):
+    """The `Step` of (wall, kind, ladder index k): its table built (`NODE_DATA`) and its node phases computed
+    (in phases, phased of the `Context`) on first use."""
+    off = tables.off
+    if not tables.built[wall, kind, k]:
+        _build(tables.tabs[wall, kind, k], NODE_DATA, off, kind, _ladder_h(k, tables.h_ref), wall, cst)
+        tables.built[wall, kind, k] = True
+    tab = tables.tabs[wall, kind, k]
     if not phased[kind, k]:
-        for i in range(s + 1):
-            phases[kind, k, 0, i], phases[kind, k, 1, i] = _rotate(1.0, 0.0, Om * tab[off[_TAU] + i])
+        Om = cst.par.Omega
+        for i in range(off.s + 1):
+            phases[kind, k, 0, i], phases[kind, k, 1, i] = rotate(1.0, 0.0, Om * tab[off.TAU + i])
         phased[kind, k] = True
-    return phases[kind, k]
+    return Step(tab, phases[kind, k], off)
 
 
-@njit(cache=True)
-def _active(Y, ct, st, wall, n, modes, par):
-    """(c, c') of `wall`."""
-    cl, cld, cr, crd = _closing_at(Y, ct, st, n, modes, par)
+@kernel
+def _active(Y, ct, st, wall, cst):
+    """(c, c') of `wall` (Eqs. 4-6)."""
+    cl, cld, cr, crd = closing_at(Y, ct, st, cst)
     return (cl, cld) if wall == 0 else (cr, crd)
 
 
-@njit(cache=True)
+@kernel
 def _resolution(tail, F, s):
     """max |c_m| / max |F| over the two highest Legendre coefficients c_m of the step's force polynomial:
     small when the force is resolved (spectral decay), O(1) when it is not (a near-release inside)."""
@@ -546,64 +693,70 @@ def _resolution(tail, F, s):
     return top / fmax if fmax > 0.0 else 0.0
 
 
-@njit(cache=True)
-def _forward_step(tab, off, ph, Y, ct, st, wall, n, s, par, ws, A, ratio, tail):
-    """Solve a step from Y that has no release inside: nodal forces in ws[_F], first guess ratio times the
-    free indentation (ratio is updated). False if Newton's method failed, an indentation is not positive or
-    the force is not resolved."""
-    chom = ws[_CHOM]
-    delta = ws[_DELTA]
-    _free_closing(tab, off, ph, Y, ct, st, wall, n, s, par, chom)
+@kernel
+def _forward_step(step, Y, ct, st, wall, ratio, ws, cst):
+    """Solve a step from Y that has no release inside: nodal forces in row F of ws, first guess ratio times
+    the free indentation (ratio is updated). False if Newton's method failed or an indentation is not positive."""
+    s = step.off.s
+    chom = ws.rows[ROW.chom]
+    delta = ws.rows[ROW.delta]
+    _free_closing(step, Y, ct, st, wall, cst, chom, False)
     for i in range(s):
         delta[i] = ratio[i] * chom[i]
-    if _newton(tab, off, chom, delta, ws[_F], ws[_D], A, ws[_RHS], s, par[_KH]) < 0:
+    if _newton(step, ws, cst.par.k_H) < 0:
         return False
     for i in range(s):
         if not delta[i] > 0.0:
             return False
     for i in range(s):
         ratio[i] = delta[i] / chom[i]
-    return _resolution(tail, ws[_F], s) <= _RESOLUTION_TOL
+    return True
 
 
-@njit(cache=True)
-def _release_step(tab, off, ph, S, Fs, ct, st, d, d_lo, d_hi, c_e, cd_e, wall, n, s, modes, par, ws, A, ratio):
-    """Newton's method for the release step of table `tab` that starts d before the last step's end (phase
-    ct, st there; series S of the state, Fs of the force): unknowns the nodal indentations and d, equations
-    the collocation and c_w = 0 at the step's end. d is kept in [d_lo, d_hi] (the series' range). Returns
-    (status, d): 0 converged, 1 failed, 2 d left its range (the release is elsewhere: another ladder
-    length); the nodal forces are left in ws[_F]."""
-    chom = ws[_CHOM]
-    dchom = ws[_DCHOM]
-    delta = ws[_DELTA]
-    F = ws[_F]
-    D = ws[_D]
-    rhs = ws[_RHS]
-    Ys = ws[_YS]
-    Yd = ws[_YNEW]  # dY/dt at the start (the row is free while the release step runs)
-    Om = par[_OM]
-    kH = par[_KH]
+@kernel
+def _release_step(step, end, d, wall, ratio, ws, cst):
+    """Newton's method for the release step `step` that starts d before the last step's `end` (a `StepEnd`;
+    the series of that step's state and force in ws.S and row Fs of ws): unknowns the nodal indentations and d,
+    equations the collocation and c_w = 0 at the step's end. d is kept in [-0.3 h, 0.6 h] of the last step
+    (the series' range). Returns (status, d): 0 converged, 1 failed, 2 d left its range (the release is
+    elsewhere: another ladder length); the nodal forces are left in row F of ws."""
+    md, par = cst.modes, cst.par
+    lay = state_layout(md.size)
+    tab, off = step.tab, step.off
+    s = off.s
+    rows, A, S = ws.rows, ws.A, ws.S
+    chom, dchom, delta, F, D, rhs = (rows[ROW.chom], rows[ROW.dchom], rows[ROW.delta], rows[ROW.F], rows[ROW.D],
+                                     rows[ROW.rhs])
+    Fs = rows[ROW.Fs, :S.shape[0]]
+    Ys = rows[ROW.Ys]
+    Yd = rows[ROW.Ynew]  # dY/dt at the start (free while the release step runs)
+    Om = par.Omega
+    kH = par.k_H
     sgn = 1.0 if wall == 0 else -1.0
-    row = _PL if wall == 0 else _PR
-    oW = off[_W]
+    oW = off.W
+    d_lo = -0.3 * end.h
+    d_hi = 0.6 * end.h
+    c_e = end.c
     for i in range(s):
         delta[i] = ratio[i] * c_e
     for _ in range(30):
         # the start state (series at d), its rate dY/dt (Eqs. 3-7 with the force's series) and c_hom at the nodes
-        _series_at(S, d, Ys, 2 * n + 2)
+        _series_at(S, d, Ys, lay.acc)
         f = Fs[Fs.size - 1]
         for q in range(Fs.size - 2, -1, -1):
             f = f * d + Fs[q]
-        for j in range(n):
-            Yd[j] = Ys[n + j]
-            Yd[n + j] = -2.0 * modes[_SIG, j] * Ys[n + j] - modes[_W2, j] * Ys[j] - sgn * modes[row, j] * f
-        Yd[2 * n] = Ys[2 * n + 1]
-        Yd[2 * n + 1] = sgn * f * par[_IMA]
-        cb, sb = _rotate(ct, st, -Om * d)
-        _free_closing(tab, off, ph, Ys, cb, sb, wall, n, s, par, chom, Yd, dchom)
+        for j in range(lay.n):
+            Yd[lay.x + j] = Ys[lay.v + j]
+            Yd[lay.v + j] = (-2.0 * md[j].sig * Ys[lay.v + j] - md[j].w2 * Ys[lay.x + j]
+                             - sgn * _phi(md, j, wall) * f)
+        Yd[lay.z] = Ys[lay.zd]
+        Yd[lay.zd] = sgn * f * par.inv_m_a
+        cb, sb = rotate(end.cos, end.sin, -Om * d)
+        _free_closing(step, Ys, cb, sb, wall, cst, chom, False)
+        _free_closing(step, Yd, cb, sb, wall, cst, dchom, True)
         _forces(delta, F, D, kH, s)
         # the collocation equations at the nodes, then c_w = 0 at the end, and the column of d (d/dd = -d/dt_start)
-        scale = max(_collocation_equations(tab, off, chom, delta, F, D, A, rhs, s), abs(chom[s]))
+        scale = max(_collocation_equations(step, chom, delta, F, D, A, rhs), abs(chom[s]))
         rhs[s] = chom[s]
         r = s + 1
         for k in range(s):
@@ -614,7 +767,7 @@ def _release_step(tab, off, ph, S, Fs, ct, st, d, d_lo, d_hi, c_e, cd_e, wall, n
         A[s, s] = -dchom[s]
         if not _solve_in_place(A, rhs, s + 1):
             return 1, d
-        change = abs(rhs[s] * cd_e)
+        change = abs(rhs[s] * end.cd)
         for i in range(s):
             delta[i] -= rhs[i]
             change = max(change, abs(rhs[i]))
@@ -634,50 +787,56 @@ def _release_step(tab, off, ph, S, Fs, ct, st, d, d_lo, d_hi, c_e, cd_e, wall, n
     return 1, d
 
 
-@njit(cache=True)
-def contact(Y, t, t_stop, wall, n, modes, par, colloc):
-    """Integrate the contact with `wall` (0 left, 1 right) from its located onset (t, Y) to its release.
+@kernel
+def contact(Y, t, t_stop, wall, ctx, cst):
+    """Integrate the contact with `wall` (0 left, 1 right) from its located onset (t, Y) to its release (Eqs. 3-7).
 
     Returns (outcome, t, steps): RELEASED with Y the state at the release time t, or FALLBACK with Y the
     valid state at t (the onset itself if steps == 0) from where the Dormand-Prince contact goes on.
-    colloc: the tuple of `arguments` (tables, node data, first guesses and workspace); in it memo[0 / 1 / 2]
-    holds the indentations of the last onset / regular / release step over their first guess.
+    ctx: the `Context` of the run; ctx.guesses[0 / 1 / 2] holds the indentations of the last onset / regular /
+    release step over their first guess.
     """
-    tabs, built, off, u, wb, b, xq, bq, M_onset, M_regular, tail, h_ref, memo, ws, A, S, phases, phased = colloc
-    s = u.size
-    m = 2 * n + 2
-    Om = par[_OM]
-    kH = par[_KH]
+    tables, phases, phased, guesses, ws = ctx.tables, ctx.phases, ctx.phased, ctx.guesses, ctx.work
+    h_ref = tables.h_ref
+    nodes = NODE_DATA
+    rows, S = ws.rows, ws.S
+    F = rows[ROW.F, :NODES]
+    Fs = rows[ROW.Fs, :S.shape[0]]
+    par = cst.par
+    lay = state_layout(cst.modes.size)
+    s = NODES
+    m = lay.acc
+    Om = par.Omega
+    kH = par.k_H
     sgn = 1.0 if wall == 0 else -1.0
     ct = math.cos(Om * t)
     st = math.sin(Om * t)
-    _, v = _active(Y, ct, st, wall, n, modes, par)
+    _, v = _active(Y, ct, st, wall, cst)
     if not v > 0.0:
         return FALLBACK, t, 0
-    t_hertz = _HERTZ_TIME * (5.0 * par[_MA] * v * v / (4.0 * kH)) ** 0.4 / v
+    t_hertz = _HERTZ_TIME * (5.0 * par.m_a * v * v / (4.0 * kH)) ** 0.4 / v
     k = _ladder(min(_ONSET_FRACTION * t_hertz, _MAX_STEP_PERIODS * h_ref), h_ref, False)
     if k < 0 or t + 1.5 * t_hertz >= t_stop:
         return FALLBACK, t, 0
     kind = ONSET
-    Ynew = ws[_YNEW, :Y.size]
+    Ynew = rows[ROW.Ynew, :Y.size]
     steps = 0
     halvings = 0
     for _ in range(100):
         # a step (onset or regular) from the last accepted state; it is repeated at half the length if it
         # failed (Newton, a release inside, unresolved force) or ended too close to the release (its force
         # is then not smooth in the step's time), at most _MAX_HALVINGS times in a contact
-        tab = _table(tabs, built, off, wall, kind, k, h_ref, u, wb, b, xq, bq, n, modes, par)
-        ph = _phases(phases, phased, tab, off, kind, k, Om, s)
+        step = _step_table(tables, phases, phased, wall, kind, k, cst)
         h = _ladder_h(k, h_ref)
         R = 0.0
-        ok = _forward_step(tab, off, ph, Y, ct, st, wall, n, s, par, ws, A, memo[kind], tail)
+        ok = (_forward_step(step, Y, ct, st, wall, guesses[kind], ws, cst)
+              and _resolution(nodes.tail, F, s) <= _RESOLUTION_TOL)
         if ok:
-            _end_state(tab, off, ph, Y, Ynew, ws[_F], ct, st, wall, n, s, par)
-            c1 = ct * ph[0, s] - st * ph[1, s]
-            s1 = st * ph[0, s] + ct * ph[1, s]
-            c_e, cd_e = _active(Ynew, c1, s1, wall, n, modes, par)
+            _end_state(step, Y, Ynew, F, ct, st, wall)
+            c1, s1 = _node_phase(step.ph, s, ct, st)
+            c_e, cd_e = _active(Ynew, c1, s1, wall, cst)
             if c_e > 0.0:
-                R = _time_to_release(c_e, cd_e, par[_MA], kH)
+                R = _time_to_release(c_e, cd_e, par.m_a, kH)
         if R < _CLEARANCE * h:
             k -= LADDER_PER_OCTAVE
             halvings += 1
@@ -692,36 +851,34 @@ def contact(Y, t, t_stop, wall, n, modes, par, colloc):
         steps += 1
         if R <= _RELEASE_REACH * h:
             # the release step: its end is the release, its start t - d lies in the last step (series there)
-            Fs = ws[_FS, :S.shape[0]]
-            _series(Y, ws[_F, :s], M_onset if kind == ONSET else M_regular, h, wall, n, modes, par, S, Fs)
+            _series(Y, F, nodes.onset if kind == ONSET else nodes.regular, h, wall, cst, S, Fs)
+            end = StepEnd(ct, st, h, c_e, cd_e)
             for _attempt in range(3):
                 k = _ladder(R + 0.1 * h, h_ref, True)
                 if k < 0:
                     return FALLBACK, t, steps
-                tab = _table(tabs, built, off, wall, RELEASE, k, h_ref, u, wb, b, xq, bq, n, modes, par)
-                ph = _phases(phases, phased, tab, off, RELEASE, k, Om, s)
+                step = _step_table(tables, phases, phased, wall, RELEASE, k, cst)
                 h_k = _ladder_h(k, h_ref)
-                status, d = _release_step(tab, off, ph, S, Fs, ct, st, h_k - R, -0.3 * h, 0.6 * h, c_e, cd_e, wall, n, s,
-                                          modes, par, ws, A, memo[2])
+                status, d = _release_step(step, end, h_k - R, wall, guesses[2], ws, cst)
                 if status == 1:
                     return FALLBACK, t, steps
                 R = h_k - min(max(d, -0.3 * h), 0.6 * h)  # the release as found (or as far as the series reaches)
                 if (status == 0 and 0.0 <= d <= 0.25 * h) or R > _RELEASE_REACH * h:
                     break
-            if status == 0 and 0.0 <= d <= 0.25 * h and _resolution(tail, ws[_F], s) <= _RESOLUTION_TOL:
+            if status == 0 and 0.0 <= d <= 0.25 * h and _resolution(nodes.tail, F, s) <= _RESOLUTION_TOL:
                 if t - d + h_k >= t_stop:
                     return FALLBACK, t, steps
                 # the state at the release step's start: the series, without the overlap's share of F_w
-                Ys = ws[_YS]
+                Ys = rows[ROW.Ys]
                 _series_at(S, d, Ys, m)
-                cs, ss = _rotate(ct, st, -Om * d)
+                cs, ss = rotate(ct, st, -Om * d)
                 ore, oim = _overlap_fourier(Fs, d, ct, st, Om)
                 Ynew[:m] = Ys[:m]
                 Ynew[m:] = Y[m:]
-                frow = 2 * n + 2 if wall == 0 else 2 * n + 4
+                frow = lay.F_l if wall == 0 else lay.F_r
                 Ynew[frow] -= sgn * ore
                 Ynew[frow + 1] -= sgn * oim
-                _end_state(tab, off, ph, Ynew, Y, ws[_F], cs, ss, wall, n, s, par)
+                _end_state(step, Ynew, Y, F, cs, ss, wall)
                 return RELEASED, t - d + h_k, steps + 1
             # the contact lasts longer than predicted, or its end is not resolved: a regular step first
         k = _ladder(min(R / 1.6, _MAX_STEP_PERIODS * h_ref), h_ref, False)
@@ -731,56 +888,35 @@ def contact(Y, t, t_stop, wall, n, modes, par, colloc):
     return FALLBACK, t, steps
 
 
-def workspace(nodes: Nodes, n: int) -> tuple[np.ndarray, ...]:
-    """Scratch arrays of `contact` (ws, A, S) for n modes, and a fresh memo of first guesses."""
-    s = nodes.u.size
-    order = nodes.onset.shape[0]
-    memo = np.empty((3, s))
-    memo[0] = 0.85  # onset: indentation / free indentation (Hertz: ~0.7 at the half contact)
-    memo[1] = 0.9
-    memo[2] = (1.0 - nodes.u) ** 2  # release: indentation / indentation at the start, linear in time to the end
-    return np.zeros((_WS_ROWS, max(s + 1, 2 * n + 6, order))), np.zeros((s + 1, s + 1)), np.zeros((order, 2 * n + 2)), memo
-
-
 # ----------------------------------------------------------------------------------------------------------
 # tables per system
 # ----------------------------------------------------------------------------------------------------------
-class Tables:
-    """The ladder of tables of one system (filled on first use by `contact`), with the universal node data."""
-
-    def __init__(self, n: int):
-        self.nodes = Nodes()
-        self.off = _offsets(NODES, n)
-        self.tabs = np.zeros((2, 3, LADDER_SIZE, int(self.off[_SIZE])))
-        self.built = np.zeros((2, 3, LADDER_SIZE), dtype=np.bool_)
-
-
 #: Tables of the most recently used systems (a few MB each). They depend on the modes, the wall values and
 #: the sphere's mass only, so a whole sweep (and every point of a study with the same D) shares them.
 _CACHE: OrderedDict[bytes, Tables] = OrderedDict()
 _CACHE_SIZE = 4
+#: The fields of the `sim.flight.MODE` records the tables depend on.
+_SYSTEM_FIELDS = ("sig", "wd", "w2", "phi_l", "phi_r")
 
 
 def tables_for(modes: np.ndarray, m_a: float) -> Tables:
-    """The `Tables` of the system with this modal table (rows of `sim.flight`) and sphere mass m_a (kg)."""
-    key = np.ascontiguousarray(modes[[_SIG, _WD, _W2, _PL, _PR]]).tobytes() + np.float64(m_a).tobytes()
+    """The `Tables` of the system with these mode records (`sim.flight.MODE`) and sphere mass m_a (kg)."""
+    key = np.stack([modes[name] for name in _SYSTEM_FIELDS]).tobytes() + np.float64(m_a).tobytes()
     tables = _CACHE.pop(key, None)
     if tables is None:
-        tables = Tables(modes.shape[1])
+        off = table_layout(NODES, modes.size)
+        h_ref = 2.0 * math.pi / math.sqrt(float(np.max(modes["w2"])))  # the period of the highest mode
+        tables = Tables(tabs=np.zeros((2, 3, LADDER_SIZE, off.size)),
+                        built=np.zeros((2, 3, LADDER_SIZE), dtype=np.bool_), off=off, h_ref=h_ref)
     _CACHE[key] = tables
     while len(_CACHE) > _CACHE_SIZE:
         _CACHE.popitem(last=False)
     return tables
 
 
-def arguments(sys, modes: np.ndarray) -> tuple:
-    """The tuple `sim.exact._advance` passes on to `contact` for one run_step call (fresh first guesses, and
-    room for the node phases of its Omega)."""
-    tables = tables_for(modes, sys.m_a)
-    nodes = tables.nodes
-    n = modes.shape[1]
-    ws, A, S, memo = workspace(nodes, n)
-    h_ref = 2.0 * math.pi / math.sqrt(float(np.max(modes[_W2])))  # period of the highest mode
-    return (tables.tabs, tables.built, tables.off, nodes.u, nodes.wb, nodes.b, nodes.xq, nodes.bq, nodes.onset,
-            nodes.regular, nodes.tail, h_ref, memo, ws, A, S, np.zeros((3, LADDER_SIZE, 2, NODES + 1)),
-            np.zeros((3, LADDER_SIZE), dtype=np.bool_))
+def context(cst: Constants) -> Context:
+    """The `Context` for one run_step call of the system in `cst`: its tables, fresh first guesses, and room
+    for the node phases of its Omega."""
+    return Context(tables=tables_for(cst.modes, float(cst.par["m_a"])), guesses=first_guesses(NODE_DATA),
+                   phases=np.zeros((3, LADDER_SIZE, 2, NODES + 1)), phased=np.zeros((3, LADDER_SIZE), dtype=np.bool_),
+                   work=workspace(NODE_DATA, cst.modes.size))

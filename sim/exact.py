@@ -1,4 +1,4 @@
-"""Exact free-flight integrator with located contacts (issue 5), for Eqs. 3-7 of the seed paper.
+"""Exact free-flight integrator with located contacts, for Eqs. 3-7 of the seed paper.
 
 Between contacts the system is linear (Sect. 5.5, Eq. 9): each mode is a damped oscillator under the
 harmonic base excitation and the sphere flies at constant absolute velocity. We split every quantity into
@@ -33,9 +33,9 @@ Contact: from the located onset, exponential Gauss collocation (`sim.collocation
 sphere exact, the Hertz force at 10 nodes per step, two to four steps per impact, the last one ending
 exactly at the release; rebound errors ~1e-10). Where that cannot go on (a contact crossing the end of a
 period or a record instant, a force it does not resolve, about 2 % of the contacts in the rig's sweeps)
-an embedded Dormand-Prince 5(4) step with error control on all modal states (scaled to m of wall/tip
-displacement, tolerance rtol) takes over; its release is located by Newton iteration on the length of the
-last step (|c| < GAP_TOLERANCE * g). Chattering is handled because every release is followed by the same
+an embedded Dormand-Prince 5(4) step with error control on all modal states (`sim.dopri5`, scaled to m
+of wall/tip displacement, tolerance rtol) takes over; its release is located by Newton iteration on the
+length of the last step (|c| < GAP_TOLERANCE * g). Chattering is handled because every release is followed by the same
 certified free-flight search.
 
 Measure (Sect. 5): c_1 = (2/T) int_T q_tip e^{-i Omega t} dt is exact. The particular part contributes
@@ -51,16 +51,15 @@ quadrature at all.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
-from sim import collocation
+from sim import collocation, dopri5, flight
 from sim.errors import SimulationDiverged, SimulationInputError
-from sim.flight import (GRAZE, ONSET, REGULAR, RELEASE, _ABASE, _APL, _APR, _G, _HG, _HMAX, _IMA, _IWD, _KH, _MA,
-                        _ML0, _MR0, _N_PAR, _N_ROWS, _OM, _PIM, _PL, _PR, _PRE, _RHI, _RHR, _SCV, _SCX, _SCZ, _SCZD,
-                        _SIG, _SIM, _SOW, _SRE, _TOL, _VMIN, _W2, _W2OW, _WD, _WLI, _WLR, _WRI, _WRR, _apply_flight,
-                        _closing, _closing_at, _flight_transitions, _rotate, _time_map, _transition)
+from sim.flight import (COUNT, NONFINITE, OK, OVERLAP, STALLED, STALLED_SEARCH, Constants, Output, mode_records,
+                        run_record, state_layout)
+from sim.jit import kernel
 from sim.system import SystemArrays, check_run_step
 
 #: Free-flight grid steps per excitation period (certification cells; no effect on accuracy).
@@ -75,26 +74,53 @@ GAP_TOLERANCE = 1e-12
 #: Contact onsets need an approach speed above this (m/s) unless the indentation already exceeds the tolerance.
 MIN_APPROACH_SPEED = 1e-9
 
-# counters
-_C_GRID, _C_SEARCH, _C_EVAL, _C_ACC, _C_REJ, _C_REL, _C_CONTACT, _C_COLLOC, _C_FALLBACK = range(9)
-_N_COUNT = 9
-# status codes
-_OK, _NONFINITE, _OVERLAP, _STALLED, _STALLED_SEARCH = 0, 1, 2, 3, 4
 _MAX_SEARCH = 200_000
 _MAX_ONSETS_PER_PERIOD = 100_000
 
-# Dormand-Prince 5(4) tableau (Dormand & Prince 1980; the coefficients of scipy's RK45 / MATLAB ode45)
-_C2, _C3, _C4, _C5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
-_A21 = 1 / 5
-_A31, _A32 = 3 / 40, 9 / 40
-_A41, _A42, _A43 = 44 / 45, -56 / 15, 32 / 9
-_A51, _A52, _A53, _A54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
-_A61, _A62, _A63, _A64, _A65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
-_B1, _B3, _B4, _B5, _B6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
-_E1, _E3, _E4, _E5, _E6, _E7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
+
+class Grid(NamedTuple):
+    """The free-flight grid of one run: N steps of h = T / N per excitation period T (s), the state recorded
+    at every `stride`-th grid point, and cos, sin(Omega k h) of the grid points k = 0..N (`rot`, 2 x (N + 1)).
+    The per-mode constants of a grid step are in the MODE records (grid_a ... grid_d, grid_decay, grid_kappa)."""
+
+    N: int
+    T: float
+    h: float
+    stride: int
+    rot: np.ndarray
 
 
-@njit(cache=True, inline="always")
+class Work(NamedTuple):
+    """Scratch of the period loop: the deviation state Y and a flight's end state Ynew (`sim.flight.StateLayout`),
+    the state at a located onset (`scratch`), the mode envelopes A_j (`A`), the modal deviations at the
+    period's start (`X0`) and the counters (int64, `sim.flight.COUNT`)."""
+
+    Y: np.ndarray
+    Ynew: np.ndarray
+    scratch: np.ndarray
+    A: np.ndarray
+    X0: np.ndarray
+    counters: np.ndarray
+
+
+class Run(NamedTuple):
+    """Everything `_advance` works with: the constants, the grid, the output, the scratch of the period loop,
+    of the Dormand-Prince contact (counting into the same counters) and the collocation context, and whether
+    contacts start by collocation (else all by Dormand-Prince)."""
+
+    cst: Constants
+    grid: Grid
+    out: Output
+    work: Work
+    dp: dopri5.Work
+    colloc: collocation.Context
+    use_collocation: bool
+
+
+# ----------------------------------------------------------------------------------------------------------
+# free flight: certification and the search for onsets
+# ----------------------------------------------------------------------------------------------------------
+@kernel(inline="always")
 def _majorant_step(c, cd, M):
     """Smallest positive root h of c + cd h + M h^2 / 2 = 0 for c < 0 (inf if there is none)."""
     if M <= 0.0:
@@ -105,46 +131,58 @@ def _majorant_step(c, cd, M):
     return (root - cd) / M
 
 
-@njit(cache=True)
-def _curvature_bounds(Y, n, modes, par):
-    """M_l, M_r: bounds of |c''| valid from now on in free flight (mode envelopes only decay)."""
-    Ml = par[_ML0]
-    Mr = par[_MR0]
-    for j in range(n):
-        x = Y[j]
-        q = (Y[n + j] + modes[_SIG, j] * x) * modes[_IWD, j]
-        A = math.sqrt(x * x + q * q) * modes[_W2, j]
-        Ml += modes[_APL, j] * A
-        Mr += modes[_APR, j] * A
+@kernel(inline="always")
+def _envelope(Y, j, cst):
+    """A_j, the modulus of mode j's complex amplitude (m sqrt(kg)); it only decays in free flight (Eq. 9)."""
+    md = cst.modes
+    lay = state_layout(md.size)
+    x = Y[lay.x + j]
+    q = (Y[lay.v + j] + md[j].sig * x) * md[j].inv_wd
+    return math.sqrt(x * x + q * q)
+
+
+@kernel
+def _curvature_bounds(Y, cst):
+    """M_l, M_r: bounds of |c''| (m/s^2) valid from now on in free flight (mode envelopes only decay)."""
+    md, par = cst.modes, cst.par
+    Ml = par.M_l0
+    Mr = par.M_r0
+    for j in range(md.size):
+        A = _envelope(Y, j, cst) * md[j].w2
+        Ml += md[j].abs_phi_l * A
+        Mr += md[j].abs_phi_r * A
     return Ml, Mr
 
 
-@njit(cache=True)
-def _search(Y, t0, tau_end, n, modes, par, scratch, counters):
-    """First contact onset in (t0, t0 + tau_end] of the free flight from Y, by conservative Newton steps.
+@kernel
+def _search(Y, t0, tau_end, cst, scratch, counters):
+    """First contact onset in (t0, t0 + tau_end] of the free flight from Y (Eqs. 4-6, 9), by conservative
+    Newton steps on the quadratic majorants of the closing functions.
 
     Returns (tau, wall): wall 0 (left) or 1 (right) with the onset at t0 + tau and the state there in
-    scratch[:2 n + 2], -1 if the interval is certified contact-free, -2 if the search stalled.
+    scratch[:acc], -1 if the interval is certified contact-free, -2 if the search stalled.
     """
-    Ml, Mr = _curvature_bounds(Y, n, modes, par)
-    tol = par[_TOL]
-    vmin = par[_VMIN]
+    md, par = cst.modes, cst.par
+    lay = state_layout(md.size)
+    Ml, Mr = _curvature_bounds(Y, cst)
+    tol = par.gap_tol
+    vmin = par.v_min
     tau = 0.0
     for _ in range(_MAX_SEARCH):
         if tau == 0.0:
-            scratch[:2 * n + 2] = Y[:2 * n + 2]
-            cl, cld, cr, crd = _closing(Y, t0, n, modes, par)
+            scratch[:lay.acc] = Y[:lay.acc]
+            cl, cld, cr, crd = flight.closing(Y, t0, cst)
         else:
-            for j in range(n):
-                a, b, c, d = _transition(tau, modes, j)
-                x = Y[j]
-                v = Y[n + j]
-                scratch[j] = a * x + b * v
-                scratch[n + j] = c * x + d * v
-            scratch[2 * n] = Y[2 * n] + tau * Y[2 * n + 1]
-            scratch[2 * n + 1] = Y[2 * n + 1]
-            cl, cld, cr, crd = _closing(scratch, t0 + tau, n, modes, par)
-        counters[_C_EVAL] += 1
+            for j in range(lay.n):
+                a, b, c, d = flight.transition(tau, md, j)
+                x = Y[lay.x + j]
+                v = Y[lay.v + j]
+                scratch[lay.x + j] = a * x + b * v
+                scratch[lay.v + j] = c * x + d * v
+            scratch[lay.z] = Y[lay.z] + tau * Y[lay.zd]
+            scratch[lay.zd] = Y[lay.zd]
+            cl, cld, cr, crd = flight.closing(scratch, t0 + tau, cst)
+        counters[COUNT.search_evaluations] += 1
         if cl > -tol and (cld > vmin or cl > tol):
             return tau, 0
         if cr > -tol and (crd > vmin or cr > tol):
@@ -156,486 +194,24 @@ def _search(Y, t0, tau_end, n, modes, par, scratch, counters):
     return tau, -2
 
 
-# ----------------------------------------------------------------------------------------------------------
-# contact: Dormand-Prince 5(4) with error control
-# ----------------------------------------------------------------------------------------------------------
-# No fastmath: reassociation lets each compiled specialisation round differently, and the chaotic response
-# turns one ulp into a different trajectory; with a cold numba cache serial and parallel runs then differed
-# (tests/sim/test_batch.py failed 3 times out of 3 on a fresh checkout), breaking issue 6's bit-identity.
-_FAST = False
+@kernel(inline="always")
+def _grid_bounds(A, h, cst):
+    """(B_l, B_r, M_l, M_r) of a grid step of h s for the mode envelopes A: the chord bounds' curvature terms
+    and the bounds of |c''| (module docstring)."""
+    md, par = cst.modes, cst.par
+    Bl = par.M_l0 * h * h * 0.125
+    Br = par.M_r0 * h * h * 0.125
+    Ml = par.M_l0
+    Mr = par.M_r0
+    for j in range(md.size):
+        Bl += md[j].abs_phi_l * md[j].grid_kappa * A[j]
+        Br += md[j].abs_phi_r * md[j].grid_kappa * A[j]
+        Ml += md[j].abs_phi_l * md[j].w2 * A[j]
+        Mr += md[j].abs_phi_r * md[j].w2 * A[j]
+    return Bl, Br, Ml, Mr
 
 
-@njit(cache=True, inline="always", fastmath=_FAST)
-def _rhs(ct, st, Y, out, n, modes, par):
-    """Eqs. 3-7 in the deviation coordinates at cos, sin(Omega t) = ct, st, plus the integrands of F_l, F_r."""
-    g = par[_G]
-    z = Y[2 * n]
-    dl = par[_WLR] * ct - par[_WLI] * st - z - g
-    dr = par[_WRR] * ct - par[_WRI] * st - z + g
-    for j in range(n):
-        x = Y[j]
-        dl += modes[_PL, j] * x
-        dr += modes[_PR, j] * x
-    kH = par[_KH]
-    fl = kH * dl * math.sqrt(dl) if dl > 0.0 else 0.0
-    fr = -kH * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
-    for j in range(n):
-        v = Y[n + j]
-        out[j] = v
-        out[n + j] = -2.0 * modes[_SIG, j] * v - modes[_W2, j] * Y[j] - modes[_PL, j] * fl - modes[_PR, j] * fr
-    out[2 * n] = Y[2 * n + 1]
-    out[2 * n + 1] = (fl + fr) * par[_IMA]
-    out[2 * n + 2] = fl * ct
-    out[2 * n + 3] = -fl * st
-    out[2 * n + 4] = fr * ct
-    out[2 * n + 5] = -fr * st
-
-
-@njit(cache=True, inline="always")
-def _warp(kind, u, s):
-    """(phi(u), phi'(u)) of a step of length s with the time map `kind` of `sim.flight._time_map`: with it
-    an onset or release step keeps its 5th order (in t the local error is O(h^2.5) there)."""
-    w, dw = _time_map(kind, u)
-    return s * w, s * dw
-
-
-@njit(cache=True, fastmath=_FAST)
-def _dp_step(Y, ct0, st0, s, kind, K, tmp, Ynew, n, modes, par):
-    """One Dormand-Prince 5(4) step from (t, Y), cos, sin(Omega t) = ct0, st0, over the time map of `_warp`
-    (kind, length s in time). The phase is carried by rotations (`_rotate`): no cos/sin per step.
-
-    K holds the raw right-hand sides F: K[0] = F(t, Y) on entry, K[6] = F(t + s, Ynew) on exit (FSAL);
-    dY/du = phi'(u) F(t_a + phi(u), Y). Returns the scaled error estimate (accept if <= 1): max over the
-    mechanical states of |err_i| / scale_i, scales from `_prepare` (m of wall/tip displacement).
-    """
-    m = Y.size
-    Om = par[_OM]
-    _, d1 = _warp(kind, 0.0, s)
-    p2, d2 = _warp(kind, _C2, s)
-    p3, d3 = _warp(kind, _C3, s)
-    p4, d4 = _warp(kind, _C4, s)
-    p5, d5 = _warp(kind, _C5, s)
-    _, d6 = _warp(kind, 1.0, s)
-    for i in range(m):
-        tmp[i] = Y[i] + _A21 * d1 * K[0, i]
-    ct, st = _rotate(ct0, st0, Om * p2)
-    _rhs(ct, st, tmp, K[1], n, modes, par)
-    for i in range(m):
-        tmp[i] = Y[i] + _A31 * d1 * K[0, i] + _A32 * d2 * K[1, i]
-    ct, st = _rotate(ct0, st0, Om * p3)
-    _rhs(ct, st, tmp, K[2], n, modes, par)
-    for i in range(m):
-        tmp[i] = Y[i] + _A41 * d1 * K[0, i] + _A42 * d2 * K[1, i] + _A43 * d3 * K[2, i]
-    ct, st = _rotate(ct0, st0, Om * p4)
-    _rhs(ct, st, tmp, K[3], n, modes, par)
-    for i in range(m):
-        tmp[i] = Y[i] + _A51 * d1 * K[0, i] + _A52 * d2 * K[1, i] + _A53 * d3 * K[2, i] + _A54 * d4 * K[3, i]
-    ct, st = _rotate(ct0, st0, Om * p5)
-    _rhs(ct, st, tmp, K[4], n, modes, par)
-    for i in range(m):
-        tmp[i] = (Y[i] + _A61 * d1 * K[0, i] + _A62 * d2 * K[1, i] + _A63 * d3 * K[2, i] + _A64 * d4 * K[3, i]
-                  + _A65 * d5 * K[4, i])
-    ct, st = _rotate(ct0, st0, Om * s)
-    _rhs(ct, st, tmp, K[5], n, modes, par)
-    for i in range(m):
-        Ynew[i] = Y[i] + _B1 * d1 * K[0, i] + _B3 * d3 * K[2, i] + _B4 * d4 * K[3, i] + _B5 * d5 * K[4, i] + _B6 * d6 * K[5, i]
-    _rhs(ct, st, Ynew, K[6], n, modes, par)
-    err = 0.0
-    for j in range(n):
-        for i, inv in ((j, modes[_SCX, j]), (n + j, modes[_SCV, j])):
-            e = (_E1 * d1 * K[0, i] + _E3 * d3 * K[2, i] + _E4 * d4 * K[3, i] + _E5 * d5 * K[4, i]
-                 + _E6 * d6 * K[5, i] + _E7 * d6 * K[6, i])
-            err = max(err, abs(e) * inv)
-    for i, inv in ((2 * n, par[_SCZ]), (2 * n + 1, par[_SCZD])):
-        e = (_E1 * d1 * K[0, i] + _E3 * d3 * K[2, i] + _E4 * d4 * K[3, i] + _E5 * d5 * K[4, i]
-             + _E6 * d6 * K[5, i] + _E7 * d6 * K[6, i])
-        err = max(err, abs(e) * inv)
-    return err
-
-
-@njit(cache=True)
-def _locate_release(Y, t, ct0, st0, s, s_max, kind, wall_left, K, tmp, Ynew, n, modes, par, counters):
-    """Length s of a step of `kind` from (t, Y) that ends at the release c = 0 of the active wall.
-
-    Newton iteration on the step length from the guess s, bracketed as soon as a step ends open; never
-    longer than s_max. On return Ynew holds the state at t + s; returns (s, err of that step, found).
-    """
-    tol = par[_TOL]
-    lo = 0.0
-    hi = np.inf
-    err = 0.0
-    c_s = 1.0
-    for _ in range(60):
-        if hi < np.inf:
-            if not (lo < s < hi):
-                s = 0.5 * (lo + hi)
-        elif s <= lo:
-            s = 2.0 * lo
-        s = min(s, s_max)
-        err = _dp_step(Y, ct0, st0, s, kind, K, tmp, Ynew, n, modes, par)
-        counters[_C_REL] += 1
-        ct1, st1 = _rotate(ct0, st0, par[_OM] * s)
-        a1, a2, a3, a4 = _closing_at(Ynew, ct1, st1, n, modes, par)
-        c_s = a1 if wall_left else a3
-        cd_s = a2 if wall_left else a4
-        if c_s > 0.0:
-            if s >= s_max:
-                return s, err, False
-            lo = s
-        else:
-            hi = s
-        if abs(c_s) <= tol or (hi < np.inf and hi - lo <= 4e-16 * (t + hi)):
-            break
-        if cd_s < 0.0:
-            s = s - c_s / cd_s
-        else:
-            s = 0.5 * (lo + hi) if hi < np.inf else 2.0 * s
-    if c_s > tol:
-        if hi == np.inf:
-            return s, err, False
-        s = hi
-        err = _dp_step(Y, ct0, st0, s, kind, K, tmp, Ynew, n, modes, par)
-    return s, err, True
-
-
-@njit(cache=True, inline="always")
-def _first_root(c, cd, cdd):
-    """Smallest tau > 0 with c + cd tau + cdd tau^2 / 2 = 0 for c > 0 (inf if none): release prediction."""
-    if cdd == 0.0:
-        return -c / cd if cd < 0.0 else np.inf
-    disc = cd * cd - 2.0 * cdd * c
-    if disc < 0.0:
-        return np.inf
-    sq = math.sqrt(disc)
-    best = np.inf
-    for r in ((-cd - sq) / cdd, (-cd + sq) / cdd):
-        if 0.0 < r < best:
-            best = r
-    return best
-
-
-@njit(cache=True)
-def _contact(Y, t, t_stop, h, at_onset, K, tmp, Ynew, n, modes, par, counters, fixed_step, memo):
-    """Integrate a contact phase from (t, Y) until all contacts have opened or t_stop is reached.
-
-    at_onset: t is a located onset (the first step then uses the onset time map). The release is
-    predicted from c, c', c'' of the active wall and reached by a step with the release time map whose
-    length is found by Newton iteration. Returns (t, h_next, released, status, extra_onsets). With
-    fixed_step > 0 the step is fixed (order studies) and only cut at t_stop and at the release.
-
-    memo[0], memo[1]: err / (v^1.5 s^2.5) of the last onset / release step (v: contact speed, s: length).
-    The embedded error estimate of these steps grows like s^2.5 (the force ~ u^3 is integrated exactly only
-    by the 5th-order solution), so their length is predicted from that law instead of by trial.
-    """
-    Om = par[_OM]
-    ct = math.cos(Om * t)  # the phase at t, carried along by rotations
-    st = math.sin(Om * t)
-    _rhs(ct, st, Y, K[0], n, modes, par)
-    cl, cld, cr, crd = _closing_at(Y, ct, st, n, modes, par)
-    wall_left = cl > cr  # the wall in contact (or about to be)
-    open_l = cl <= 0.0
-    open_r = cr <= 0.0
-    c_act = cl if wall_left else cr
-    cd_act = cld if wall_left else crd
-    first = at_onset
-    extra = 0
-    adaptive = fixed_step <= 0.0
-    if not adaptive:
-        h = fixed_step
-    elif first and memo[0] > 0.0:
-        h = (0.5 / (memo[0] * max(cd_act, 1e-6) ** 1.5)) ** 0.4
-    v_onset = max(cd_act, 1e-6)
-    for _ in range(10_000_000):
-        step = min(h, par[_HMAX])
-        last = step >= t_stop - t
-        if last:
-            step = t_stop - t
-        if adaptive and not first and c_act > 0.0:
-            # c'' of the active wall from the accelerations in K[0] (harmonic part: -Omega^2 times its value)
-            if wall_left:
-                cdd = -Om * Om * (par[_WLR] * ct - par[_WLI] * st) - K[0, 2 * n + 1]
-                for j in range(n):
-                    cdd += modes[_PL, j] * K[0, n + j]
-            else:
-                cdd = Om * Om * (par[_WRR] * ct - par[_WRI] * st) + K[0, 2 * n + 1]
-                for j in range(n):
-                    cdd -= modes[_PR, j] * K[0, n + j]
-            tau = _first_root(c_act, cd_act, cdd)
-            v_rel = max(abs(cd_act + cdd * tau), 1e-6)
-            s_rel = (0.5 / (memo[1] * v_rel**1.5)) ** 0.4 if memo[1] > 0.0 else step
-            if tau <= 1.2 * s_rel and tau <= 1.25 * step and tau < t_stop - t:
-                s, err, found = _locate_release(Y, t, ct, st, tau, min(2.0 * step, t_stop - t), RELEASE, wall_left, K,
-                                                tmp, Ynew, n, modes, par, counters)
-                if found:
-                    memo[1] = max(err, 1e-3) / (v_rel**1.5 * s**2.5)
-                    if err <= 1.0:
-                        for i in range(Y.size):
-                            Y[i] = Ynew[i]
-                        counters[_C_ACC] += 1
-                        return t + s, h, True, _OK, extra
-                    # too long: a regular step that leaves a release step of acceptable length
-                    counters[_C_REJ] += 1
-                    h = max(s - s * 0.9 * err ** -0.4, 0.05 * s)
-                    continue
-            elif tau < step + s_rel and tau < t_stop - t:
-                # approach so that the release step left over is s_rel (never longer than the step control allows)
-                step = min(step, max(tau - 0.9 * s_rel, 0.5 * tau))
-                last = False
-        kind = ONSET if first else REGULAR
-        err = _dp_step(Y, ct, st, step, kind, K, tmp, Ynew, n, modes, par)
-        if not math.isfinite(err):
-            return t, h, False, _NONFINITE, extra
-        if adaptive and err > 1.0:
-            counters[_C_REJ] += 1
-            if first:
-                memo[0] = err / (v_onset**1.5 * step**2.5)
-                h = step * max(0.1, 0.9 * err ** -0.4)
-            else:
-                h = step * max(0.2, 0.9 * err ** -0.2)
-            continue
-        if adaptive and first:
-            memo[0] = max(err, 1e-3) / (v_onset**1.5 * step**2.5)
-        ct1, st1 = _rotate(ct, st, Om * step)
-        ncl, ncld, ncr, ncrd = _closing_at(Ynew, ct1, st1, n, modes, par)
-        if ncl <= 0.0 and ncr <= 0.0:
-            # release inside (t, t + step]: a step with the release time map ending exactly there
-            kind = GRAZE if first else RELEASE
-            c_end = ncl if wall_left else ncr
-            cd_end = ncld if wall_left else ncrd
-            guess = step - c_end / cd_end if cd_end < 0.0 else 0.5 * step
-            s, err, found = _locate_release(Y, t, ct, st, guess, min(2.0 * step, t_stop - t), kind, wall_left, K, tmp,
-                                            Ynew, n, modes, par, counters)
-            if adaptive and err > 1.0 and s > 1e-3 * step:
-                # too long for the tolerance: first a shorter (onset or regular) step towards the release
-                counters[_C_REJ] += 1
-                h = s * min(0.5, max(0.2, 0.9 * err ** -0.2))
-                continue
-            counters[_C_ACC] += 1
-            if not found:
-                # the release-map step still ends (barely, |c| ~ rounding) closed while the regular step ended
-                # open: c hovers at 0 (sphere riding on the wall); release at the regular step's end
-                s = step
-                _dp_step(Y, ct, st, s, ONSET if first else REGULAR, K, tmp, Ynew, n, modes, par)
-            for i in range(Y.size):
-                Y[i] = Ynew[i]
-            return t + s, h, True, _OK, extra
-        # accepted step inside the contact
-        counters[_C_ACC] += 1
-        if (ncl > 0.0 and open_l and not first and not wall_left) or (ncr > 0.0 and open_r and not first and wall_left):
-            extra += 1  # the other wall closed within the contact (not located; physically excluded)
-        open_l = ncl <= 0.0
-        open_r = ncr <= 0.0
-        c_act = ncl if wall_left else ncr
-        cd_act = ncld if wall_left else ncrd
-        first = False
-        if ncl > par[_G] or ncr > par[_G]:
-            return t + step, h, False, _OVERLAP, extra
-        for i in range(Y.size):
-            Y[i] = Ynew[i]
-        for i in range(Y.size):
-            K[0, i] = K[6, i]
-        t = t + step
-        norm = 1.5 - 0.5 * (ct1 * ct1 + st1 * st1)  # keeps cos^2 + sin^2 = 1 to rounding along the rotations
-        ct = ct1 * norm
-        st = st1 * norm
-        if adaptive and not last:
-            h = step * min(5.0, max(0.2, 0.9 * max(err, 1e-10) ** -0.2))
-        if last:
-            return t_stop, h, False, _OK, extra
-    return t, h, False, _STALLED, extra
-
-
-# ----------------------------------------------------------------------------------------------------------
-# the period loop
-# ----------------------------------------------------------------------------------------------------------
-@njit(cache=True)
-def _to_state(Y, t, y_out, n, modes, par):
-    """Write [s, s', u_a, u_a'] at phase time t from the deviation state Y (inverse of the split in `_advance`)."""
-    Om = par[_OM]
-    ct = math.cos(Om * t)
-    st = math.sin(Om * t)
-    for j in range(n):
-        sr = modes[_SRE, j]
-        si = modes[_SIM, j]
-        y_out[j] = Y[j] + sr * ct - si * st
-        y_out[n + j] = Y[n + j] - Om * (sr * st + si * ct)
-    y_out[2 * n] = Y[2 * n] - par[_ABASE] * ct
-    y_out[2 * n + 1] = Y[2 * n + 1] + par[_ABASE] * Om * st
-
-
-@njit(cache=True)
-def _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record, stride, amplitudes,
-             impacts, counters, fixed_step, use_collocation, colloc):
-    """Advance y (phase 0) over n_periods excitation periods; returns (status, period of failure).
-
-    Contacts start with `collocation.contact` (arguments in the tuple colloc) if use_collocation, and go on
-    with the Dormand-Prince `_contact` wherever that falls back."""
-    n = modes.shape[1]
-    m = 2 * n + 6
-    Om = par[_OM]
-    T = 2.0 * math.pi / Om
-    hg = par[_HG]
-    Y = np.zeros(m)
-    Ynew = np.zeros(m)
-    tmp = np.zeros(m)
-    K = np.zeros((7, m))
-    tr = np.empty((4, n))
-    A = np.empty(n)
-    X0 = np.empty(2 * n)  # modal deviation state at the start of the period
-    memo = np.zeros(2)
-    # phase 0: s = x + Re(S), s' = v - Omega Im(S), u_a = z - a_base
-    for j in range(n):
-        Y[j] = y[j] - modes[_SRE, j]
-        Y[n + j] = y[n + j] + Om * modes[_SIM, j]
-    Y[2 * n] = y[2 * n] + par[_ABASE]
-    Y[2 * n + 1] = y[2 * n + 1]
-    recording = record.shape[0] > 0
-    rows = N // stride
-    if recording:
-        for i in range(2 * n + 2):
-            record[0, i] = y[i]
-    cl, _, cr, _ = _closing(Y, 0.0, n, modes, par)
-    no_contact = par[_KH] == 0.0  # host structure alone (k_H = 0): linear, exact everywhere
-    in_contact = (cl > 0.0 or cr > 0.0) and not no_contact
-    at_onset = False
-    onset_wall = 0
-    h_contact = 0.0
-    c1l = c1ld = c1r = c1rd = 0.0
-    t = 0.0
-    for p in range(n_periods):
-        Y[2 * n + 2:] = 0.0
-        X0[:] = Y[:2 * n]
-        onsets = 0
-        k = 0  # grid index of the current point (free flight on the grid) or of the last grid point passed
-        A_valid = False
-        c_valid = False  # c_l, c_r and their rates at the current grid point known from the last grid step
-        t = 0.0 if not in_contact else t
-        while True:
-            wall = -1  # set to 0/1 when a search locates an onset (state in tmp, at t + tau)
-            tau = 0.0
-            if in_contact:
-                c_valid = False
-                ks = (int(t / (stride * hg)) + 1) * stride
-                t_stop = T if ks >= N else ks * hg
-                released = False
-                status = _OK
-                extra = 0
-                if at_onset and use_collocation:
-                    outcome, t_new, steps = collocation.contact(Y, t, t_stop, onset_wall, n, modes, par, colloc)
-                    counters[_C_COLLOC] += steps
-                    released = outcome == collocation.RELEASED
-                    t = t_new
-                    if not released:
-                        counters[_C_FALLBACK] += 1
-                        at_onset = steps == 0
-                if not released:
-                    if h_contact <= 0.0:
-                        h_contact = 0.01 / math.sqrt(modes[_W2, n - 1])
-                    t, h_contact, released, status, extra = _contact(Y, t, t_stop, h_contact, at_onset, K, tmp, Ynew,
-                                                                     n, modes, par, counters, fixed_step, memo)
-                at_onset = False
-                onsets += extra
-                if status != _OK:
-                    return status, p
-                if not released:
-                    if recording:
-                        _to_state(Y, t, record[p * rows + min(ks, N) // stride], n, modes, par)
-                    if t_stop == T:
-                        break
-                    continue
-                in_contact = False
-                k = int(t / hg)
-                if k >= N:
-                    k = N - 1
-                # free flight from the release to the next grid point
-                tau_end = (k + 1) * hg - t
-                tau, wall = _search(Y, t, tau_end, n, modes, par, tmp, counters)
-                if wall == -2:
-                    return _STALLED_SEARCH, p
-                if wall < 0:
-                    _flight_transitions(tau, modes, tr)
-                    _apply_flight(Y, Ynew, tau, tr, n)
-                    Y[:] = Ynew
-                    k += 1
-                    t = k * hg
-                    A_valid = False
-            else:
-                # one grid step k -> k + 1 in closed form, accepted if certified contact-free
-                if not A_valid:
-                    for j in range(n):
-                        x = Y[j]
-                        q = (Y[n + j] + modes[_SIG, j] * x) * modes[_IWD, j]
-                        A[j] = math.sqrt(x * x + q * q)
-                    A_valid = True
-                counters[_C_GRID] += 1
-                _apply_flight(Y, Ynew, hg, tr_g, n)
-                if c_valid:  # the end of the last accepted grid step
-                    c0l, c0ld, c0r, c0rd = c1l, c1ld, c1r, c1rd
-                else:
-                    c0l, c0ld, c0r, c0rd = _closing_at(Y, rot_g[0, k], rot_g[1, k], n, modes, par)
-                c1l, c1ld, c1r, c1rd = _closing_at(Ynew, rot_g[0, k + 1], rot_g[1, k + 1], n, modes, par)
-                Bl = par[_ML0] * hg * hg * 0.125
-                Br = par[_MR0] * hg * hg * 0.125
-                Ml = par[_ML0]
-                Mr = par[_MR0]
-                for j in range(n):
-                    Bl += modes[_APL, j] * kappa_g[j] * A[j]
-                    Br += modes[_APR, j] * kappa_g[j] * A[j]
-                    Ml += modes[_APL, j] * modes[_W2, j] * A[j]
-                    Mr += modes[_APR, j] * modes[_W2, j] * A[j]
-                ok = no_contact or (_max_bound(c0l, c0ld, c1l, c1ld, Bl, Ml, hg) < 0.0
-                                    and _max_bound(c0r, c0rd, c1r, c1rd, Br, Mr, hg) < 0.0)
-                if not ok:
-                    counters[_C_SEARCH] += 1
-                    tau, wall = _search(Y, t, hg, n, modes, par, tmp, counters)
-                    if wall == -2:
-                        return _STALLED_SEARCH, p
-                c_valid = wall < 0
-                if wall < 0:
-                    Y[:] = Ynew
-                    for j in range(n):
-                        A[j] *= dec_g[j]
-                    k += 1
-                    t = k * hg
-            if wall >= 0:
-                # a located onset (`_search` left the state there in tmp): the contact starts
-                Y[:2 * n + 2] = tmp[:2 * n + 2]
-                t = t + tau
-                in_contact = True
-                at_onset = True
-                onset_wall = wall
-                onsets += 1
-                counters[_C_CONTACT] += 1
-                h_contact = _initial_contact_step(Y, t, n, modes, par)
-                A_valid = False
-                continue
-            if onsets > _MAX_ONSETS_PER_PERIOD:
-                return _STALLED, p
-            if recording and k % stride == 0:
-                _to_state(Y, t, record[p * rows + k // stride], n, modes, par)
-            if k >= N:
-                break
-        # c_1 = phi_tip^T S + (2/T) sum_j phi_tip,j int_T x_j e^{-i Omega t} dt, the integral from the module docstring
-        cre = par[_PRE]
-        cim = par[_PIM]
-        for j in range(n):
-            dx = Y[j] - X0[j]
-            nre = (-(Y[n + j] - X0[n + j]) - 2.0 * modes[_SIG, j] * dx - modes[_PL, j] * Y[2 * n + 2]
-                   - modes[_PR, j] * Y[2 * n + 4])
-            nim = -Om * dx - modes[_PL, j] * Y[2 * n + 3] - modes[_PR, j] * Y[2 * n + 5]
-            cre += 2.0 / T * (modes[_RHR, j] * nre - modes[_RHI, j] * nim)
-            cim += 2.0 / T * (modes[_RHR, j] * nim + modes[_RHI, j] * nre)
-        amplitudes[p] = math.sqrt(cre * cre + cim * cim)
-        impacts[p] = onsets
-        t = 0.0
-        for i in range(m):
-            if not math.isfinite(Y[i]):
-                return _NONFINITE, p
-    _to_state(Y, 0.0, y, n, modes, par)
-    return _OK, n_periods
-
-
-@njit(cache=True, inline="always")
+@kernel(inline="always")
 def _max_bound(c0, c0d, c1, c1d, B, M, h):
     """Smallest of the chord and the two Taylor upper bounds of max c over a step of length h."""
     chord = max(c0, c1) + B
@@ -644,20 +220,236 @@ def _max_bound(c0, c0d, c1, c1d, B, M, h):
     return min(chord, min(left, right))
 
 
-@njit(cache=True)
-def _initial_contact_step(Y, t, n, modes, par):
-    """First step of a contact, tied to the Hertz contact time t_c = 2.9432 delta_max / v0 (rigid wall)."""
-    cl, cld, cr, crd = _closing(Y, t, n, modes, par)
+# ----------------------------------------------------------------------------------------------------------
+# the state of the integrator contract
+# ----------------------------------------------------------------------------------------------------------
+@kernel
+def _from_state(y, Y, cst):
+    """Y = the deviation state of y = [s, s', u_a, u_a'] at phase 0: s = x + Re(S), s' = v - Omega Im(S),
+    u_a = z - a_base (the split of the module docstring)."""
+    md, par = cst.modes, cst.par
+    lay = state_layout(md.size)
+    for j in range(lay.n):
+        Y[lay.x + j] = y[lay.x + j] - md[j].S_re
+        Y[lay.v + j] = y[lay.v + j] + par.Omega * md[j].S_im
+    Y[lay.z] = y[lay.z] + par.a_base
+    Y[lay.zd] = y[lay.zd]
+
+
+@kernel
+def _to_state(Y, t, y_out, cst):
+    """Write [s, s', u_a, u_a'] at phase time t from the deviation state Y (inverse of `_from_state` at t)."""
+    md, par = cst.modes, cst.par
+    lay = state_layout(md.size)
+    Om = par.Omega
+    ct = math.cos(Om * t)
+    st = math.sin(Om * t)
+    for j in range(lay.n):
+        sr = md[j].S_re
+        si = md[j].S_im
+        y_out[lay.x + j] = Y[lay.x + j] + sr * ct - si * st
+        y_out[lay.v + j] = Y[lay.v + j] - Om * (sr * st + si * ct)
+    y_out[lay.z] = Y[lay.z] - par.a_base * ct
+    y_out[lay.zd] = Y[lay.zd] + par.a_base * Om * st
+
+
+# ----------------------------------------------------------------------------------------------------------
+# the phases of a period: free flight (grid steps, searches, the flight from a release), contact (in
+# `sim.collocation`, `sim.dopri5`), the period's Fourier coefficient; and the period loop
+# ----------------------------------------------------------------------------------------------------------
+@kernel
+def _fly(p, t, released, onsets, cst, grid, work, record):
+    """Free flight of period p from t (Eq. 9) until a contact onset or the period's end. From a release at t
+    the flight to the next grid point is searched; from there the flight goes on one grid step at a time in
+    closed form, each step accepted if certified contact-free, else searched. The state is recorded at the
+    record instants passed. More than _MAX_ONSETS_PER_PERIOD onsets so far (onsets) stop the run at the first
+    grid point reached.
+
+    Returns (status, t, wall, tau): an onset at wall 0/1 at t + tau (its state in work.scratch), t the release
+    or the grid point the searched step starts from, or wall -1 at the period's end. t is a grid point unless
+    released.
+    """
+    md, par = cst.modes, cst.par
+    lay = state_layout(md.size)
+    Y, Ynew, A, scratch, counters = work.Y, work.Ynew, work.A, work.scratch, work.counters
+    N, hg, rot = grid.N, grid.h, grid.rot
+    stride = grid.stride
+    rows = N // stride
+    recording = record.shape[0] > 0
+    k = int(t / hg)
+    if released:
+        # from the release to the next grid point
+        if k >= N:
+            k = N - 1
+        tau, wall = _search(Y, t, (k + 1) * hg - t, cst, scratch, counters)
+        if wall != -1:
+            return (STALLED_SEARCH if wall == -2 else OK), t, wall, tau
+        flight.free_flight(Y, Ynew, tau, md)
+        Y[:] = Ynew
+        k += 1
+        t = k * hg
+        if onsets > _MAX_ONSETS_PER_PERIOD:
+            return STALLED, t, -1, 0.0
+        if recording and k % stride == 0:
+            _to_state(Y, t, record[p * rows + k // stride], cst)
+        if k >= N:
+            return OK, t, -1, 0.0
+    no_contact = par.k_H == 0.0  # host structure alone (k_H = 0): linear, exact everywhere
+    for j in range(lay.n):
+        A[j] = _envelope(Y, j, cst)
+    c_valid = False  # c_l, c_r and their rates at the current grid point known from the last grid step
+    c1l = c1ld = c1r = c1rd = 0.0
+    while True:
+        counters[COUNT.grid_steps] += 1
+        flight.grid_flight(Y, Ynew, hg, md)
+        if c_valid:  # the end of the last accepted grid step
+            c0l, c0ld, c0r, c0rd = c1l, c1ld, c1r, c1rd
+        else:
+            c0l, c0ld, c0r, c0rd = flight.closing_at(Y, rot[0, k], rot[1, k], cst)
+        c1l, c1ld, c1r, c1rd = flight.closing_at(Ynew, rot[0, k + 1], rot[1, k + 1], cst)
+        Bl, Br, Ml, Mr = _grid_bounds(A, hg, cst)
+        ok = no_contact or (_max_bound(c0l, c0ld, c1l, c1ld, Bl, Ml, hg) < 0.0
+                            and _max_bound(c0r, c0rd, c1r, c1rd, Br, Mr, hg) < 0.0)
+        if not ok:
+            counters[COUNT.searches] += 1
+            tau, wall = _search(Y, t, hg, cst, scratch, counters)
+            if wall != -1:
+                return (STALLED_SEARCH if wall == -2 else OK), t, wall, tau
+        c_valid = True
+        Y[:] = Ynew
+        for j in range(lay.n):
+            A[j] *= md[j].grid_decay
+        k += 1
+        t = k * hg
+        if recording and k % stride == 0:
+            _to_state(Y, t, record[p * rows + k // stride], cst)
+        if k >= N:
+            return OK, t, -1, 0.0
+
+
+@kernel(inline="always")
+def _stop_time(t, grid):
+    """(t_stop, ks): a contact phase from t stops at the next record instant (grid point ks) or at the period's end."""
+    ks = (int(t / (grid.stride * grid.h)) + 1) * grid.stride
+    return (grid.T if ks >= grid.N else ks * grid.h), ks
+
+
+@kernel
+def _initial_contact_step(Y, t, cst):
+    """First Dormand-Prince step of a contact, tied to the Hertz contact time t_c = 2.9432 delta_max / v0
+    (rigid wall, Eq. 4)."""
+    cl, cld, cr, crd = flight.closing(Y, t, cst)
     v = max(cld, crd, 1e-6)
-    delta_max = (5.0 * par[_MA] * v * v / (4.0 * par[_KH])) ** 0.4
-    return min(0.02 * 2.9432 * delta_max / v, par[_HMAX])
+    delta_max = (5.0 * cst.par.m_a * v * v / (4.0 * cst.par.k_H)) ** 0.4
+    return min(0.02 * 2.9432 * delta_max / v, cst.par.h_max)
+
+
+@kernel(inline="always")
+def _fundamental(Y, X0, T, cst):
+    """|c_1| (m, Sect. 5) of the period that ends with Y and started with the modal deviations X0:
+    c_1 = phi_tip^T S + (2/T) sum_j phi_tip,j int_T x_j e^{-i Omega t} dt, the integral of the module docstring."""
+    md, par = cst.modes, cst.par
+    lay = state_layout(md.size)
+    n = lay.n
+    cre = par.P_re
+    cim = par.P_im
+    for j in range(n):
+        dx = Y[lay.x + j] - X0[j]
+        nre = (-(Y[lay.v + j] - X0[n + j]) - 2.0 * md[j].sig * dx - md[j].phi_l * Y[lay.F_l]
+               - md[j].phi_r * Y[lay.F_r])
+        nim = -par.Omega * dx - md[j].phi_l * Y[lay.F_l + 1] - md[j].phi_r * Y[lay.F_r + 1]
+        cre += 2.0 / T * (md[j].rho_re * nre - md[j].rho_im * nim)
+        cim += 2.0 / T * (md[j].rho_re * nim + md[j].rho_im * nre)
+    return math.sqrt(cre * cre + cim * cim)
+
+
+@kernel
+def _advance(y, run):
+    """Advance y (phase 0) over the periods of run.out; returns (status, period of failure).
+
+    Each period from phase 0: free flight (`_fly`), contacts (`collocation.contact` from an onset if
+    run.use_collocation, `dopri5.contact` wherever that falls back), then the period's |c_1| and onset count
+    (`_fundamental`). A contact may go on into the next period. (One kernel for all periods: a kernel call
+    per period would count references to every array it is handed.)"""
+    cst, grid, colloc, dp, use_collocation = run.cst, run.grid, run.colloc, run.dp, run.use_collocation
+    work = run.work
+    Y, X0, scratch, counters = work.Y, work.X0, work.scratch, work.counters
+    amplitudes, impacts, record = run.out.amplitudes, run.out.impacts, run.out.record
+    lay = state_layout(cst.modes.size)
+    N, stride = grid.N, grid.stride
+    _from_state(y, Y, cst)
+    if record.shape[0] > 0:
+        for i in range(lay.acc):
+            record[0, i] = y[i]
+    cl, _, cr, _ = flight.closing(Y, 0.0, cst)
+    in_contact = (cl > 0.0 or cr > 0.0) and not cst.par.k_H == 0.0
+    h_contact = 0.0  # the Dormand-Prince contact's step, carried from contact to contact
+    for p in range(amplitudes.size):
+        Y[lay.acc:] = 0.0
+        X0[:] = Y[:lay.z]
+        onsets = 0
+        t = 0.0
+        released = False  # the free flight starts at a release (else at a grid point)
+        at_onset = False
+        wall = 0
+        while True:
+            if in_contact:
+                t_stop, ks = _stop_time(t, grid)
+                released = False
+                status = OK
+                extra = 0
+                if at_onset and use_collocation:
+                    outcome, t, steps = collocation.contact(Y, t, t_stop, wall, colloc, cst)
+                    counters[COUNT.collocation_steps] += steps
+                    released = outcome == collocation.RELEASED
+                    if not released:
+                        counters[COUNT.collocation_fallbacks] += 1
+                        at_onset = steps == 0
+                if not released:
+                    if h_contact <= 0.0:
+                        h_contact = 0.01 / math.sqrt(cst.modes[lay.n - 1].w2)
+                    t, h_contact, released, status, extra = dopri5.contact(Y, t, t_stop, h_contact, at_onset, dp, cst)
+                at_onset = False
+                onsets += extra
+                if status != OK:
+                    return status, p
+                if not released:
+                    if record.shape[0] > 0:
+                        _to_state(Y, t, record[p * (N // stride) + min(ks, N) // stride], cst)
+                    if t_stop == grid.T:
+                        break
+                    continue
+                in_contact = False
+            status, t, wall, tau = _fly(p, t, released, onsets, cst, grid, work, record)
+            if status != OK:
+                return status, p
+            if wall < 0:
+                break
+            # a located onset at t + tau (its state in work.scratch): the contact starts
+            Y[:lay.acc] = scratch[:lay.acc]
+            t = t + tau
+            in_contact = True
+            at_onset = True
+            onsets += 1
+            counters[COUNT.contacts] += 1
+            h_contact = _initial_contact_step(Y, t, cst)
+        amplitudes[p] = _fundamental(Y, X0, grid.T, cst)
+        impacts[p] = onsets
+        for i in range(Y.size):
+            if not math.isfinite(Y[i]):
+                return NONFINITE, p
+    _to_state(Y, 0.0, y, cst)
+    return OK, amplitudes.size
 
 
 # ----------------------------------------------------------------------------------------------------------
 # Python entry point
 # ----------------------------------------------------------------------------------------------------------
-def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float, h_max: float):
-    """Constant tables of the kernel for one excitation (see the module docstring for the symbols)."""
+def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float, h_max: float,
+             h_fixed: float = 0.0, stride: int | None = None) -> tuple[Constants, Grid]:
+    """Constants and grid of the kernels for one excitation (see the module docstring for the symbols); the
+    state is recorded every `stride` grid steps (default N: once per period)."""
+    stride = N if stride is None else stride
     omega = np.asarray(sys.omega, dtype=np.float64)
     D = np.asarray(sys.D, dtype=np.float64)
     n = omega.size
@@ -670,44 +462,42 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
     atol = rtol * sys.g
     wpos = np.maximum(np.maximum(np.abs(sys.phi_l), np.abs(sys.phi_r)), np.abs(sys.phi_tip))
     wpos = np.where(wpos > 0, wpos, 1e-300)
-    modes = np.empty((_N_ROWS, n))
-    modes[_SIG], modes[_WD], modes[_W2] = sig, wd, omega**2
-    modes[_PL], modes[_PR] = sys.phi_l, sys.phi_r
     rho = sys.phi_tip / (omega**2 - Omega**2 + 2j * sig * Omega)  # phi_tip,j / Delta_j
-    modes[_RHR], modes[_RHI] = rho.real, rho.imag
-    modes[_APL], modes[_APR] = np.abs(sys.phi_l), np.abs(sys.phi_r)
-    modes[_SRE], modes[_SIM] = S.real, S.imag
-    # inverse error scales: x_j error -> displacement phi_j x_j (m); velocity error e_v -> amplitude e_v / omega_j
-    modes[_SCX] = wpos / atol
-    modes[_SCV] = wpos / (atol * omega)
-    modes[_SOW], modes[_IWD], modes[_W2OW] = sig / wd, 1.0 / wd, omega**2 / wd
-    par = np.zeros(_N_PAR)
-    par[_OM], par[_ABASE], par[_MA], par[_KH], par[_G] = Omega, a_base, sys.m_a, sys.k_H, sys.g
-    par[_IMA] = 1.0 / sys.m_a
-    par[_WLR], par[_WLI], par[_WRR], par[_WRI] = Wl.real, Wl.imag, Wr.real, Wr.imag
-    par[_PRE], par[_PIM] = P.real, P.imag
-    par[_TOL] = GAP_TOLERANCE * sys.g
-    par[_VMIN] = MIN_APPROACH_SPEED
     hg = 2.0 * math.pi / Omega / N
-    par[_HG] = hg
-    par[_ML0], par[_MR0] = abs(Wl) * Omega**2, abs(Wr) * Omega**2
-    par[_SCZ] = 1.0 / atol
-    par[_SCZD] = 1.0 / (atol * omega[0])
-    par[_HMAX] = h_max
+    unset = np.zeros(n)
+    md = mode_records(
+        sig=sig, wd=wd, w2=omega**2, phi_l=sys.phi_l, phi_r=sys.phi_r, abs_phi_l=np.abs(sys.phi_l),
+        abs_phi_r=np.abs(sys.phi_r), sig_wd=sig / wd, inv_wd=1.0 / wd, w2_wd=omega**2 / wd, S_re=S.real,
+        S_im=S.imag, rho_re=rho.real, rho_im=rho.imag,
+        # inverse error scales: x_j error -> displacement phi_j x_j (m); velocity error e_v -> amplitude e_v / omega_j
+        err_x=wpos / atol, err_v=wpos / (atol * omega),
+        grid_a=unset, grid_b=unset, grid_c=unset, grid_d=unset,  # below, from the records' transition
+        grid_decay=np.exp(-sig * hg), grid_kappa=np.minimum(omega**2 * hg * hg / 8.0, 2.0))
+    par = run_record(Omega=Omega, a_base=a_base, m_a=sys.m_a, inv_m_a=1.0 / sys.m_a, k_H=sys.k_H, g=sys.g,
+                     W_l_re=Wl.real, W_l_im=Wl.imag, W_r_re=Wr.real, W_r_im=Wr.imag, P_re=P.real, P_im=P.imag,
+                     gap_tol=GAP_TOLERANCE * sys.g, v_min=MIN_APPROACH_SPEED, M_l0=abs(Wl) * Omega**2,
+                     M_r0=abs(Wr) * Omega**2, err_z=1.0 / atol, err_zd=1.0 / (atol * omega[0]),
+                     h_max=h_max, h_fixed=h_fixed)
     tr_g = np.empty((4, n))
-    _flight_transitions(hg, modes, tr_g)
-    dec_g = np.exp(-sig * hg)
-    kappa_g = np.minimum(omega**2 * hg * hg / 8.0, 2.0)
+    flight.flight_transitions(hg, md, tr_g)
+    md["grid_a"], md["grid_b"], md["grid_c"], md["grid_d"] = tr_g
     phase = Omega * hg * np.arange(N + 1)
-    rot_g = np.vstack([np.cos(phase), np.sin(phase)])
-    return modes, par, tr_g, dec_g, kappa_g, rot_g
+    grid = Grid(N=N, T=2.0 * math.pi / Omega, h=hg, stride=stride, rot=np.vstack([np.cos(phase), np.sin(phase)]))
+    return Constants(modes=md, par=par), grid
+
+
+def _work(cst: Constants) -> Work:
+    """A fresh `Work` for the period loop."""
+    lay = state_layout(cst.modes.size)
+    return Work(Y=np.zeros(lay.size), Ynew=np.zeros(lay.size), scratch=np.zeros(lay.size), A=np.empty(lay.n),
+                X0=np.empty(lay.z), counters=np.zeros(len(COUNT), dtype=np.int64))
 
 
 def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: SystemArrays,
              record: np.ndarray | None = None, *, rtol: float = CONTACT_RTOL, grid_per_period: int = GRID_PER_PERIOD,
              fixed_contact_step: float = 0.0, contacts: str = "collocation",
              stats: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Advance y in place over `n_periods` whole excitation periods, exact between contacts (issue 5).
+    """Advance y in place over `n_periods` whole excitation periods, exact between contacts (Eqs. 3-9, Sect. 5).
 
     Integrator contract of `sim.system` (same as `sim.ode3.run_step`): y = [s, s', u_a, u_a'] at
     excitation phase 0 (float64, length 2 n_modes + 2); Omega in rad/s; a_base in m. Returns
@@ -722,7 +512,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     Dormand-Prince only).
     contacts: "collocation" (default: `sim.collocation`, Dormand-Prince where it falls back) or "dopri5"
     (every contact by the Dormand-Prince 5(4) pair with error control at rtol).
-    stats: optional dict that receives the kernel's counters (grid steps, searches, contact steps, ...).
+    stats: optional dict that receives the kernel's counters (the fields of `sim.flight.Counters`: grid
+    steps, searches, contact steps, ...).
     Raises SimulationInputError for bad arguments, SimulationDiverged for a non-finite state, an
     indentation beyond the clearance or a stalled contact search.
     """
@@ -738,24 +529,19 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     N = -(-N // samples) * samples
     omega_max = float(np.max(sys.omega))
     h_max = 0.5 / omega_max  # keeps DOPRI5 far inside its stability region on the highest mode
-    modes, par, tr_g, dec_g, kappa_g, rot_g = _prepare(Omega, a_base, sys, N, rtol, h_max)
-    amplitudes = np.empty(n_periods)
-    impacts = np.zeros(n_periods, dtype=np.int64)
-    counters = np.zeros(_N_COUNT, dtype=np.int64)
+    cst, grid = _prepare(Omega, a_base, sys, N, rtol, h_max, float(fixed_contact_step), N // samples)
+    work = _work(cst)
+    out = Output(amplitudes=np.empty(n_periods), impacts=np.zeros(n_periods, dtype=np.int64), record=record_arr)
     use_collocation = contacts == "collocation" and fixed_contact_step <= 0.0
-    colloc = collocation.arguments(sys, modes)
-    status, period = _advance(y, n_periods, N, modes, par, tr_g, dec_g, kappa_g, rot_g, record_arr,
-                              N // samples, amplitudes, impacts, counters, float(fixed_contact_step), use_collocation,
-                              colloc)
+    run = Run(cst, grid, out, work, dopri5.work(work.Y.size, work.counters), collocation.context(cst), use_collocation)
+    status, period = _advance(y, run)
     if stats is not None:
-        names = ("grid_steps", "searches", "search_evaluations", "contact_steps", "rejected_steps",
-                 "release_iterations", "contacts", "collocation_steps", "collocation_fallbacks")
-        for name, value in zip(names, counters):
+        for name, value in zip(COUNT._fields, work.counters):
             stats[name] = stats.get(name, 0) + int(value)
-    if status != _OK:
-        why = {_NONFINITE: "non-finite state", _OVERLAP: "an indentation larger than the clearance",
-               _STALLED: "a contact phase that did not progress",
-               _STALLED_SEARCH: "a contact search that did not progress"}[status]
+    if status != OK:
+        why = {NONFINITE: "non-finite state", OVERLAP: "an indentation larger than the clearance",
+               STALLED: "a contact phase that did not progress",
+               STALLED_SEARCH: "a contact search that did not progress"}[status]
         raise SimulationDiverged(
             f"exact integrator failed in period {period + 1} of this step ({why}); check k_H, g and the level")
-    return amplitudes, impacts
+    return out.amplitudes, out.impacts

@@ -1,60 +1,243 @@
-"""The state layout shared by the contact integrators of `sim.exact` and `sim.collocation`, and the
-closed-form pieces of free flight (the homogeneous part of Eq. 9; symbols in `sim.exact`'s docstring)."""
+"""What the integrators' kernels share (`sim.exact`, `sim.dopri5`, `sim.collocation`; the layout and the
+output also `sim.ode3`): the named layout of the state, the constants of one run as numba records, the
+output of a period loop, the kernels' counters and status codes, and the closed-form pieces of free flight
+(the homogeneous part of Eq. 9; symbols in `sim.exact`'s docstring).
+
+Conventions of the kernels (each measured against the positional code they replace, same machine code speed):
+* Constants are numba records read by name (``md[j].sig``, ``par.Omega``): a structured array with a record
+  per mode and one record of scalars. A record costs no reference counting, whereas every array a kernel
+  keeps from its arguments across a call is counted up and down (two atomic operations) on every call.
+* Hence tuples of arrays (workspaces, contexts) are unpacked at a kernel's entry, and a kernel called per
+  contact step or per grid step is handed few arrays.
+* A kernel takes the state layout from `state_layout(n)`, not from an argument: inlined, its offsets are
+  arithmetic on n that the compiler sees (offsets handed over as numbers made the contact steps 15 % slower).
+"""
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
-from numba import njit
+import numpy as np
 
-# rows of the per-mode constant table
-_SIG, _WD, _W2, _PL, _PR, _RHR, _RHI, _APL, _APR, _SRE, _SIM, _SCX, _SCV, _SOW, _IWD, _W2OW = range(16)
-_N_ROWS = 16
-# entries of the scalar parameter vector
-(_OM, _ABASE, _MA, _KH, _G, _WLR, _WLI, _WRR, _WRI, _PRE, _PIM, _TOL, _VMIN, _HG, _ML0, _MR0, _SCZ, _SCZD,
- _HMAX, _IMA) = range(20)
-_N_PAR = 20
+from sim.jit import kernel
+
+
+# ----------------------------------------------------------------------------------------------------------
+# the deviation state Y and the constants of a run
+# ----------------------------------------------------------------------------------------------------------
+class StateLayout(NamedTuple):
+    """Offsets of the components of the deviation state Y (length `size`) of `sim.exact` for n modes.
+
+    Y[x + j], Y[v + j]: homogeneous deviation x_j of mode j and its rate (m sqrt(kg), m sqrt(kg) / s);
+    Y[z], Y[zd]: sphere coordinate z = u_a + a_base cos(Omega t) and its rate (m, m/s); these 2 n + 2
+    components (up to `acc`) are the mechanical state. From `acc` on, integrals carried through the period:
+    Y[F_l], Y[F_l + 1] = Re, Im of F_l = int f_l e^{-i Omega t} dt (N s), the same for F_r.
+    """
+
+    n: int
+    x: int
+    v: int
+    z: int
+    zd: int
+    acc: int
+    F_l: int
+    F_r: int
+    size: int
+
+
+@kernel(inline="always")
+def state_layout(n: int) -> StateLayout:
+    """The `StateLayout` for n modes. A new component is one line here and one field in `StateLayout`."""
+    x = 0
+    v = x + n
+    z = v + n
+    zd = z + 1
+    acc = zd + 1
+    F_l = acc
+    F_r = F_l + 2
+    size = F_r + 2
+    return StateLayout(n=n, x=x, v=v, z=z, zd=zd, acc=acc, F_l=F_l, F_r=F_r, size=size)
+
+
+#: The constants of mode j in one run (a record per mode; Eqs. 7, 9 and the scales of the contact steps).
+MODE = np.dtype([
+    ("sig", np.float64),  # decay rate sigma_j = D_j omega_j (1/s)
+    ("wd", np.float64),  # damped frequency omega_dj = omega_j sqrt(1 - D_j^2) (rad/s)
+    ("w2", np.float64),  # omega_j^2 (1/s^2)
+    ("phi_l", np.float64),  # mode value at the left wall (1/sqrt(kg))
+    ("phi_r", np.float64),  # ... at the right wall
+    ("abs_phi_l", np.float64),  # |phi_l,j|, |phi_r,j| (curvature bounds)
+    ("abs_phi_r", np.float64),
+    ("sig_wd", np.float64),  # sigma_j / omega_dj, 1 / omega_dj, omega_j^2 / omega_dj: the transition
+    ("inv_wd", np.float64),  # without divisions
+    ("w2_wd", np.float64),
+    ("S_re", np.float64),  # particular harmonic solution S_j (m sqrt(kg)), Re and Im
+    ("S_im", np.float64),
+    ("rho_re", np.float64),  # phi_tip,j / Delta_j (the Fourier coefficient from the deviations)
+    ("rho_im", np.float64),
+    ("err_x", np.float64),  # inverse error scales of a Dormand-Prince step: of x_j (1/(m sqrt(kg)))
+    ("err_v", np.float64),  # ... and of x_j' (s/(m sqrt(kg)))
+    ("grid_a", np.float64),  # the transition (`transition`) over a free-flight grid step h (`sim.exact`)
+    ("grid_b", np.float64),
+    ("grid_c", np.float64),
+    ("grid_d", np.float64),
+    ("grid_decay", np.float64),  # exp(-sigma_j h): the envelope's decay over a grid step
+    ("grid_kappa", np.float64),  # min(omega_j^2 h^2 / 8, 2): the chord bound's factor of a grid step
+], align=True)
+
+#: The scalar constants of one run (one record).
+RUN = np.dtype([
+    ("Omega", np.float64),  # excitation frequency (rad/s)
+    ("a_base", np.float64),  # base amplitude (m)
+    ("m_a", np.float64),  # sphere mass (kg) and its inverse
+    ("inv_m_a", np.float64),
+    ("k_H", np.float64),  # Hertz constant (N/m^1.5)
+    ("g", np.float64),  # clearance (m)
+    ("W_l_re", np.float64),  # W_w = phi_w^T S + a_base: harmonic wall motion relative to the base (m)
+    ("W_l_im", np.float64),
+    ("W_r_re", np.float64),
+    ("W_r_im", np.float64),
+    ("P_re", np.float64),  # phi_tip^T S: harmonic tip displacement (m)
+    ("P_im", np.float64),
+    ("gap_tol", np.float64),  # onset/release tolerance on the closing functions (m)
+    ("v_min", np.float64),  # least approach speed of an onset (m/s)
+    ("M_l0", np.float64),  # |W_w| Omega^2: the harmonic part of the curvature bounds (m/s^2)
+    ("M_r0", np.float64),
+    ("err_z", np.float64),  # inverse error scales of a Dormand-Prince step: of z (1/m) and z' (s/m)
+    ("err_zd", np.float64),
+    ("h_max", np.float64),  # longest Dormand-Prince contact step (s)
+    ("h_fixed", np.float64),  # > 0: fixed Dormand-Prince contact step instead of error control (s)
+], align=True)
+
+
+def mode_records(**columns: np.ndarray) -> np.ndarray:
+    """The `MODE` records of n modes from a float array of n values per field (every field by name, SI units)."""
+    missing = set(MODE.names) - set(columns)
+    if missing or len(columns) != len(MODE.names):
+        raise ValueError(f"mode_records needs exactly the fields of MODE; missing {sorted(missing)}")
+    table = np.empty((np.size(columns["sig"]), len(MODE.names)))
+    for i, name in enumerate(MODE.names):
+        table[:, i] = columns[name]
+    return table.view(MODE).reshape(-1)  # MODE has float64 fields only: a row of the table is a record
+
+
+def run_record(**values: float) -> np.void:
+    """The `RUN` record with these values (every field by name, in SI units)."""
+    missing = set(RUN.names) - set(values)
+    if missing or len(values) != len(RUN.names):
+        raise ValueError(f"run_record needs exactly the fields of RUN; missing {sorted(missing)}")
+    return np.array([values[name] for name in RUN.names], dtype=np.float64).view(RUN)[0]
+
+
+class Constants(NamedTuple):
+    """The constants of one run of the exact integrator: a `MODE` record per mode and the `RUN` record (the
+    state layout is `state_layout(modes.size)`)."""
+
+    modes: np.ndarray
+    par: np.void
+
+
+class Output(NamedTuple):
+    """What the period loop of an integrator writes (contract of `sim.system`): per period |c_1| of q_tip (m)
+    and the number of contact onsets, and the state [s, s', u_a, u_a'] at the record instants into the rows
+    of `record` (none: 0 rows)."""
+
+    amplitudes: np.ndarray
+    impacts: np.ndarray
+    record: np.ndarray
+
+
+class Phase(NamedTuple):
+    """A phase time t (s) of the excitation period with cos(Omega t) and sin(Omega t)."""
+
+    t: float
+    cos: float
+    sin: float
+
+
+class Counters(NamedTuple):
+    """Index of each counter of the exact integrator's kernels (`run_step(..., stats=...)` uses the names)."""
+
+    grid_steps: int
+    searches: int
+    search_evaluations: int
+    contact_steps: int
+    rejected_steps: int
+    release_iterations: int
+    contacts: int
+    collocation_steps: int
+    collocation_fallbacks: int
+
+
+COUNT = Counters(*range(len(Counters._fields)))
+# status of a kernel
+OK, NONFINITE, OVERLAP, STALLED, STALLED_SEARCH = range(5)
 
 
 # ----------------------------------------------------------------------------------------------------------
 # free flight in closed form
 # ----------------------------------------------------------------------------------------------------------
-@njit(cache=True, inline="always")
-def _transition(tau, modes, j):
-    """Transition of the damped oscillator j over tau: (x, v)(tau) = [[a, b], [c, d]] (x0, v0)."""
-    e = math.exp(-modes[_SIG, j] * tau)
-    co = math.cos(modes[_WD, j] * tau)
-    si = math.sin(modes[_WD, j] * tau)
-    q = modes[_SOW, j] * si  # sigma / omega_d sin: the rows hold the ratios (no divisions here)
-    return e * (co + q), e * si * modes[_IWD, j], -e * modes[_W2OW, j] * si, e * (co - q)
+@kernel(inline="always")
+def transition(tau, md, j):
+    """Transition of the damped oscillator j over tau s (Eq. 9, homogeneous):
+    (x, v)(tau) = [[a, b], [c, d]] (x0, v0)."""
+    e = math.exp(-md[j].sig * tau)
+    co = math.cos(md[j].wd * tau)
+    si = math.sin(md[j].wd * tau)
+    q = md[j].sig_wd * si  # the records hold the ratios (no divisions here)
+    return e * (co + q), e * si * md[j].inv_wd, -e * md[j].w2_wd * si, e * (co - q)
 
 
-@njit(cache=True)
-def _flight_transitions(tau, modes, tr):
-    """tr[:, j] = transition (a, b, c, d) of mode j over a free flight of length tau."""
-    for j in range(modes.shape[1]):
-        tr[0, j], tr[1, j], tr[2, j], tr[3, j] = _transition(tau, modes, j)
+@kernel
+def flight_transitions(tau, md, tr):
+    """tr[:, j] = transition (a, b, c, d) of mode j over a free flight of tau s (Eq. 9)."""
+    for j in range(md.size):
+        tr[0, j], tr[1, j], tr[2, j], tr[3, j] = transition(tau, md, j)
 
 
-@njit(cache=True)
-def _apply_flight(Y, Ynew, tau, tr, n):
-    """Ynew = free flight of Y over tau (the force integrals F_w do not change)."""
-    for j in range(n):
-        x = Y[j]
-        v = Y[n + j]
-        Ynew[j] = tr[0, j] * x + tr[1, j] * v
-        Ynew[n + j] = tr[2, j] * x + tr[3, j] * v
-    Ynew[2 * n] = Y[2 * n] + tau * Y[2 * n + 1]
-    for i in range(2 * n + 1, Y.size):
+@kernel(inline="always")
+def _fly_mode(Y, Ynew, j, tr, lay):
+    """Mode j of a free flight with the transition tr = (a, b, c, d) of `transition` (Eq. 9)."""
+    a, b, c, d = tr
+    x = Y[lay.x + j]
+    v = Y[lay.v + j]
+    Ynew[lay.x + j] = a * x + b * v
+    Ynew[lay.v + j] = c * x + d * v
+
+
+@kernel(inline="always")
+def _fly_sphere(Y, Ynew, tau, lay):
+    """The sphere of a free flight over tau s (constant velocity); the carried integrals do not change."""
+    Ynew[lay.z] = Y[lay.z] + tau * Y[lay.zd]
+    for i in range(lay.zd, Y.size):
         Ynew[i] = Y[i]
 
 
-# time maps of a contact step, t = t_a + h w(u) with u in [0, 1] (`_time_map`)
+@kernel
+def grid_flight(Y, Ynew, h, md):
+    """Ynew = free flight of Y over one grid step h (s) with the transitions of the records (grid_a ... grid_d)."""
+    lay = state_layout(md.size)
+    for j in range(lay.n):
+        _fly_mode(Y, Ynew, j, (md[j].grid_a, md[j].grid_b, md[j].grid_c, md[j].grid_d), lay)
+    _fly_sphere(Y, Ynew, h, lay)
+
+
+@kernel
+def free_flight(Y, Ynew, tau, md):
+    """Ynew = free flight of Y over tau s (Eq. 9)."""
+    lay = state_layout(md.size)
+    for j in range(lay.n):
+        _fly_mode(Y, Ynew, j, transition(tau, md, j), lay)
+    _fly_sphere(Y, Ynew, tau, lay)
+
+
+# time maps of a contact step, t = t_a + h w(u) with u in [0, 1] (`time_map`)
 ONSET, REGULAR, RELEASE, GRAZE = 0, 1, 2, 3
 
 
-@njit(cache=True, inline="always")
-def _time_map(kind, u):
-    """(w(u), w'(u)) of a contact step's time map t = t_a + h w(u), w(1) = 1.
+@kernel(inline="always")
+def time_map(kind, u):
+    """(w(u), w'(u)) of a contact step's time map t = t_a + h w(u), w(1) = 1 (contacts of Eq. 4).
 
     At a contact onset (release) the Hertz force behaves like (t - t_on)^1.5 ((t_rel - t)^1.5) and a step
     in t loses its order; with t - t_on = h u^2 (t_rel - t = h (1 - u)^2) the force is a smooth function of
@@ -69,40 +252,43 @@ def _time_map(kind, u):
     return u, 1.0
 
 
-@njit(cache=True, inline="always")
-def _closing(Y, t, n, modes, par):
-    """(c_l, c_l', c_r, c_r') at phase time t: contact at a wall when its c > 0 (Eqs. 4-6)."""
-    return _closing_at(Y, math.cos(par[_OM] * t), math.sin(par[_OM] * t), n, modes, par)
+@kernel(inline="always")
+def closing(Y, t, cst):
+    """(c_l, c_l', c_r, c_r') at phase time t s: contact at a wall when its c > 0 (Eqs. 4-6)."""
+    Om = cst.par.Omega
+    return closing_at(Y, math.cos(Om * t), math.sin(Om * t), cst)
 
 
-@njit(cache=True, inline="always")
-def _closing_at(Y, ct, st, n, modes, par):
-    """`_closing` with cos, sin(Omega t) given."""
-    Om = par[_OM]
-    sl = par[_WLR] * ct - par[_WLI] * st
-    sld = -Om * (par[_WLR] * st + par[_WLI] * ct)
-    sr = par[_WRR] * ct - par[_WRI] * st
-    srd = -Om * (par[_WRR] * st + par[_WRI] * ct)
-    for j in range(n):
-        x = Y[j]
-        v = Y[n + j]
-        sl += modes[_PL, j] * x
-        sld += modes[_PL, j] * v
-        sr += modes[_PR, j] * x
-        srd += modes[_PR, j] * v
-    z = Y[2 * n]
-    zd = Y[2 * n + 1]
-    g = par[_G]
+@kernel(inline="always")
+def closing_at(Y, ct, st, cst):
+    """`closing` with cos, sin(Omega t) given."""
+    md, par = cst.modes, cst.par
+    lay = state_layout(md.size)
+    Om = par.Omega
+    sl = par.W_l_re * ct - par.W_l_im * st
+    sld = -Om * (par.W_l_re * st + par.W_l_im * ct)
+    sr = par.W_r_re * ct - par.W_r_im * st
+    srd = -Om * (par.W_r_re * st + par.W_r_im * ct)
+    for j in range(lay.n):
+        x = Y[lay.x + j]
+        v = Y[lay.v + j]
+        sl += md[j].phi_l * x
+        sld += md[j].phi_l * v
+        sr += md[j].phi_r * x
+        srd += md[j].phi_r * v
+    z = Y[lay.z]
+    zd = Y[lay.zd]
+    g = par.g
     return sl - z - g, sld - zd, -(sr - z) - g, -(srd - zd)
 
 
-# 1 / (k (k + 1)) for the nested Taylor series of `_rotate` (multiplications: a chain of divisions is slow)
+# 1 / (k (k + 1)) for the nested Taylor series of `rotate` (multiplications: a chain of divisions is slow)
 _C12, _C34, _C56, _C78, _C910, _C1112 = 1 / 2, 1 / 12, 1 / 30, 1 / 56, 1 / 90, 1 / 132
 _S23, _S45, _S67, _S89, _S1011, _S1213 = 1 / 6, 1 / 20, 1 / 42, 1 / 72, 1 / 110, 1 / 156
 
 
-@njit(cache=True, inline="always")
-def _rotate(ct, st, angle):
+@kernel(inline="always")
+def rotate(ct, st, angle):
     """cos, sin(theta + angle) from cos, sin(theta); Taylor series (to 1e-20) for the small angles of contacts."""
     if abs(angle) < 0.2:
         a2 = angle * angle

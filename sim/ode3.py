@@ -23,11 +23,13 @@ checked at the step points).
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
 from sim.errors import SimulationDiverged, SimulationInputError
+from sim.flight import Output, state_layout
+from sim.jit import kernel
 from sim.system import SystemArrays, check_run_step
 
 #: Sect. 3.2: the highest retained mode's period is sampled with 15 time levels.
@@ -81,77 +83,118 @@ def check_stability(sys: SystemArrays, h: float) -> None:
                 f"sqrt(3); use a step below {limit:.3g} s (smaller dt_scale)")
 
 
-@njit(cache=True, inline="always", fastmath=_FAST)
-def _indentations(y, n, phi_l, phi_r, g):
+class Steps(NamedTuple):
+    """The fixed steps of one run: N steps of h (s) per excitation period, the state recorded every `stride`
+    steps, Omega (rad/s), a_base (m), and cos(Omega t) at the three stages of each step (`cos_stage`, 3 x N)
+    and cos, sin(Omega t_k) at the steps."""
+
+    N: int
+    h: float
+    stride: int
+    Omega: float
+    a_base: float
+    cos_stage: np.ndarray
+    cos0: np.ndarray
+    sin0: np.ndarray
+
+
+class Coefficients(NamedTuple):
+    """Eqs. 3-7 as the kernel evaluates them: w2 = omega^2, c = 2 D omega (1/s), the wall values phi_l, phi_r,
+    the base forcing amplitudes f_modal = gamma a_base Omega^2 and f_sphere = a_base Omega^2, m_a, k_H, g."""
+
+    w2: np.ndarray
+    c: np.ndarray
+    phi_l: np.ndarray
+    phi_r: np.ndarray
+    f_modal: np.ndarray
+    f_sphere: float
+    m_a: float
+    k_H: float
+    g: float
+
+
+@kernel(inline="always", fastmath=_FAST)
+def _indentations(y, co, lay):
     """(delta_l, delta_r) of Eqs. 4-6: contact at the left wall when delta_l > 0, at the right when delta_r < 0."""
-    u = y[2 * n]
-    dl = -u - g
-    dr = -u + g
-    for j in range(n):
-        dl += phi_l[j] * y[j]
-        dr += phi_r[j] * y[j]
+    u = y[lay.z]
+    dl = -u - co.g
+    dr = -u + co.g
+    for j in range(lay.n):
+        dl += co.phi_l[j] * y[lay.x + j]
+        dr += co.phi_r[j] * y[lay.x + j]
     return dl, dr
 
 
-@njit(cache=True, inline="always", fastmath=_FAST)
-def _deriv(y, cos_t, n, w2, c, phi_l, phi_r, f_modal, f_sphere, m_a, k_H, g, out):
+@kernel(inline="always", fastmath=_FAST)
+def _deriv(y, cos_t, co, lay, out):
     """Right-hand side of Eqs. 3-7 in relative coordinates (see module docstring)."""
-    dl, dr = _indentations(y, n, phi_l, phi_r, g)
-    fl = k_H * dl * math.sqrt(dl) if dl > 0.0 else 0.0
-    fr = -k_H * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
-    for j in range(n):
-        out[j] = y[n + j]
-        out[n + j] = -c[j] * y[n + j] - w2[j] * y[j] - phi_l[j] * fl - phi_r[j] * fr + f_modal[j] * cos_t
-    out[2 * n] = y[2 * n + 1]
-    out[2 * n + 1] = (fl + fr) / m_a + f_sphere * cos_t
+    dl, dr = _indentations(y, co, lay)
+    fl = co.k_H * dl * math.sqrt(dl) if dl > 0.0 else 0.0
+    fr = -co.k_H * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
+    for j in range(lay.n):
+        out[lay.x + j] = y[lay.v + j]
+        out[lay.v + j] = (-co.c[j] * y[lay.v + j] - co.w2[j] * y[lay.x + j] - co.phi_l[j] * fl - co.phi_r[j] * fr
+                          + co.f_modal[j] * cos_t)
+    out[lay.z] = y[lay.zd]
+    out[lay.zd] = (fl + fr) / co.m_a + co.f_sphere * cos_t
 
 
-@njit(cache=True, fastmath=_FAST)
-def _advance(y, n_periods, N, h, Omega, a_base, omega, D, phi_l, phi_r, phi_tip, gamma, m_a, k_H, g,
-             cos_stage, cos0, sin0, record, rec_stride, amplitudes, impacts):
-    """Advance y in place over n_periods * N ode3 steps; returns (status, step index of a failure)."""
-    n = omega.size
-    ny = 2 * n + 2
-    w2 = omega * omega
-    c = 2.0 * D * omega
-    f_modal = gamma * (a_base * Omega * Omega)
-    f_sphere = a_base * Omega * Omega
+@kernel(inline="always", fastmath=_FAST)
+def _tip(y, phi_tip, lay):
+    """q_tip = phi_tip^T s (m)."""
+    q = 0.0
+    for j in range(lay.n):
+        q += phi_tip[j] * y[lay.x + j]
+    return q
+
+
+@kernel(fastmath=_FAST)
+def _advance(y, sys, steps, out):
+    """Advance y in place over the periods of `out`, N ode3 steps each; returns (status, step index of a failure)."""
+    lay = state_layout(sys.omega.size)
+    N = steps.N
+    Omega, a_base = steps.Omega, steps.a_base
+    co = Coefficients(w2=sys.omega * sys.omega, c=2.0 * sys.D * sys.omega, phi_l=sys.phi_l, phi_r=sys.phi_r,
+                      f_modal=sys.gamma * (a_base * Omega * Omega), f_sphere=a_base * Omega * Omega, m_a=sys.m_a,
+                      k_H=sys.k_H, g=sys.g)
+    ny = lay.acc
+    # arrays bound once: read from a tuple inside the step loop, numba would count references at every step
+    h = steps.h
+    cos_stage, cos0, sin0, phi_tip = steps.cos_stage, steps.cos0, steps.sin0, sys.phi_tip
     k1 = np.empty(ny)
     k2 = np.empty(ny)
     k3 = np.empty(ny)
     yt = np.empty(ny)
     b1, b2, b3 = h * 2.0 / 9.0, h / 3.0, h * 4.0 / 9.0
+    record = out.record
     recording = record.shape[0] > 0
-    rows_per_period = N // rec_stride
+    stride = steps.stride
+    rows_per_period = N // stride
     if recording:
         record[0, :] = y
     # contact state at the start (continuous with the end of the previous call)
-    dl, dr = _indentations(y, n, phi_l, phi_r, g)
-    has_contact = k_H > 0.0  # k_H = 0: the host structure alone, no contacts to count
+    dl, dr = _indentations(y, co, lay)
+    has_contact = co.k_H > 0.0  # k_H = 0: the host structure alone, no contacts to count
     closed_l = dl > 0.0 and has_contact
     closed_r = dr < 0.0 and has_contact
-    for p in range(n_periods):
-        q = 0.0
-        for j in range(n):
-            q += phi_tip[j] * y[j]
-        re = 0.5 * q  # trapezoid end weight, phase 0: cos = 1, sin = 0
+    for p in range(out.amplitudes.size):
+        re = 0.5 * _tip(y, phi_tip, lay)  # trapezoid end weight, phase 0: cos = 1, sin = 0
         im = 0.0
         onsets = 0
         for k in range(N):
-            _deriv(y, cos_stage[0, k], n, w2, c, phi_l, phi_r, f_modal, f_sphere, m_a, k_H, g, k1)
+            # the Bogacki-Shampine stages of the module docstring (Sect. 3.2)
+            _deriv(y, cos_stage[0, k], co, lay, k1)
             for i in range(ny):
                 yt[i] = y[i] + 0.5 * h * k1[i]
-            _deriv(yt, cos_stage[1, k], n, w2, c, phi_l, phi_r, f_modal, f_sphere, m_a, k_H, g, k2)
+            _deriv(yt, cos_stage[1, k], co, lay, k2)
             for i in range(ny):
                 yt[i] = y[i] + 0.75 * h * k2[i]
-            _deriv(yt, cos_stage[2, k], n, w2, c, phi_l, phi_r, f_modal, f_sphere, m_a, k_H, g, k3)
+            _deriv(yt, cos_stage[2, k], co, lay, k3)
             for i in range(ny):
                 y[i] += b1 * k1[i] + b2 * k2[i] + b3 * k3[i]
             # measures at the new step point t_{k+1}
-            dl, dr = _indentations(y, n, phi_l, phi_r, g)
-            q = 0.0
-            for j in range(n):
-                q += phi_tip[j] * y[j]
+            dl, dr = _indentations(y, co, lay)
+            q = _tip(y, phi_tip, lay)
             kk = k + 1
             if kk < N:
                 re += q * cos0[kk]
@@ -166,16 +209,16 @@ def _advance(y, n_periods, N, h, Omega, a_base, omega, D, phi_l, phi_r, phi_tip,
                 onsets += 1
             closed_l = now_l
             closed_r = now_r
-            if has_contact and (dl > g or -dr > g):
+            if has_contact and (dl > co.g or -dr > co.g):
                 return _OVERLAP, p * N + k
-            if recording and kk % rec_stride == 0:
-                record[p * rows_per_period + kk // rec_stride, :] = y
-        amplitudes[p] = 2.0 / N * math.sqrt(re * re + im * im)
-        impacts[p] = onsets
+            if recording and kk % stride == 0:
+                record[p * rows_per_period + kk // stride, :] = y
+        out.amplitudes[p] = 2.0 / N * math.sqrt(re * re + im * im)
+        out.impacts[p] = onsets
         for i in range(ny):
             if not math.isfinite(y[i]):
                 return _NONFINITE, (p + 1) * N
-    return _OK, n_periods * N
+    return _OK, out.amplitudes.size * N
 
 
 def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: SystemArrays,
@@ -208,14 +251,14 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     cos_stage = np.empty((3, N))
     for row, c_stage in enumerate((0.0, 0.5, 0.75)):
         cos_stage[row] = np.cos(phase + c_stage * Omega * h)
-    amplitudes = np.empty(n_periods)
-    impacts = np.zeros(n_periods, dtype=np.int64)
-    status, where = _advance(y, n_periods, N, h, Omega, a_base, sys.omega, sys.D, sys.phi_l, sys.phi_r,
-                             sys.phi_tip, sys.gamma, float(sys.m_a), float(sys.k_H), float(sys.g),
-                             cos_stage, np.cos(phase), np.sin(phase), record_arr, N // samples, amplitudes, impacts)
+    steps = Steps(N=N, h=h, stride=N // samples, Omega=Omega, a_base=a_base, cos_stage=cos_stage,
+                  cos0=np.cos(phase), sin0=np.sin(phase))
+    out = Output(amplitudes=np.empty(n_periods), impacts=np.zeros(n_periods, dtype=np.int64), record=record_arr)
+    kernel_sys = sys._replace(m_a=float(sys.m_a), k_H=float(sys.k_H), g=float(sys.g))
+    status, where = _advance(y, kernel_sys, steps, out)
     if status != _OK:
         t = where * h
         why = "non-finite state" if status == _NONFINITE else "an indentation larger than the clearance"
         raise SimulationDiverged(
             f"ode3 diverged after {t:.4g} s of this step ({why}); reduce dt_scale or check k_H, g and the level")
-    return amplitudes, impacts
+    return out.amplitudes, out.impacts

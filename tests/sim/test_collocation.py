@@ -19,24 +19,25 @@ OMEGA = 2 * math.pi * 1000.0
 
 @pytest.fixture(scope="module")
 def beam():
-    """The 9-mode cantilever-like system and its kernel tables (rows of sim.flight) at 1 kHz excitation."""
+    """The 9-mode cantilever-like system and its kernel constants (sim.flight.Constants) at 1 kHz excitation."""
     sys = system_arrays(cantilever_like_model(), Impactor())
-    modes, par, *_ = exact._prepare(OMEGA, 2e-5, sys, 48, exact.CONTACT_RTOL, 0.5 / sys.omega.max())
-    return sys, modes, par
+    cst, _ = exact._prepare(OMEGA, 2e-5, sys, 48, exact.CONTACT_RTOL, 0.5 / sys.omega.max())
+    return sys, cst
 
 
-def _table(modes, par, kind, h, wall=0, nodes=None, quadrature=C.TABLE_QUADRATURE):
-    nodes = nodes or C.Nodes()
-    xq, bq = np.polynomial.legendre.leggauss(quadrature)
-    off = C._offsets(nodes.u.size, N9)
-    tab = np.zeros(off[C._SIZE])
-    C._build(tab, off, kind, h, wall, nodes.u, nodes.wb, nodes.b, 0.5 * (xq + 1), 0.5 * bq, N9, modes, par)
+def _table(cst, kind, h, wall=0, nodes=None, quadrature=C.TABLE_QUADRATURE):
+    nodes = nodes or C.gauss_nodes()
+    if quadrature != C.TABLE_QUADRATURE:
+        nodes = C.gauss_nodes(nodes.u.size, nodes.onset.shape[0], quadrature)
+    off = C.table_layout(nodes.u.size, N9)
+    tab = np.zeros(off.size)
+    C._build(tab, nodes, off, kind, h, wall, cst)
     return tab, off
 
 
 def _phases(tab, off, s, Omega=OMEGA):
-    """cos, sin(Omega tau) at the nodes and the end of a table (what `C._phases` caches per run)."""
-    tau = tab[off[C._TAU]:off[C._TAU] + s + 1]
+    """cos, sin(Omega tau) at the nodes and the end of a table (what `C._step_table` caches per run)."""
+    tau = tab[off.TAU:off.TAU + s + 1]
     return np.vstack([np.cos(Omega * tau), np.sin(Omega * tau)])
 
 
@@ -44,10 +45,10 @@ def _phases(tab, off, s, Omega=OMEGA):
 def test_tables_are_converged_in_their_quadrature(beam, kind):
     """Every block of a table (a 40 us step, the highest mode turning by 5 rad) agrees with the same table
     built with twice the quadrature points to 1e-13 of the block's largest entry."""
-    _, modes, par = beam
-    coarse, off = _table(modes, par, kind, 40e-6)
-    fine, _ = _table(modes, par, kind, 40e-6, quadrature=2 * C.TABLE_QUADRATURE)
-    for block in range(C._SIZE):
+    _, cst = beam
+    coarse, off = _table(cst, kind, 40e-6)
+    fine, _ = _table(cst, kind, 40e-6, quadrature=2 * C.TABLE_QUADRATURE)
+    for block in range(len(C.TABLE_BLOCKS)):
         a, b = coarse[off[block]:off[block + 1]], fine[off[block]:off[block + 1]]
         assert np.max(np.abs(a - b)) <= 1e-13 * np.max(np.abs(b))
 
@@ -67,28 +68,27 @@ def _state_in_contact(sys):
 def test_backward_series_is_the_step_solution(beam, kind, M):
     """The Taylor series that carries the state back from a step's end (into which the release step starts)
     equals an independent forward step over the first 75 % (or 85 %) with the same force polynomial."""
-    sys, modes, par = beam
-    nodes = C.Nodes()
+    sys, cst = beam
+    nodes = C.gauss_nodes()
     h = 30e-6
-    tab, off = _table(modes, par, kind, h)
+    tab, off = _table(cst, kind, h)
     Y = _state_in_contact(sys)
     F = 40.0 + 30.0 * np.sin(3.0 * nodes.u)  # nodal forces (N): any smooth pulse piece
     Yend = np.empty_like(Y)
-    C._end_state(tab, off, _phases(tab, off, nodes.u.size), Y, Yend, F, 1.0, 0.0, 0, N9, nodes.u.size, par)
+    C._end_state(C.Step(tab, _phases(tab, off, nodes.u.size), off), Y, Yend, F, 1.0, 0.0, 0)
     S = np.zeros((C.SERIES_ORDER, 2 * N9 + 2))
     Fs = np.zeros(C.SERIES_ORDER)
-    C._series(Yend, F, getattr(nodes, M), h, 0, N9, modes, par, S, Fs)
+    C._series(Yend, F, getattr(nodes, M), h, 0, cst, S, Fs)
     for fraction in (0.75, 0.85):
         # the same force polynomial on the part [0, fraction h] of the step: the map w(u) = u or u^2 of the
         # shorter step reaches w = fraction at u' = fraction (regular) or sqrt(fraction) (onset)
         scale = fraction if kind == C.REGULAR else math.sqrt(fraction)
-        part, _ = _table(modes, par, kind, fraction * h)
+        part, _ = _table(cst, kind, fraction * h)
         lag = np.empty((nodes.u.size, nodes.u.size))
         for row, v in zip(lag, nodes.u):
             C._lagrange(nodes.u, nodes.wb, scale * v, row)
         Ypart = np.empty_like(Y)
-        C._end_state(part, off, _phases(part, off, nodes.u.size), Y, Ypart, lag @ F, 1.0, 0.0, 0, N9, nodes.u.size,
-                     par)
+        C._end_state(C.Step(part, _phases(part, off, nodes.u.size), off), Y, Ypart, lag @ F, 1.0, 0.0, 0)
         Yb = np.empty(2 * N9 + 2)
         C._series_at(S, (1.0 - fraction) * h, Yb, 2 * N9 + 2)
         scale_state = np.concatenate([np.full(N9, np.abs(Y[:N9]).max()), np.full(N9, np.abs(Y[N9:2 * N9]).max()),
@@ -100,9 +100,9 @@ def test_observed_order_of_a_collocation_step(beam):
     """Regular steps through a closed contact against DOP853: with s = 4 nodes the log-log fit of the
     sphere's velocity error against h has at least the order of Gauss quadrature of the impulse (2 s = 8;
     measured 9.2)."""
-    sys, modes, par0 = beam
-    modes, par, *_ = exact._prepare(OMEGA, 0.0, sys, 48, exact.CONTACT_RTOL, 0.5 / sys.omega.max())
-    nodes = C.Nodes(4, C.SERIES_ORDER)
+    sys, _ = beam
+    cst, _ = exact._prepare(OMEGA, 0.0, sys, 48, exact.CONTACT_RTOL, 0.5 / sys.omega.max())
+    nodes = C.gauss_nodes(4, C.SERIES_ORDER)
     y0 = np.zeros(2 * N9 + 2)
     y0[2 * N9] = -sys.g - 5e-6
     y0[2 * N9 + 1] = -0.3
@@ -110,18 +110,18 @@ def test_observed_order_of_a_collocation_step(beam):
     y_ref, onsets, releases, _ = reference_run(y0, span, OMEGA, 0.0, sys)
     assert releases.size == 0
     steps, errors = [], []
-    ws, A, *_ = C.workspace(nodes, N9)
+    ws = C.workspace(nodes, N9)
     for n_steps in (2, 3, 4, 6):
         h = span / n_steps
-        tab, off = _table(modes, par, C.REGULAR, h, nodes=nodes)
+        tab, off = _table(cst, C.REGULAR, h, nodes=nodes)
         Y = np.zeros(2 * N9 + 6)
         Y[:2 * N9 + 2] = y0
         ratio = np.ones(4)
-        ph = _phases(tab, off, 4, Omega=par[C._OM])
+        step = C.Step(tab, _phases(tab, off, 4, Omega=cst.par["Omega"]), off)
         for _ in range(n_steps):
-            assert C._forward_step(tab, off, ph, Y, 1.0, 0.0, 0, N9, 4, par, ws, A, ratio, nodes.tail * 0.0)
+            assert C._forward_step(step, Y, 1.0, 0.0, 0, ratio, ws, cst)
             Ynew = np.empty_like(Y)
-            C._end_state(tab, off, ph, Y, Ynew, ws[C._F, :4].copy(), 1.0, 0.0, 0, N9, 4, par)
+            C._end_state(step, Y, Ynew, ws.rows[C.ROW.F, :4].copy(), 1.0, 0.0, 0)
             Y = Ynew
         steps.append(h)
         errors.append(abs(Y[2 * N9 + 1] - y_ref[2 * N9 + 1]) / 0.3)
@@ -171,7 +171,8 @@ def test_dopri5_contacts_on_request_and_bad_choice(beam):
 
 def test_tables_are_shared_by_systems_with_the_same_modes(beam):
     """The ladder of tables is built once per system (modes, walls, sphere mass), whatever the excitation."""
-    sys, modes, _ = beam
-    other, *_ = exact._prepare(2 * OMEGA, 1e-4, sys, 48, exact.CONTACT_RTOL, 0.5 / sys.omega.max())
+    sys, cst = beam
+    other, _ = exact._prepare(2 * OMEGA, 1e-4, sys, 48, exact.CONTACT_RTOL, 0.5 / sys.omega.max())
+    modes, other = cst.modes, other.modes
     assert C.tables_for(modes, sys.m_a) is C.tables_for(other, sys.m_a)
     assert C.tables_for(modes, sys.m_a) is not C.tables_for(modes, 2 * sys.m_a)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from sim import exact, ode3
+from sim import dopri5, exact, flight, ode3
 from sim.errors import SimulationInputError
 from sim.system import Impactor, system_arrays
 
@@ -181,20 +181,19 @@ def test_release_is_located_when_the_first_guess_ends_short():
     impact) whenever its first trial step ended still closed; it must converge onto c = 0 from either side."""
     sys = system_arrays(cantilever_like_model(), Impactor())
     Omega = 2 * math.pi * 1000.0
-    modes, par, *_ = exact._prepare(Omega, 0.0, sys, 48, 1e-7, 0.5 / sys.omega.max())
+    cst, _ = exact._prepare(Omega, 0.0, sys, 48, 1e-7, 0.5 / sys.omega.max())
     n = N9
     Y = np.zeros(2 * n + 6)
     Y[2 * n] = -sys.g - 1e-7  # 0.1 um into the left wall ...
     Y[2 * n + 1] = 0.2  # ... opening at 0.2 m/s: the release is ~0.5 us ahead
-    K = np.zeros((7, Y.size))
-    exact._rhs(1.0, 0.0, Y, K[0], n, modes, par)
-    counters = np.zeros(exact._N_COUNT, dtype=np.int64)
+    work = dopri5.work(Y.size, np.zeros(len(flight.COUNT), dtype=np.int64))
+    dopri5.rhs(1.0, 0.0, Y, work.K[0], cst)
     guess = 0.3e-6  # ends short of the release
     for first_guess in (guess, 3 * guess):
-        Ynew = np.zeros_like(Y)
-        s, err, found = exact._locate_release(Y, 0.0, 1.0, 0.0, first_guess, 4e-6, exact.RELEASE, True, K,
-                                              np.zeros_like(Y), Ynew, n, modes, par, counters)
-        c_left = exact._closing(Ynew, s, n, modes, par)[0]
+        Ynew = work.end
+        s, err, found = dopri5.locate_release(Y, flight.Phase(0.0, 1.0, 0.0), first_guess, 4e-6, flight.RELEASE, True,
+                                              work, cst)
+        c_left = flight.closing(Ynew, s, cst)[0]
         assert found and err <= 1.0
         assert abs(c_left) <= exact.GAP_TOLERANCE * sys.g
         assert s == pytest.approx(0.5e-6, rel=0.01)
