@@ -47,6 +47,7 @@ a `StudyError` whose one line names the file, the key and the fix.
 from __future__ import annotations
 
 import math
+import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -54,7 +55,7 @@ from typing import Any, Mapping
 
 from uq.errors import StudyError
 from uq.models import make_model
-from uq.space import Parameter, ParameterSpace, resolve_k_H
+from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_H, resolve_value
 
 KINDS = ("interval", "sobol")
 DESIGNS = ("individual", "joint", "residual")
@@ -170,7 +171,7 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
             raise StudyError(f"[study] modal_model must be the path of a modal-model file (`ies modes --save`), got {modal_model!r}")
         modal_model = base_dir / modal_model
 
-    space = _parse_parameters(data.get("parameters"), model_spec, base_dir)
+    space = _parse_parameters(data.get("parameters"), model_spec, base_dir, source)
 
     exc = dict(data.get("excitation", {}))
     levels_raw = exc.pop("levels", [1.0] if model_spec != "ies" else None)
@@ -192,7 +193,7 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
     if interior < 0:
         raise StudyError(f"[interval] interior must be >= 0, got {interior}")
     z = float(_number("interval", "z", iv.get("z", 2.0), positive=False))
-    fix = _parse_fix(iv.get("fix", {"k_H": "best_estimate"} if "k_H" in space.names else {}), space, base_dir)
+    fix = _parse_fix(iv.get("fix", {"k_H": "best_estimate"} if "k_H" in space.names else {}), space, base_dir, source)
     if "residual" in designs and not fix:
         raise StudyError("[interval] the residual design needs fixed parameters: fix = { k_H = \"best_estimate\" }")
 
@@ -215,7 +216,7 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
     return study
 
 
-def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir: Path) -> ParameterSpace:
+def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir: Path, source: str) -> ParameterSpace:
     model = make_model(model_spec, parameters=tuple(table or {}))
     default = model.default_space()
     if default is None:  # a user's function: every parameter must be given in full
@@ -244,8 +245,8 @@ def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir
         spec = _check_param_table(p.name, table[p.name])
         values = {}
         for key in ("nominal", "min", "max"):
-            raw = spec.get(key, getattr(p, key))
-            values[key] = resolve_k_H(raw, base_dir=base_dir) if p.name == "k_H" else raw
+            values[key] = resolve_value(p.name, spec.get(key, getattr(p, key)), base_dir=base_dir)
+            _warn_implausible(source, f"[parameters.{p.name}] {key}", p.name, values[key])
         if "best_estimate" in spec:
             if p.name != "k_H":
                 raise StudyError(f"[parameters.{p.name}] best_estimate is only defined for k_H")
@@ -257,6 +258,15 @@ def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir
     return ParameterSpace(tuple(params), extras)
 
 
+def _warn_implausible(source: str, where: str, name: str, value: object) -> None:
+    """One warning line on stderr when a value of g or k_H in study file `source` has an implausible magnitude
+    (probably a unit slip)."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        warning = plausibility_warning(name, value)
+        if warning:
+            sys.stderr.write(f"warning: {source + ': ' if source else ''}{where}: {warning}\n")
+
+
 def _check_param_table(name: str, spec: Any) -> Mapping[str, Any]:
     if not isinstance(spec, Mapping):
         raise StudyError(f"[parameters.{name}] must be a table with nominal, min, max")
@@ -266,7 +276,7 @@ def _check_param_table(name: str, spec: Any) -> Mapping[str, Any]:
     return spec
 
 
-def _parse_fix(fix: Any, space: ParameterSpace, base_dir: Path) -> dict[str, float]:
+def _parse_fix(fix: Any, space: ParameterSpace, base_dir: Path, source: str) -> dict[str, float]:
     if not isinstance(fix, Mapping):
         raise StudyError(f"[interval] fix must be a table like {{ k_H = \"best_estimate\" }}, got {fix!r}")
     out = {}
@@ -277,8 +287,9 @@ def _parse_fix(fix: Any, space: ParameterSpace, base_dir: Path) -> dict[str, flo
             if f"{pname}_best_estimate" not in space.extras:
                 raise StudyError(f"[interval] fix: '{pname}' has no best estimate; give a number")
             value = space.extras[f"{pname}_best_estimate"]
-        elif pname == "k_H":
-            value = resolve_k_H(raw, base_dir=base_dir)
+        elif pname in ("k_H", "g"):
+            value = resolve_value(pname, raw, base_dir=base_dir)
+            _warn_implausible(source, f"[interval] fix.{pname}", pname, value)
         else:
             value = float(_number("interval", f"fix.{pname}", raw, positive=space[pname].positive))
         out[pname] = float(value)
