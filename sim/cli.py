@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any, Iterator, Sequence
 
 from sim.errors import SimulationInputError
+from sim.options import clearance, figure_file, hertz_constant, positive_int
 
 MODES_HELP = "modal model of the host structure: frequencies, damping, mode values, participation (built-in rig or file)"
 SWEEP_HELP = "stepped-sine frequency response (mean and max amplitude per eta, spread over repetitions; Fig. 5)"
@@ -180,8 +181,8 @@ def _external_model(args: argparse.Namespace) -> tuple[Any, dict | None, list[st
 def modes_command(args: argparse.Namespace) -> int:
     """`ies modes`: show (and with --save write) the built-in rig's model, a modal-model file, the 3D solid
     model or the modes of a CalculiX job."""
-    from sim.files import dumps
-    from sim.modal_file import load_modal_model, save_modal_model
+    from sim.files import dumps, report_written
+    from sim.modal_file import save_modal_model
 
     rig = provenance = None
     report: list[str] = []
@@ -195,7 +196,7 @@ def modes_command(args: argparse.Namespace) -> int:
     elif args.model:
         if args.variant is not None:
             raise SimulationInputError("--variant selects a built-in rig model; it cannot be used with --model")
-        model = load_modal_model(args.model)
+        model = model_file(args.model)
     else:
         from sim.rig import DEFAULT_VARIANT, rig_modes, seed_rig_model, variant_parameters
 
@@ -208,6 +209,7 @@ def modes_command(args: argparse.Namespace) -> int:
     if args.save:
         data["saved_to"] = str(save_modal_model(model, args.save, provenance))
     print(dumps(data) if args.json else "\n".join([*report, modes_table(data)]))
+    report_written([data["saved_to"]] if args.save else [], json_mode=args.json)
     return 0
 
 
@@ -217,9 +219,11 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
     """Model and impactor options (Table 2 parameters)."""
     parser.add_argument("--model", metavar="FILE", help="modal-model file (default: the built-in model of the seed rig)")
     parser.add_argument("--D", type=float, metavar="D1", help="modal damping ratio of mode 1 (-), default the model's (0.00085)")
-    parser.add_argument("--g", type=float, metavar="M", help="clearance g in m (default 0.58e-3 m)")
-    parser.add_argument("--k-H", dest="k_H", type=float, metavar="N/M^1.5",
-                        help="Hertz constant k_H in N/m^1.5 (default 282e3 N/mm^1.5 = 8.918e9 N/m^1.5)")
+    parser.add_argument("--g", type=clearance, metavar="G",
+                        help="clearance g in m, or with a unit: 0.58mm, 580um (default 0.58 mm)")
+    parser.add_argument("--k-H", dest="k_H", type=hertz_constant, metavar="K_H",
+                        help="Hertz constant k_H in N/m^1.5, or with a unit: 282e3N/mm^1.5 (default 282e3 N/mm^1.5 = "
+                             "8.918e9 N/m^1.5)")
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
 
 
@@ -238,8 +242,9 @@ def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int
     parser.add_argument("--wait", type=float, default=None, metavar="S",
                         help="wait time per frequency in s (default 3, or 15 with --no-impactor, Sect. 5.1)")
     parser.add_argument("--hold", type=float, default=5.0, metavar="S", help="hold time per frequency in s (default 5)")
-    parser.add_argument("--reps", type=int, default=default_reps, metavar="N",
-                        help=f"runs from rest, each with its own random frequency offsets (default {default_reps})")
+    parser.add_argument("--reps", type=positive_int, default=default_reps, metavar="N",
+                        help=f"stepped-sine runs, each from the initial conditions of --start with its own random "
+                             f"perturbation (--perturb) (default {default_reps})")
     parser.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
     parser.add_argument("--perturbation", type=float, default=5e-4, metavar="REL",
                         help="half-width of the uniform relative frequency offset per point (default 5e-4)")
@@ -254,7 +259,8 @@ def add_simulation_arguments(parser: argparse.ArgumentParser, *, default_reps: i
     add_protocol_arguments(parser, default_reps=default_reps)
     add_system_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--plot", metavar="FILE", help=f"write a {figure}-like plot (PNG/PDF by suffix)")
+    parser.add_argument("--plot", type=figure_file, metavar="FILE",
+                        help=f"write a {figure}-like plot (format by suffix: .png, .pdf, .svg, ...)")
     parser.add_argument("--out", metavar="DIR", help=f"write {stem}.csv (data) and {stem}.json (data + metadata)")
 
 
@@ -294,13 +300,23 @@ def parse_levels(text: str) -> list[float]:
     return [check_level(v) for v in values]
 
 
+def model_file(path: str) -> Any:
+    """The modal model of a file (`sim.modal_file`), its source naming the file first: ``file PATH (what the file
+    says it holds)``, so that a saved built-in model is reported as the file it now is."""
+    import dataclasses
+
+    from sim.modal_file import load_modal_model
+
+    model = load_modal_model(path)
+    return dataclasses.replace(model, source=f"file {path} ({model.source})")
+
+
 def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     """(modal model, impactor or None) of the system and impactor options (Eqs. 3-7, Table 2)."""
-    from sim.modal_file import load_modal_model
     from sim.rig import seed_rig_model
     from sim.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor
 
-    model = load_modal_model(args.model) if args.model else seed_rig_model(n_modes=9)
+    model = model_file(args.model) if args.model else seed_rig_model(n_modes=9)
     if args.D is not None:
         model = model.with_damping(args.D)
     clearance = CLEARANCE_NOMINAL if args.g is None else args.g
@@ -357,13 +373,13 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, progress: s
         yield folder, protocol, model, impactor, results
 
 
-def write_results(folder: Path | None, stem: str, header: Sequence[str], rows: Any, data: dict) -> None:
-    """With --out: the table as STEM.csv (data) and `data` as STEM.json (data + metadata)."""
+def write_results(folder: Path | None, stem: str, header: Sequence[str], rows: Any, data: dict) -> list[Path]:
+    """With --out: the table as STEM.csv (data) and `data` as STEM.json (data + metadata); the paths written."""
     from sim.files import dumps, write_csv, write_text
 
-    if folder is not None:
-        write_csv(folder / f"{stem}.csv", header, rows)
-        write_text(folder / f"{stem}.json", dumps(data) + "\n")
+    if folder is None:
+        return []
+    return [write_csv(folder / f"{stem}.csv", header, rows), write_text(folder / f"{stem}.json", dumps(data) + "\n")]
 
 
 # ---- ies sweep ----------------------------------------------------------------------------------------------
@@ -378,7 +394,7 @@ def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
 def sweep_command(args: argparse.Namespace) -> int:
     """`ies sweep`: one stepped-sine frequency response (Sects. 5.1, 5.2; Fig. 5)."""
     from sim.figures import plot_sweep
-    from sim.files import dumps
+    from sim.files import dumps, report_written
     from sim.protocol import check_level
 
     started = time.perf_counter()
@@ -390,11 +406,13 @@ def sweep_command(args: argparse.Namespace) -> int:
                                                             "k_H_N_per_m1p5": impactor.k_H},
                     D1=float(model.damping_ratios[0]))
         columns = [result.regime_per_eta if name == "regime" else getattr(result, name) for name in SWEEP_COLUMNS]
-        write_results(folder, "sweep", SWEEP_COLUMNS, zip(*columns), data)
+        written = write_results(folder, "sweep", SWEEP_COLUMNS, zip(*columns), data)
     if args.plot:
         plot_sweep(result, args.plot, f"a_base/a_base* = {level:g}, {result.n_samples} samples ({protocol.integrator})")
+        written.append(args.plot)
     if args.json:
         print(dumps(data))
+        report_written(written, json_mode=True)
         return 0
     print(f"# a_base/a_base* = {level:g}: {result.n_runs} runs, {result.n_samples} samples, {protocol.integrator}, "
           f"{data['wall_time_s']:.1f} s")
@@ -404,6 +422,7 @@ def sweep_command(args: argparse.Namespace) -> int:
               f"{result.impacts_per_period[i]:6.2f}  {result.regime_per_eta[i]}")
     print(f"resonant mean {result.resonant_mean:.4f} at eta {result.eta_resonant_mean:.4f} ({result.regime}); "
           f"resonant max {result.resonant_max:.4f} at eta {result.eta_resonant_max:.4f}")
+    report_written(written)
     return 0
 
 
@@ -419,7 +438,7 @@ def add_overview_arguments(parser: argparse.ArgumentParser) -> None:
 def overview_command(args: argparse.Namespace) -> int:
     """`ies overview`: the resonant level at each excitation level (Sect. 5.3; Fig. 6)."""
     from sim.figures import plot_overview
-    from sim.files import dumps
+    from sim.files import dumps, report_written
 
     started = time.perf_counter()
     levels = parse_levels(args.levels)
@@ -441,16 +460,19 @@ def overview_command(args: argparse.Namespace) -> int:
             "wall_time_s": time.perf_counter() - started,
         }
         columns = [data["levels" if name == "level" else name] for name in OVERVIEW_COLUMNS]
-        write_results(folder, "overview", OVERVIEW_COLUMNS, zip(*columns), data)
+        written = write_results(folder, "overview", OVERVIEW_COLUMNS, zip(*columns), data)
     if args.plot:
         plot_overview(levels, results, args.plot, f"{protocol.sequence}, {args.reps} runs ({protocol.integrator})")
+        written.append(args.plot)
     if args.json:
         print(dumps(data))
+        report_written(written, json_mode=True)
         return 0
     print(f"{'level':>7} {'res.mean':>9} {'res.max':>9} {'eta(mean)':>9} {'imp/T':>6}  regime")
     for i, level in enumerate(levels):
         print(f"{level:7.3f} {data['resonant_mean'][i]:9.4f} {data['resonant_max'][i]:9.4f} "
               f"{data['eta_resonant_mean'][i]:9.4f} {data['impacts_per_period'][i]:6.2f}  {data['regime'][i]}")
+    report_written(written)
     return 0
 
 

@@ -20,6 +20,7 @@ import json
 import math
 import os
 import secrets
+import sys
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterable, Iterator, Sequence
@@ -119,6 +120,14 @@ def write_csv(path: str | os.PathLike, header: Sequence[str], rows: Iterable[Seq
     writer.writerow(header)
     writer.writerows([csv_value(v) for v in row] for row in rows)
     return write_text(path, buffer.getvalue())
+
+
+def report_written(paths: Iterable[str | os.PathLike], *, json_mode: bool = False) -> None:
+    """One confirmation line ``wrote PATH`` per file a command wrote: on stdout after a text report, on stderr
+    when stdout carries one JSON object (`json_mode`)."""
+    stream = sys.stderr if json_mode else sys.stdout
+    for path in paths:
+        stream.write(f"wrote {path}\n")
 
 
 def save_figure(fig: Any, path: str | os.PathLike) -> Path:

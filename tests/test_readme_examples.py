@@ -82,15 +82,18 @@ SWEEP_ROW = re.compile(r"\s*(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)$")
 SWEEP_SUMMARY = re.compile(r"resonant mean (\S+) at eta (\S+) \((\S+)\); resonant max (\S+) at eta (\S+)$")
 
 
-def sweep_table(lines: list[str]) -> tuple[str, list[tuple], tuple]:
-    """(first line without its wall time, rows (eta, mean, max, cv, imp/T, regime), summary) of `ies sweep`."""
+def sweep_table(lines: list[str]) -> tuple[str, list[tuple], tuple, list[str]]:
+    """(first line without its wall time, rows (eta, mean, max, cv, imp/T, regime), summary, the files-written
+    lines) of `ies sweep`."""
     header = re.sub(r", [0-9.]+ s$", "", lines[0])
+    written = [line for line in lines if line.startswith("wrote ")]
+    lines = lines[:len(lines) - len(written)]
     rows = []
     for line in lines[2:-1]:
         eta, mean, peak, cv, impacts, regime = SWEEP_ROW.match(line).groups()
         rows.append((eta, float(mean), float(peak), float(cv), float(impacts), regime))
     mean, eta_mean, regime, peak, eta_max = SWEEP_SUMMARY.match(lines[-1]).groups()
-    return header, rows, (float(mean), eta_mean, regime, float(peak), eta_max)
+    return header, rows, (float(mean), eta_mean, regime, float(peak), eta_max), written
 
 
 def test_the_sweep_example(tmp_path, monkeypatch, capsys):
@@ -104,9 +107,9 @@ def test_the_sweep_example(tmp_path, monkeypatch, capsys):
     the grid, the place and the regime of the resonance exactly."""
     (command, expected), = [(c, e) for c, e in EXAMPLES if c.startswith("ies sweep")]
     printed = run(command, tmp_path, monkeypatch, capsys).splitlines()
-    header, rows, summary = sweep_table(printed)
-    readme_header, readme_rows, readme_summary = sweep_table(expected)
-    assert header == readme_header and printed[1] == expected[1]
+    header, rows, summary, written = sweep_table(printed)
+    readme_header, readme_rows, readme_summary, readme_written = sweep_table(expected)
+    assert header == readme_header and printed[1] == expected[1] and written == readme_written
     assert [r[0] for r in rows] == [r[0] for r in readme_rows]
     for (eta, mean, peak, cv, impacts, regime), (_, mean0, peak0, cv0, impacts0, regime0) in zip(rows, readme_rows):
         periodic = cv0 <= 0.15

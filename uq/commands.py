@@ -25,6 +25,8 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, Callable
 
+from sim.options import positive_int
+
 #: the calibration `ies reproduce` runs: no arguments, returns the JSON object of `ies calibrate --json`
 Calibrate = Callable[[], dict]
 
@@ -50,7 +52,7 @@ def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
 def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     """--out, --jobs, --scheduler, --resume, --no-figures, --quiet."""
     parser.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: the study's [study] output)")
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, metavar="N",
+    parser.add_argument("--jobs", type=positive_int, default=os.cpu_count() or 1, metavar="N",
                         help="local worker processes (default: the number of CPU cores; 1 runs in this process)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="run on a Dask cluster, e.g. tcp://host:8786 (needs dask.distributed)")
@@ -69,7 +71,7 @@ def add_interval_arguments(parser: argparse.ArgumentParser) -> None:
 def add_sobol_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies sobol`."""
     parser.add_argument("study", type=Path, metavar="STUDY.toml", help="study file ([study] kind = \"sobol\")")
-    parser.add_argument("--n", type=int, metavar="N", help="base sample size, a power of two (default: [sobol] n)")
+    parser.add_argument("--n", type=positive_int, metavar="N", help="base sample size, a power of two (default: [sobol] n)")
     add_run_arguments(parser)
 
 
@@ -129,7 +131,7 @@ def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
                         help="reduced protocol (fewer levels, frequencies, repetitions, shorter holds); same trends")
     parser.add_argument("--out", type=Path, default=Path("ies-out/reproduce"), metavar="DIR",
                         help="output folder (default ies-out/reproduce)")
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, metavar="N",
+    parser.add_argument("--jobs", type=positive_int, default=os.cpu_count() or 1, metavar="N",
                         help="local worker processes (default: the number of CPU cores)")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://host:8786")
     parser.add_argument("--resume", action="store_true", help="continue an interrupted reproduction in --out")
@@ -187,6 +189,7 @@ def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
     """`ies reproduce`: check every study first, connect to the cluster once, then calibrate (with
     `calibrate` unless --calibration FILE or --no-calibration) and run."""
     from uq.runner import check_writable, dask_client
+    from uq.space import calibrated_k_H
     from uq.study import load_study
 
     figures = ("fig7", "fig8") if args.figure == "all" else (args.figure,)
@@ -197,14 +200,18 @@ def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
         studies = [replace(s, modal_model=args.model) for s in studies]
     for s in studies:
         s.make_model().check()  # bad settings (e.g. an unknown integrator) fail here, before anything is written
+    calibration = None
+    if args.calibration is not None:  # a bad file fails here too
+        calibration = {"k_H": calibrated_k_H(args.calibration), "source": str(args.calibration)}
     with dask_client(args.scheduler) as client:  # connected once, first: a bad address leaves nothing behind
         check_writable(args.out)
-        return _reproduce(args, figures, studies, client, calibrate)
+        return _reproduce(args, figures, studies, client, calibrate, calibration)
 
 
 def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list, client: Any,
-               calibrate: Calibrate) -> int:
-    """Calibration (unless disabled), then each figure's interval study, its figures and its summary."""
+               calibrate: Calibrate, calibration: dict | None) -> int:
+    """Calibration (the given one, or run unless disabled), then each figure's interval study, its figures and
+    its summary."""
     from uq.errors import StudyError
     from uq.execute import run_interval_study
     from uq.figures import interval_figures
@@ -212,10 +219,7 @@ def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list
     from uq.space import K_H_STAR, calibrated_k_H
 
     out = args.out
-    calibration = None
-    if args.calibration is not None:
-        calibration = {"k_H": calibrated_k_H(args.calibration), "source": str(args.calibration)}
-    elif not args.no_calibration:
+    if calibration is None and args.calibration is None and not args.no_calibration:
         calibration = run_calibration(calibrate, out)
     if calibration is not None:
         k_cal = calibrated_k_H(calibration)

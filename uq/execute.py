@@ -202,7 +202,7 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     from uq.sobol import sobol_indices, sobol_sample
 
     model = _checked_model(study)
-    n = n or study.sobol_n
+    n = study.sobol_n if n is None else n
     X = sobol_sample(study.space, n, seed=study.seed)
     points = [study.space.from_values(x) for x in X]
     model, result, results, ran, elapsed = _run_points(study, model, points, out, resume, jobs, scheduler, progress,
