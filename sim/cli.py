@@ -247,7 +247,11 @@ def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int
                              f"perturbation (--perturb) (default {default_reps})")
     parser.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
     parser.add_argument("--perturbation", type=float, default=5e-4, metavar="REL",
-                        help="half-width of the uniform relative frequency offset per point (default 5e-4)")
+                        help="half-width of the uniform random relative frequency offset (default 5e-4)")
+    parser.add_argument("--perturb", default="start", choices=("start", "each-point"),
+                        help="what the offset perturbs: the first wait of each run, every hold at the nominal "
+                             "frequency (default, the paper's Sect. 5.1), or every point, each sample interpolated "
+                             "back onto the grid from the frequencies simulated")
     parser.add_argument("--integrator", default="exact", metavar="NAME",
                         help="time integrator: exact (default; closed-form free flight, located contacts) or ode3 (the paper's fixed step)")
     parser.add_argument("--dt-scale", dest="dt_scale", type=float, default=1.0, metavar="X",
@@ -332,7 +336,7 @@ def build_protocol(args: argparse.Namespace) -> Any:
     start, stop, n = parse_grid(args.eta, "--eta")
     wait = args.wait if args.wait is not None else (15.0 if args.no_impactor else 3.0)
     return SteppedSine(eta_start=start, eta_stop=stop, n_eta=n, sequence=args.sequence, wait=wait,
-                       hold=args.hold, perturbation=args.perturbation, repetition=args.repetition,
+                       hold=args.hold, perturbation=args.perturbation, perturb=args.perturb, repetition=args.repetition,
                        integrator=args.integrator, dt_scale=args.dt_scale, start=args.start)
 
 
@@ -447,10 +451,10 @@ def overview_command(args: argparse.Namespace) -> int:
             "levels": levels,
             "resonant_mean": [r.resonant_mean for r in results],
             "resonant_max": [r.resonant_max for r in results],
-            "resonant_mean_lo": [float(r.resonant_mean_samples.min()) for r in results],
-            "resonant_mean_hi": [float(r.resonant_mean_samples.max()) for r in results],
-            "resonant_max_lo": [float(r.resonant_max_samples.min()) for r in results],
-            "resonant_max_hi": [float(r.resonant_max_samples.max()) for r in results],
+            "resonant_mean_lo": [r.resonant_spread("mean")[0] for r in results],
+            "resonant_mean_hi": [r.resonant_spread("mean")[1] for r in results],
+            "resonant_max_lo": [r.resonant_spread("max")[0] for r in results],
+            "resonant_max_hi": [r.resonant_spread("max")[1] for r in results],
             "eta_resonant_mean": [r.eta_resonant_mean for r in results],
             "eta_resonant_max": [r.eta_resonant_max for r in results],
             "regime": [r.regime for r in results],

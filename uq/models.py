@@ -148,8 +148,9 @@ class IESModel:
 
     def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, tuple[float, float, int]]:
         """Resonant levels over the repetitions of one (point, level), exactly as `sim.protocol.aggregate_runs`
-        (largest repetition-averaged mean / max over eta, Sect. 5.2-5.3), with the standard error from the
-        spread of the repetition samples: {output: (value, standard error, number of samples)}."""
+        (largest repetition-averaged mean / max over eta, Sect. 5.2-5.3), with the standard error of the
+        repetition samples at that eta (`SweepResult.resonant_spread`; NaN for a single sample: no noise
+        estimate): {output: (value, standard error, number of samples)}."""
         import numpy as np
         from sim.protocol import SweepRun, aggregate_runs
 
@@ -164,9 +165,8 @@ class IESModel:
             return {name: (float("nan"), float("nan"), 0) for name in self.outputs}
         res = aggregate_runs(runs)
         n = int(res.n_samples)
-        se = lambda samples: float(np.std(samples, ddof=1) / np.sqrt(n)) if n >= 2 else 0.0  # noqa: E731
-        return {"mean": (res.resonant_mean, se(res.resonant_mean_samples), n),
-                "max": (res.resonant_max, se(res.resonant_max_samples), n),
+        return {"mean": (res.resonant_mean, res.resonant_spread("mean")[2], n),
+                "max": (res.resonant_max, res.resonant_spread("max")[2], n),
                 "apr": (1.0 if res.regime == "APR" else 0.0, 0.0, n)}
 
 

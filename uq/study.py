@@ -25,6 +25,8 @@ Layout (every table and key is optional except where noted; SI units)::
     eta = { start = 0.95, stop = 1.01, n = 25 }   # Omega / omega_1*
     repetition = "leg"           # "leg" or "run": what counts as one repetition sample (sim.protocol)
     start = "base-velocity"      # initial conditions of each run: "rest" or "base-velocity" (sim.protocol)
+    perturbation = 5e-4          # half-width of the random relative frequency offset of each run (sim.protocol)
+    perturb = "start"            # what it perturbs: "start" (each run's first wait) or "each-point"
     wait = 3.0                   # s
     hold = 5.0                   # s
     sequence = "up-down-up"
@@ -62,8 +64,8 @@ DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
     "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output"},
     "parameters": None,  # one sub-table per parameter
-    "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "repetition", "start",
-                   "dt_scale"},
+    "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "perturb", "repetition",
+                   "start", "dt_scale"},
     "interval": {"designs", "interior", "z", "fix"},
     "sobol": {"n", "bootstrap", "confidence"},
 }
@@ -302,7 +304,7 @@ def _parse_protocol(exc: Mapping[str, Any]) -> dict[str, Any]:
     for key in ("wait", "hold", "perturbation", "dt_scale"):
         if key in exc:
             out[key] = float(_number("excitation", key, exc[key]))
-    for key in ("sequence", "integrator", "repetition", "start"):
+    for key in ("sequence", "integrator", "repetition", "start", "perturb"):
         if key in exc:
             if not isinstance(exc[key], str):
                 raise StudyError(f"[excitation] {key} must be a string, got {exc[key]!r}")
