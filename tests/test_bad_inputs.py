@@ -146,3 +146,23 @@ def test_a_truncated_binary_stl_names_the_real_reason(tmp_path, capsys):
     stub = tmp_path / "stub.stl"
     stub.write_bytes(data[:50])
     refused(capsys, main(["calibrate", str(stub)]), "too short for a binary STL")
+
+
+# ---- one repetition ------------------------------------------------------------------------------------------
+
+def test_one_repetition_says_monotonicity_could_not_be_tested(tmp_path, capsys):
+    """One stepped-sine run per point gives no noise estimate: no 'not monotone beyond the noise', nothing
+    flagged, and the report says the check could not be made."""
+    import csv
+
+    study = tmp_path / "one.toml"
+    study.write_text("[study]\nkind = 'interval'\nrepetitions = 1\n[parameters.k_H]\n[parameters.g]\n[excitation]\n"
+                     "levels = [7.4]\neta = { start = 0.975, stop = 0.98, n = 2 }\nwait = 0.1\nhold = 0.1\n"
+                     "[interval]\ndesigns = ['individual', 'joint']\n")
+    assert main(["interval", str(study), "--out", str(tmp_path / "o"), "--quiet", "--jobs", "1", "--no-figures"]) == 0
+    captured = capsys.readouterr()
+    assert "not monotone" not in captured.err + captured.out
+    assert "monotonicity could not be tested" in captured.err
+    with open(tmp_path / "o" / "bands.csv", newline="") as fh:
+        bands = list(csv.DictReader(fh))
+    assert bands and all(r["tested"] == "0" and r["flagged"] == "0" for r in bands)

@@ -240,6 +240,8 @@ def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list
         for key, ok in s["monotone"].items():
             if not ok:
                 print(f"{figure}: monotonicity check failed for {key} (band widened; see study.json)")
+        for key in s["untested"]:
+            print(f"{figure}: monotonicity could not be tested for {key} (one repetition: no noise estimate)")
         if any(d == "individual" for d in study.designs):
             print(f"{figure}: change of the mean resonant level from each parameter's min to its max:")
             print(trend_table(folder))

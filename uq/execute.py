@@ -151,20 +151,21 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
             bd = _band_with_failures(d, mean, se, study.z, level_labels)
             bands[(d.name, o)] = bd
             for msg in bd.notes:
-                _warn(result, f"{o}: {msg} -> band widened")
+                _warn(result, f"{o}: {msg}")
             for j, level in enumerate(study.levels):
                 band_rows.append([d.name, o, level, bd.lower[j], bd.upper[j], bd.corner_lower[j], bd.corner_upper[j],
-                                  int(bd.flagged[j]), bd.violation[j]])
+                                  int(bd.flagged[j]), bd.violation[j], int(bd.tested[j])])
     result.files.append(write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
                                    _runs_rows(results, points, study, model.outputs, names)))
     result.files.append(write_csv(folder / "points.csv", ["design", "point", "role", *names, "level", "output",
                                                            "mean", "se", "n_samples"], point_rows))
     result.files.append(write_csv(folder / "bands.csv", ["design", "output", "level", "lower", "upper",
-                                                          "corner_lower", "corner_upper", "flagged", "violation"],
-                                   band_rows))
+                                                          "corner_lower", "corner_upper", "flagged", "violation",
+                                                          "tested"], band_rows))
     monotone = {f"{d}/{o}": bd.monotone for (d, o), bd in bands.items()}
+    untested = [f"{d}/{o}" for (d, o), bd in bands.items() if not bd.fully_tested]
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
-                      "wall_time_s": elapsed, "monotone": monotone, "points": len(points)}
+                      "wall_time_s": elapsed, "monotone": monotone, "untested": untested, "points": len(points)}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
     return result
 
@@ -181,7 +182,7 @@ def _band_with_failures(design: Design, mean: np.ndarray, se: np.ndarray, z: flo
         kept = tuple(p for p, keep in zip(design.points, ok) if keep)
         if not any(p.role == "corner" for p in kept):
             nan = np.array([np.nan])
-            parts.append(Band(design.name, nan, nan, nan, nan, np.array([True]), nan))
+            parts.append(Band(design.name, nan, nan, nan, nan, np.array([False]), nan, np.array([False])))
             notes.append(f"{design.name}: every corner failed at {labels[j]}; no band")
             continue
         sub = Design(design.name, design.kind, kept, design.parameter)
@@ -191,7 +192,7 @@ def _band_with_failures(design: Design, mean: np.ndarray, se: np.ndarray, z: flo
     for b in parts:
         notes.extend(b.notes)
     return Band(design.name, cat("lower"), cat("upper"), cat("corner_lower"), cat("corner_upper"), cat("flagged"),
-                cat("violation"), notes)
+                cat("violation"), cat("tested"), notes)
 
 
 def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = None, jobs: int = 1,

@@ -178,8 +178,10 @@ def _protocol_dict(protocol: Any) -> dict:
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in out.items()}
 
 
-def mean_over_repetitions(outputs: tuple[str, ...], records: list[Mapping[str, Any]]) -> dict[str, tuple[float, float, int]]:
-    """Plain repetition statistics of scalar outputs: {output: (mean, standard error, count)}."""
+def mean_over_repetitions(outputs: tuple[str, ...], records: list[Mapping[str, Any]], *,
+                          deterministic: bool = False) -> dict[str, tuple[float, float, int]]:
+    """Plain repetition statistics of scalar outputs: {output: (mean, standard error, count)}; the standard error
+    of a single value is NaN (unknown) unless the model is `deterministic` (then 0)."""
     import numpy as np
 
     out = {}
@@ -188,7 +190,7 @@ def mean_over_repetitions(outputs: tuple[str, ...], records: list[Mapping[str, A
         values = values[np.isfinite(values)]
         n = values.size
         mean = float(values.mean()) if n else float("nan")
-        se = float(values.std(ddof=1) / np.sqrt(n)) if n >= 2 else 0.0
+        se = float(values.std(ddof=1) / np.sqrt(n)) if n >= 2 else (0.0 if deterministic and n else float("nan"))
         out[name] = (mean, se, n)
     return out
 
@@ -222,7 +224,7 @@ class IshigamiModel:
         return None
 
     def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, tuple[float, float, int]]:
-        return mean_over_repetitions(self.outputs, records)
+        return mean_over_repetitions(self.outputs, records, deterministic=True)
 
     def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, float]:
         x1, x2, x3 = (params[n] for n in self.parameters)
