@@ -166,3 +166,25 @@ def test_one_repetition_says_monotonicity_could_not_be_tested(tmp_path, capsys):
     with open(tmp_path / "o" / "bands.csv", newline="") as fh:
         bands = list(csv.DictReader(fh))
     assert bands and all(r["tested"] == "0" and r["flagged"] == "0" for r in bands)
+
+
+# ---- --resume into another study -----------------------------------------------------------------------------
+
+AB = "[parameters.a]\nnominal = 0.5\nmin = 0.0\nmax = 1.0\n[parameters.b]\nnominal = 0.5\nmin = 0.0\nmax = 1.0\n"
+
+
+def test_resume_refuses_a_folder_of_another_study(tmp_path, capsys):
+    first, second = tmp_path / "first.toml", tmp_path / "second.toml"
+    head = "[study]\nkind = 'interval'\nmodel = 'uq.test_functions:noisy_linear'\nrepetitions = 2\n"
+    first.write_text(head + "seed = 1\n" + AB)
+    second.write_text(head + "seed = 2\n" + AB)  # another seed: other results
+    out = tmp_path / "o"
+    run = ["--out", str(out), "--quiet", "--jobs", "1", "--no-figures"]
+    assert main(["interval", str(first), *run]) == 0
+    before = {p: p.read_bytes() for p in files_in(out) if p.is_file()}
+    capsys.readouterr()
+    refused(capsys, main(["interval", str(second), *run, "--resume"]), "holds the tasks of another study ('first'",
+            "not of 'second'", "choose another --out")
+    assert {p: p.read_bytes() for p in files_in(out) if p.is_file()} == before  # nothing overwritten or added
+    assert main(["interval", str(first), *run, "--resume"]) == 0  # the same study continues
+    assert "(0 run now, " in capsys.readouterr().out

@@ -74,6 +74,19 @@ def _checked_model(study: Study) -> Any:
     return model
 
 
+def study_key(study: Study, model: Any) -> str:
+    """SHA-256 of what defines a study's results: the resolved study (without its output folder and file path)
+    and the model's settings. `--resume` continues a folder only with the same key."""
+    import hashlib
+    import json
+
+    from uq.runner import describe_model
+
+    data = {k: v for k, v in study.to_dict().items() if k not in ("output", "source")}
+    text = json.dumps({"study": data, "model": describe_model(model)}, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, resume: bool, jobs: int,
                 scheduler: str | None, progress: bool, client: Any) -> tuple[Any, StudyResult, dict, int, float]:
     """Connect to the cluster once (if any), then prepare the output folder and run every task of `points`.
@@ -82,7 +95,7 @@ def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, 
     with dask_client(scheduler, client) as client:
         if hasattr(model, "with_rig"):
             model = model.with_rig()
-        folder = prepare_output(out or study.output, resume=resume)
+        folder = prepare_output(out or study.output, resume=resume, study=(study.name, study_key(study, model)))
         t0 = time.perf_counter()
         results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
                                  progress=progress, client=client)

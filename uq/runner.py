@@ -40,7 +40,8 @@ class Task:
         return Task(tuple(sorted((k, float(v)) for k, v in params.items())), float(level), int(rep))
 
 
-def _describe(model: Any) -> Any:
+def describe_model(model: Any) -> Any:
+    """The model's settings as plain data (part of every task key)."""
     if hasattr(model, "describe"):
         return model.describe()
     if is_dataclass(model):
@@ -55,7 +56,7 @@ def task_key(task: Task, model: Any, seed: int, version: str) -> str:
 
 def _keyer(model: Any, seed: int, version: str) -> Callable[[Task], str]:
     """Key function with the study-wide part (model settings, seed, version) hashed once."""
-    common = hashlib.sha256(json.dumps({"seed": seed, "model": _describe(model), "version": version},
+    common = hashlib.sha256(json.dumps({"seed": seed, "model": describe_model(model), "version": version},
                                        sort_keys=True, default=str).encode())
 
     def key(task: Task) -> str:
@@ -103,14 +104,30 @@ def check_writable(folder: str | Path) -> Path:
     return folder
 
 
-def prepare_output(folder: str | Path, *, resume: bool) -> Path:
-    """Create the output folder and check it can be written; refuse to overwrite finished results."""
+#: the file in OUT/tasks naming the study whose tasks the folder holds: its name, then its key
+STUDY_MARK = "STUDY.txt"
+
+
+def prepare_output(folder: str | Path, *, resume: bool, study: tuple[str, str] | None = None) -> Path:
+    """Create the output folder and check it can be written; refuse to overwrite finished results, and refuse
+    `resume` into a folder that holds the tasks of another study. `study`: (name, key) of the study to run
+    (`uq.execute.study_key`), kept in OUT/tasks/STUDY.txt."""
     folder = Path(folder)
-    check_writable(folder / "tasks")
-    if not resume and ResultStore(folder).count():
+    store = ResultStore(folder)
+    if not resume and store.count():
         raise StudyError(f"output folder {folder} already holds task results; pass --resume to continue that study "
                          "or choose another --out")
-    for stale in (folder / "tasks").glob(".*.json"):  # a temporary file of a write cut off by SIGKILL
+    mark = store.folder / STUDY_MARK
+    if resume and study is not None and mark.is_file():
+        name, key = (mark.read_text().splitlines() + ["", ""])[:2]
+        if key != study[1] and store.count():
+            raise StudyError(f"output folder {folder} holds the tasks of another study ('{name}', key {key[:12]}), not "
+                             f"of '{study[0]}' (key {study[1][:12]}); --resume continues only the same study: choose "
+                             "another --out")
+    check_writable(store.folder)
+    if study is not None:
+        write_text(mark, f"{study[0]}\n{study[1]}\n")
+    for stale in store.folder.glob(".*.json"):  # a temporary file of a write cut off by SIGKILL
         stale.unlink(missing_ok=True)
     return folder
 
