@@ -188,3 +188,79 @@ def test_resume_refuses_a_folder_of_another_study(tmp_path, capsys):
     assert {p: p.read_bytes() for p in files_in(out) if p.is_file()} == before  # nothing overwritten or added
     assert main(["interval", str(first), *run, "--resume"]) == 0  # the same study continues
     assert "(0 run now, " in capsys.readouterr().out
+
+
+# ---- a lost Dask scheduler -----------------------------------------------------------------------------------
+
+SLOW_MODEL = '''
+import time
+
+def slow_sum(params, level, rep, seed):
+    time.sleep(0.2)
+    return params["a"] + params["b"] + level
+'''
+
+
+class Cluster:
+    """A Dask scheduler and one single-threaded worker as separate processes (`dask scheduler`, `dask worker`)."""
+
+    def __init__(self, folder: Path, env: dict) -> None:
+        import json
+        import time
+
+        self.file = folder / f"scheduler-{time.monotonic_ns()}.json"
+        run = lambda *args: subprocess.Popen([sys.executable, "-m", *args], cwd=folder, env=env,  # noqa: E731
+                                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.scheduler = run("distributed.cli.dask_scheduler", "--port", "0", "--no-dashboard",
+                             "--scheduler-file", str(self.file))
+        for _ in range(600):
+            if self.file.is_file() and self.file.stat().st_size:
+                break
+            time.sleep(0.1)
+        self.address = json.loads(self.file.read_text())["address"]
+        self.worker = run("distributed.cli.dask_worker", "--scheduler-file", str(self.file), "--nthreads", "1",
+                          "--no-dashboard")
+
+    def stop(self) -> None:
+        for proc in (self.scheduler, self.worker):
+            proc.kill()
+            proc.wait()
+
+
+def test_a_lost_scheduler_is_one_line_and_resume_finishes_the_study(tmp_path):
+    pytest.importorskip("distributed")
+    import os
+    import time
+
+    (tmp_path / "slow_model.py").write_text(SLOW_MODEL)
+    study = tmp_path / "s.toml"
+    study.write_text("[study]\nkind = 'interval'\nmodel = 'slow_model:slow_sum'\nrepetitions = 2\n" + AB +
+                     "[excitation]\nlevels = [1.0, 2.0, 3.0]\n[interval]\ndesigns = ['individual', 'joint']\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), str(Path(__file__).resolve().parents[1])])}
+    out = tmp_path / "o"
+    command = [sys.executable, "-m", "uq", "interval", str(study), "--out", str(out), "--quiet", "--no-figures"]
+    cluster = Cluster(tmp_path, env)
+    try:
+        proc = subprocess.Popen([*command, "--scheduler", cluster.address], cwd=tmp_path, env=env,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        while len(list((out / "tasks").glob("*.json"))) < 5 and proc.poll() is None:
+            time.sleep(0.1)
+        cluster.scheduler.kill()  # the scheduler dies mid-study
+        stdout, stderr = proc.communicate(timeout=120)
+    finally:
+        cluster.stop()
+    assert proc.returncode == 2, stderr
+    assert len(stderr.strip().splitlines()) == 1 and "Traceback" not in stderr, stderr
+    assert stderr.startswith(f"ies interval: error: lost the Dask scheduler {cluster.address} after ") and "--resume" in stderr
+    kept = len(list((out / "tasks").glob("*.json")))
+    assert kept >= 5 and not (out / "bands.csv").exists()
+    cluster = Cluster(tmp_path, env)  # a new cluster; --resume runs only the missing tasks
+    try:
+        done = subprocess.run([*command, "--scheduler", cluster.address, "--resume"], cwd=tmp_path, env=env,
+                              capture_output=True, text=True, timeout=300)
+    finally:
+        cluster.stop()
+    assert done.returncode == 0, done.stderr
+    assert "reused)" in done.stdout and (out / "bands.csv").is_file()
+    tasks = int(done.stdout.split(" runs (")[0].splitlines()[-1])
+    assert f"({tasks - kept} run now, {kept} reused)" in done.stdout
