@@ -360,20 +360,33 @@ def output_folder(path: str | None) -> Iterator[Path | None]:
         raise
 
 
+#: a single sweep shows a progress bar when it simulates more than this (s of simulated time, on a terminal)
+LONG_SWEEP_S = 60.0
+
+
 @contextmanager
-def simulation(args: argparse.Namespace, levels: Sequence[float], *, progress: str | None = None) -> Iterator[tuple]:
+def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str) -> Iterator[tuple]:
     """(--out folder or None, protocol, model, impactor, one `sim.protocol.sweep` result per level) of the
-    options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder;
-    `progress`: the label of a progress bar over the levels (on a terminal), None for none."""
+    options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder.
+    The integrator's kernels are warmed up (compiled on the first run) before one progress bar, `label`, counts
+    the stepped-sine points of every level and repetition (on a terminal; for one level only when it is long)."""
+    import sys
+
     from tqdm import tqdm
 
+    from sim.integrators import warm_up
     from sim.protocol import sweep
 
     protocol = build_protocol(args)
     model, impactor = build_system(args)
+    total = len(levels) * args.reps * len(protocol.legs) * protocol.n_eta
+    long_run = len(levels) > 1 or total * (protocol.wait + protocol.hold) > LONG_SWEEP_S
     with output_folder(args.out) as folder:
-        results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed)
-                   for level in tqdm(levels, desc=progress, unit="level", disable=None if progress else True, leave=False)]
+        warm_up(protocol.integrator)
+        with tqdm(total=total, desc=label, unit="pt", disable=not (long_run and sys.stderr.isatty()), leave=False,
+                  file=sys.stderr, dynamic_ncols=True) as bar:
+            results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed, progress=bar.update)
+                       for level in levels]
         yield folder, protocol, model, impactor, results
 
 
@@ -403,7 +416,7 @@ def sweep_command(args: argparse.Namespace) -> int:
 
     started = time.perf_counter()
     level = check_level(args.level)
-    with simulation(args, [level]) as (folder, protocol, model, impactor, (result,)):
+    with simulation(args, [level], label=f"sweep {level:g}") as (folder, protocol, model, impactor, (result,)):
         data = result.to_dict()
         data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps, model=model.source,
                     impactor=None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
@@ -446,7 +459,7 @@ def overview_command(args: argparse.Namespace) -> int:
 
     started = time.perf_counter()
     levels = parse_levels(args.levels)
-    with simulation(args, levels, progress="overview") as (folder, protocol, model, _, results):
+    with simulation(args, levels, label="overview") as (folder, protocol, model, _, results):
         data = {
             "levels": levels,
             "resonant_mean": [r.resonant_mean for r in results],

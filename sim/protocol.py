@@ -404,10 +404,11 @@ def aggregate_runs(runs: list[SweepRun]) -> SweepResult:
 
 
 def sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *, reps: int,
-          seed: int, nominal: Nominal = Nominal(), progress: bool | None = None) -> SweepResult:
+          seed: int, nominal: Nominal = Nominal(), progress: bool | None | Callable[[], None] = None) -> SweepResult:
     """`reps` runs (rep = 0 .. reps-1) of `run_sweep`, aggregated (Sects. 5.1, 5.2).
 
-    progress: show a tqdm bar on stderr (None: only if stderr is a terminal and the sweep is long).
+    progress: show a tqdm bar on stderr (None: only if stderr is a terminal and the sweep is long), or a
+    callable called after every point (the caller's own progress bar).
     """
     import sys as _sys
 
@@ -419,9 +420,10 @@ def sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: 
     if progress is None:
         progress = _sys.stderr.isatty() and total * (protocol.wait + protocol.hold) > 60.0
     started = time.perf_counter()
-    with tqdm(total=total, disable=not progress, unit="pt", desc=f"sweep {level:g}", leave=False) as bar:
-        runs = [run_sweep(model, impactor, level, protocol, seed=seed, rep=rep, nominal=nominal, progress=bar.update)
-                for rep in range(int(reps))]
+    with tqdm(total=total, disable=callable(progress) or not progress, unit="pt", desc=f"sweep {level:g}",
+              leave=False) as bar:
+        runs = [run_sweep(model, impactor, level, protocol, seed=seed, rep=rep, nominal=nominal,
+                          progress=progress if callable(progress) else bar.update) for rep in range(int(reps))]
     result = aggregate_runs(runs)
     result.wall_time_s = time.perf_counter() - started
     return result

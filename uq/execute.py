@@ -96,6 +96,8 @@ def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, 
         if hasattr(model, "with_rig"):
             model = model.with_rig()
         folder = prepare_output(out or study.output, resume=resume, study=(study.name, study_key(study, model)))
+        if hasattr(model, "warm_up"):
+            model.warm_up()  # compile the kernels before the progress bar (workers load them from the cache)
         t0 = time.perf_counter()
         results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
                                  progress=progress, client=client)

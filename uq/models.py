@@ -119,6 +119,12 @@ class IESModel:
         except SimulationInputError as exc:
             raise StudyError(f"[study] modal_model: {exc}") from None
 
+    def warm_up(self) -> None:
+        """Compile the integrator's kernels in this process (`sim.integrators.warm_up`; minutes on a first run)."""
+        from sim.integrators import warm_up
+
+        warm_up(self._stepped_sine().integrator)
+
     def with_rig(self) -> "IESModel":
         """This model carrying the rig's modal model (built here, used unchanged by every worker)."""
         return self if self.rig is not None else replace(self, rig=self._rig())
