@@ -27,7 +27,8 @@ OVERVIEW_HELP = "resonant response level (largest mean and max over eta) vs exci
 SEQUENCE_CHOICES = ("up", "down", "up-down-up", "up-down-up-down-up")
 SWEEP_COLUMNS = ("eta", "mean", "mean_lo", "mean_hi", "max", "max_lo", "max_hi", "cv", "impacts_per_period", "regime")
 OVERVIEW_COLUMNS = ("level", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "resonant_max", "resonant_max_lo",
-                    "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max", "impacts_per_period", "regime")
+                    "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max", "impacts_per_period", "regime",
+                    "a_base_m", "resonant_mean_se", "resonant_max_se")
 
 
 # ---- ies modes ----------------------------------------------------------------------------------------------
@@ -468,6 +469,9 @@ def overview_command(args: argparse.Namespace) -> int:
             "resonant_mean_hi": [r.resonant_spread("mean")[1] for r in results],
             "resonant_max_lo": [r.resonant_spread("max")[0] for r in results],
             "resonant_max_hi": [r.resonant_spread("max")[1] for r in results],
+            "resonant_mean_se": [r.resonant_spread("mean")[2] for r in results],
+            "resonant_max_se": [r.resonant_spread("max")[2] for r in results],
+            "a_base_m": [r.a_base for r in results],
             "eta_resonant_mean": [r.eta_resonant_mean for r in results],
             "eta_resonant_max": [r.eta_resonant_max for r in results],
             "regime": [r.regime for r in results],

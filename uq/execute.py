@@ -41,12 +41,15 @@ def _tasks(points: Sequence[dict], study: Study) -> list[Task]:
     return [Task.make(p, level, rep) for p in points for level in study.levels for rep in range(study.repetitions)]
 
 
-def statistics(model: Any, results: dict, points: Sequence[dict], study: Study) -> dict[str, tuple[np.ndarray, ...]]:
+def statistics(model: Any, results: dict, points: Sequence[dict],
+               study: Study) -> tuple[dict[str, tuple[np.ndarray, ...]], np.ndarray]:
     """Per output: (value, standard error, samples), arrays (n_points, n_levels), from the model's own
-    aggregation over the repetitions of each point and level; failed runs are left out (NaN if all)."""
+    aggregation over the repetitions of each point and level (failed runs left out, NaN if all), and the regime
+    of each point and level as the model classifies it ("" for models without regimes)."""
     outputs = list(model.outputs)
     shape = (len(points), len(study.levels))
     stats = {o: (np.full(shape, np.nan), np.full(shape, np.nan), np.zeros(shape, dtype=int)) for o in outputs}
+    regimes = np.full(shape, "", dtype=object)
     for i, p in enumerate(points):
         for j, level in enumerate(study.levels):
             records = [results[Task.make(p, level, r)] for r in range(study.repetitions)]
@@ -54,7 +57,13 @@ def statistics(model: Any, results: dict, points: Sequence[dict], study: Study) 
             for o in outputs:
                 for k in range(3):
                     stats[o][k][i, j] = agg[o][k]
-    return stats
+            regimes[i, j] = agg.get("regime", "")
+    return stats, regimes
+
+
+def parameter_columns(space: Any) -> list[str]:
+    """The CSV column of each parameter: its name with its unit, e.g. g_m, k_H_N_per_m1p5 (`Parameter.column`)."""
+    return [p.column for p in space.parameters]
 
 
 def _runs_rows(results: dict, points: Sequence[dict], study: Study, outputs: Sequence[str], names: Sequence[str]):
@@ -105,8 +114,9 @@ def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, 
 
 
 def _metadata(study: Study, model: Any, result: StudyResult, extra: dict) -> Path:
-    meta = {"study": study.to_dict(), "code_version": model.version(), "outputs": list(model.banded_outputs),
-            "warnings": result.warnings, **extra}
+    meta = {"study": {**study.to_dict(), "output": str(result.folder)}, "output_folder": str(result.folder.resolve()),
+            "code_version": model.version(), "outputs": list(model.banded_outputs), "warnings": result.warnings,
+            **extra}
     if hasattr(model, "resolved_protocol"):
         meta["study"]["protocol_resolved"] = model.resolved_protocol()
     path = result.folder / "study.json"
@@ -146,43 +156,81 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
     level_labels = [f"level {lv:g}" for lv in study.levels]
-    stats = statistics(model, results, points, study)
+    stats, regimes = statistics(model, results, points, study)
     n_failed = sum(1 for rec in results.values() if rec["error"])
     if n_failed:
         _warn(result, f"{n_failed} of {len(results)} runs failed (see the 'error' column of runs.csv)")
 
     point_rows, band_rows = [], []
     bands: dict[tuple[str, str], Band] = {}
+    i_nominal = index[nominal.key()]
     for d in [Design("nominal", "box", (nominal,))] + designs:
         rows_idx = [index[p.key()] for p in d.points]
         for o in model.outputs:
             mean, se, n = (a[rows_idx] for a in stats[o])
-            for p, i in zip(d.points, range(len(rows_idx))):
+            for row, (p, i) in enumerate(zip(d.points, rows_idx)):
                 for j, level in enumerate(study.levels):
-                    point_rows.append([d.name, p.label, p.role, *(p.values[k] for k in names), level, o,
-                                       mean[i, j], se[i, j], int(n[i, j])])
+                    point_rows.append([d.name, p.label, p.role, *(p.values[name] for name in names), level, o,
+                                       mean[row, j], se[row, j], int(n[row, j]), regimes[i, j]])
             if d.name == "nominal" or o not in outputs:
                 continue
             bd = _band_with_failures(d, mean, se, study.z, level_labels)
             bands[(d.name, o)] = bd
             for msg in bd.notes:
                 _warn(result, f"{o}: {msg}")
+            lower_se, upper_se = _edge_errors(d, mean, se, bd)
+            nominal_value, nominal_se = stats[o][0][i_nominal], stats[o][1][i_nominal]
+            outside = _nominal_outside(d, study.space.nominal(), nominal_value, nominal_se, bd, lower_se, upper_se,
+                                       study.z)
             for j, level in enumerate(study.levels):
                 band_rows.append([d.name, o, level, bd.lower[j], bd.upper[j], bd.corner_lower[j], bd.corner_upper[j],
-                                  int(bd.flagged[j]), bd.violation[j], int(bd.tested[j])])
-    result.files.append(write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
+                                  int(bd.flagged[j]), bd.violation[j], int(bd.tested[j]), lower_se[j], upper_se[j],
+                                  nominal_value[j], nominal_se[j], outside[j]])
+    columns = parameter_columns(study.space)
+    result.files.append(write_csv(folder / "runs.csv", [*columns, "level", "rep", *model.outputs, "error"],
                                    _runs_rows(results, points, study, model.outputs, names)))
-    result.files.append(write_csv(folder / "points.csv", ["design", "point", "role", *names, "level", "output",
-                                                           "mean", "se", "n_samples"], point_rows))
-    result.files.append(write_csv(folder / "bands.csv", ["design", "output", "level", "lower", "upper",
-                                                          "corner_lower", "corner_upper", "flagged", "violation",
-                                                          "tested"], band_rows))
+    result.files.append(write_csv(folder / "points.csv", ["design", "point", "role", *columns, "level", "output",
+                                                           "mean", "se", "n_samples", "regime"], point_rows))
+    result.files.append(write_csv(folder / "bands.csv", BAND_COLUMNS, band_rows))
     monotone = {f"{d}/{o}": bd.monotone for (d, o), bd in bands.items()}
     untested = [f"{d}/{o}" for (d, o), bd in bands.items() if not bd.fully_tested]
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
                       "wall_time_s": elapsed, "monotone": monotone, "untested": untested, "points": len(points)}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
     return result
+
+
+#: the columns of bands.csv (README, "Output reference")
+BAND_COLUMNS = ("design", "output", "level", "lower", "upper", "corner_lower", "corner_upper", "flagged", "violation",
+                "tested", "lower_se", "upper_se", "nominal", "nominal_se", "nominal_outside")
+
+
+def _edge_errors(design: Design, mean: np.ndarray, se: np.ndarray, bd: Band) -> tuple[np.ndarray, np.ndarray]:
+    """The standard errors of the points that give each level's lower and upper band edge (the corners, or every
+    evaluated point where the band was widened); NaN where the band has no value."""
+    corner = np.array([p.role == "corner" for p in design.points])
+    lower_se, upper_se = np.full(mean.shape[1], np.nan), np.full(mean.shape[1], np.nan)
+    for j in range(mean.shape[1]):
+        candidates = np.isfinite(mean[:, j]) & (corner | bool(bd.flagged[j]))
+        if candidates.any():
+            values = np.where(candidates, mean[:, j], np.nan)
+            lower_se[j], upper_se[j] = se[np.nanargmin(values), j], se[np.nanargmax(values), j]
+    return lower_se, upper_se
+
+
+def _nominal_outside(design: Design, nominal: dict, value: np.ndarray, se: np.ndarray, bd: Band, lower_se: np.ndarray,
+                     upper_se: np.ndarray, z: float) -> np.ndarray:
+    """Per level: 1 where the nominal value lies outside the band by more than z combined standard errors (its own
+    and the edge's), 0 where not or where a standard error is unknown, -1 where the nominal point lies outside the
+    design's parameter box (e.g. the residual band, whose k_H is fixed at its best estimate)."""
+    box = {name: (min(p.values[name] for p in design.points), max(p.values[name] for p in design.points))
+           for name in nominal}
+    if any(not lo <= nominal[name] <= hi for name, (lo, hi) in box.items()):
+        return np.full(value.shape, -1)
+    with np.errstate(invalid="ignore"):
+        below = bd.lower - value > z * np.hypot(se, lower_se)
+        above = value - bd.upper > z * np.hypot(se, upper_se)
+    return (below | above).astype(int)
 
 
 def _band_with_failures(design: Design, mean: np.ndarray, se: np.ndarray, z: float, labels: list[str]) -> Band:
@@ -226,7 +274,7 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
     rows, summary_rows, per_level = [], [], {}
-    stats = statistics(model, results, points, study)
+    stats, _ = statistics(model, results, points, study)
     n_failed = sum(1 for rec in results.values() if rec["error"])
     if n_failed:
         _warn(result, f"{n_failed} of {len(results)} runs failed (see the 'error' column of runs.csv); points "
@@ -245,7 +293,8 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
             summary_rows.append([o, level, res.variance, res.noise_variance, res.noise_share, res.failed_runs,
                                  res.message])
             per_level[f"{o}@{level:g}"] = {"noise_share": res.noise_share, "failed_runs": res.failed_runs}
-    result.files.append(write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
+    result.files.append(write_csv(folder / "runs.csv", [*parameter_columns(study.space), "level", "rep",
+                                                        *model.outputs, "error"],
                                    _runs_rows(results, points, study, model.outputs, names)))
     result.files.append(write_csv(folder / "sobol.csv", ["output", "level", "parameter", "S1", "S1_conf", "ST",
                                                           "ST_conf"], rows))

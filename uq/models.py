@@ -156,7 +156,7 @@ class IESModel:
         """Resonant levels over the repetitions of one (point, level), exactly as `sim.protocol.aggregate_runs`
         (largest repetition-averaged mean / max over eta, Sect. 5.2-5.3), with the standard error of the
         repetition samples at that eta (`SweepResult.resonant_spread`; NaN for a single sample: no noise
-        estimate): {output: (value, standard error, number of samples)}."""
+        estimate): {output: (value, standard error, number of samples)} and "regime": the regime there."""
         import numpy as np
         from sim.protocol import SweepRun, aggregate_runs
 
@@ -168,12 +168,12 @@ class IESModel:
             runs.append(SweepRun(**arrays, level=t["level"], a_base=t["a_base"], a_noabs=t["a_noabs"], seed=t["seed"],
                                  rep=t["rep"], protocol=protocol, impactor=None))
         if not runs:
-            return {name: (float("nan"), float("nan"), 0) for name in self.outputs}
+            return {**{name: (float("nan"), float("nan"), 0) for name in self.outputs}, "regime": ""}
         res = aggregate_runs(runs)
         n = int(res.n_samples)
         return {"mean": (res.resonant_mean, res.resonant_spread("mean")[2], n),
                 "max": (res.resonant_max, res.resonant_spread("max")[2], n),
-                "apr": (1.0 if res.regime == "APR" else 0.0, 0.0, n)}
+                "apr": (1.0 if res.regime == "APR" else 0.0, 0.0, n), "regime": res.regime}
 
 
 _TRACE = ("eta", "eta_actual", "leg", "mean", "max", "min", "std", "impacts_per_period", "hold_periods")

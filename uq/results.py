@@ -20,7 +20,7 @@ class Effect:
     """Change of the resonant level from a parameter's min to its max at one excitation level.
 
     delta: value(max) - value(min) (a / a_noabs*); relative: delta / nominal value; noise: the
-    combined standard error of the two values; regime: "APR" or "SMR" at the nominal point.
+    combined standard error of the two values; regime: the nominal point's regime ("APR", "SMR", "linear").
     """
 
     parameter: str
@@ -37,19 +37,35 @@ def _rows(path: Path) -> list[dict]:
         return list(csv.DictReader(fh))
 
 
+def nominal_regimes(points: list[dict], output: str = "mean") -> dict[float, str]:
+    """{level: regime} of the nominal point in points.csv: the regime where its repetition-averaged resonant level
+    is reached, as the simulator classifies it (`sim.protocol.aggregate_runs`, `sim.measures.classify_regime`:
+    APR, SMR or linear); the one source of every regime label of a study's tables and figures."""
+    return {float(r["level"]): r.get("regime", "") for r in points
+            if r["design"] == "nominal" and r["output"] == output}
+
+
+def parameter_value(row: dict, name: str) -> float:
+    """The value of parameter `name` in a row of runs.csv or points.csv, whose column carries the unit (g_m,
+    k_H_N_per_m1p5, `uq.space.column_name`) or is the bare name (dimensionless parameters)."""
+    if name in row:
+        return float(row[name])
+    (column,) = [c for c in row if c.startswith(f"{name}_")]
+    return float(row[column])
+
+
 def effects(folder: str | Path, output: str = "mean") -> list[Effect]:
     """Effects of the individual variation (designs "individual:NAME") in a study folder."""
     points = _rows(Path(folder) / "points.csv")
     nominal = {float(r["level"]): float(r["mean"]) for r in points if r["design"] == "nominal" and r["output"] == output}
-    regime = {float(r["level"]): ("APR" if float(r["mean"]) >= 0.5 else "SMR")
-              for r in points if r["design"] == "nominal" and r["output"] == "apr"}
+    regime = nominal_regimes(points, output)
     out = []
     designs = sorted({r["design"] for r in points if r["design"].startswith("individual:")})
     for design in designs:
         name = design.split(":", 1)[1]
         rows = [r for r in points if r["design"] == design and r["output"] == output and r["role"] == "corner"]
         for level in sorted({float(r["level"]) for r in rows}):
-            at = sorted((r for r in rows if float(r["level"]) == level), key=lambda r: float(r[name]))
+            at = sorted((r for r in rows if float(r["level"]) == level), key=lambda r: parameter_value(r, name))
             lo, hi = at[0], at[-1]
             delta = float(hi["mean"]) - float(lo["mean"])
             noise = float(np.hypot(float(hi["se"]), float(lo["se"])))

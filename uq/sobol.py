@@ -84,7 +84,8 @@ def sobol_indices(space: ParameterSpace, X: np.ndarray, Y: np.ndarray, *, num_re
 
     Repetitions (columns) are averaged; the noise estimate needs >= 2 finite repetitions per point.
     Alternatively Y is already a repetition statistic (1-D) and `noise` gives the variance of each
-    value due to the repetition scatter (e.g. the squared standard error).
+    value due to the repetition scatter (e.g. the squared standard error; NaN where unknown); 1-D Y without
+    `noise` is a deterministic function's (no noise).
     """
     from SALib.analyze import sobol as sobol_analyzer
 
@@ -114,6 +115,8 @@ def sobol_indices(space: ParameterSpace, X: np.ndarray, Y: np.ndarray, *, num_re
     usable = counts >= 2
     if noise is not None:
         noise_variance = float(np.mean(noise[np.isfinite(noise)])) if np.isfinite(noise).any() else np.nan
+    elif Y.shape[1] == 1:
+        noise_variance = 0.0  # one value per point, no noise given: a deterministic function
     else:
         noise_variance = float(np.mean(s2[usable] / counts[usable])) if usable.any() else np.nan
     if noise is None and not usable.all() and usable.any():

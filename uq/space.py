@@ -38,6 +38,15 @@ TABLE2 = {
 }
 
 
+def column_name(name: str, unit: str) -> str:
+    """A CSV column for a quantity and its unit: ``g`` in ``m`` -> ``g_m``, ``k_H`` in ``N/m^1.5`` ->
+    ``k_H_N_per_m1p5``, a dimensionless quantity (unit "-", "1" or "") keeps its name."""
+    if unit in ("", "-", "1"):
+        return name
+    token = unit.replace("/", "_per_").replace("^", "").replace(".", "p").replace(" ", "_")
+    return f"{name}_{token}"
+
+
 @dataclass(frozen=True)
 class Parameter:
     """One uncertain parameter: nominal value and interval [min, max] in SI units.
@@ -78,6 +87,12 @@ class Parameter:
     def varied(self) -> bool:
         """True when the interval has a positive width."""
         return self.max > self.min
+
+    @property
+    def column(self) -> str:
+        """Its name in CSV headers: the name with the unit in machine-friendly form (g_m, k_H_N_per_m1p5); the
+        bare name for a dimensionless parameter (D)."""
+        return column_name(self.name, self.unit)
 
     def at(self, t: float | np.ndarray) -> float | np.ndarray:
         """Map a unit-interval coordinate t in [0, 1] to the parameter value min + t (max - min)."""
