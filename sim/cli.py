@@ -25,10 +25,6 @@ SWEEP_HELP = "stepped-sine frequency response (mean and max amplitude per eta, s
 OVERVIEW_HELP = "resonant response level (largest mean and max over eta) vs excitation level a_base/a_base* (Fig. 6)"
 
 SEQUENCE_CHOICES = ("up", "down", "up-down-up", "up-down-up-down-up")
-SWEEP_COLUMNS = ("eta", "mean", "mean_lo", "mean_hi", "max", "max_lo", "max_hi", "cv", "impacts_per_period", "regime")
-OVERVIEW_COLUMNS = ("level", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "resonant_max", "resonant_max_lo",
-                    "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max", "impacts_per_period", "regime",
-                    "a_base_m", "resonant_mean_se", "resonant_max_se")
 
 
 # ---- ies modes ----------------------------------------------------------------------------------------------
@@ -411,9 +407,10 @@ def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
 
 def sweep_command(args: argparse.Namespace) -> int:
     """`ies sweep`: one stepped-sine frequency response (Sects. 5.1, 5.2; Fig. 5)."""
-    from sim.figures import plot_sweep
+    from sim.figures import plot_sweep, sweep_title
     from sim.files import dumps, report_written
     from sim.protocol import check_level
+    from sim.tables import SWEEP_COLUMNS, sweep_rows
 
     started = time.perf_counter()
     level = check_level(args.level)
@@ -423,10 +420,9 @@ def sweep_command(args: argparse.Namespace) -> int:
                     impactor=None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
                                                             "k_H_N_per_m1p5": impactor.k_H},
                     D1=float(model.damping_ratios[0]))
-        columns = [result.regime_per_eta if name == "regime" else getattr(result, name) for name in SWEEP_COLUMNS]
-        written = write_results(folder, "sweep", SWEEP_COLUMNS, zip(*columns), data)
+        written = write_results(folder, "sweep", SWEEP_COLUMNS, sweep_rows(result), data)
     if args.plot:
-        plot_sweep(result, args.plot, f"a_base/a_base* = {level:g}, {result.n_samples} samples ({protocol.integrator})")
+        plot_sweep(data, args.plot, sweep_title(data))
         written.append(args.plot)
     if args.json:
         print(dumps(data))
@@ -455,44 +451,24 @@ def add_overview_arguments(parser: argparse.ArgumentParser) -> None:
 
 def overview_command(args: argparse.Namespace) -> int:
     """`ies overview`: the resonant level at each excitation level (Sect. 5.3; Fig. 6)."""
-    from sim.figures import plot_overview
+    from sim.figures import overview_title, plot_overview
     from sim.files import dumps, report_written
+    from sim.tables import OVERVIEW_COLUMNS, overview_data, overview_rows, overview_text
 
     started = time.perf_counter()
     levels = parse_levels(args.levels)
     with simulation(args, levels, label="overview") as (folder, protocol, model, _, results):
-        data = {
-            "levels": levels,
-            "resonant_mean": [r.resonant_mean for r in results],
-            "resonant_max": [r.resonant_max for r in results],
-            "resonant_mean_lo": [r.resonant_spread("mean")[0] for r in results],
-            "resonant_mean_hi": [r.resonant_spread("mean")[1] for r in results],
-            "resonant_max_lo": [r.resonant_spread("max")[0] for r in results],
-            "resonant_max_hi": [r.resonant_spread("max")[1] for r in results],
-            "resonant_mean_se": [r.resonant_spread("mean")[2] for r in results],
-            "resonant_max_se": [r.resonant_spread("max")[2] for r in results],
-            "a_base_m": [r.a_base for r in results],
-            "eta_resonant_mean": [r.eta_resonant_mean for r in results],
-            "eta_resonant_max": [r.eta_resonant_max for r in results],
-            "regime": [r.regime for r in results],
-            "impacts_per_period": [float(r.impacts_per_period[r.eta == r.eta_resonant_mean][0]) for r in results],
-            "sweeps": [r.to_dict() for r in results],
-            "reps": args.reps, "seed": args.seed, "model": model.source,
-            "wall_time_s": time.perf_counter() - started,
-        }
-        columns = [data["levels" if name == "level" else name] for name in OVERVIEW_COLUMNS]
-        written = write_results(folder, "overview", OVERVIEW_COLUMNS, zip(*columns), data)
+        data = {**overview_data(levels, results), "sweeps": [r.to_dict() for r in results], "reps": args.reps,
+                "seed": args.seed, "model": model.source, "wall_time_s": time.perf_counter() - started}
+        written = write_results(folder, "overview", OVERVIEW_COLUMNS, overview_rows(data), data)
     if args.plot:
-        plot_overview(levels, results, args.plot, f"{protocol.sequence}, {args.reps} runs ({protocol.integrator})")
+        plot_overview(data, args.plot, overview_title(data))
         written.append(args.plot)
     if args.json:
         print(dumps(data))
         report_written(written, json_mode=True)
         return 0
-    print(f"{'level':>7} {'res.mean':>9} {'res.max':>9} {'eta(mean)':>9} {'imp/T':>6}  regime")
-    for i, level in enumerate(levels):
-        print(f"{level:7.3f} {data['resonant_mean'][i]:9.4f} {data['resonant_max'][i]:9.4f} "
-              f"{data['eta_resonant_mean'][i]:9.4f} {data['impacts_per_period'][i]:6.2f}  {data['regime'][i]}")
+    print(overview_text(data))
     report_written(written)
     return 0
 

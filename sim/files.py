@@ -138,15 +138,21 @@ def save_figure(fig: Any, path: str | os.PathLike) -> Path:
     return target
 
 
-@contextmanager
-def plot_to(path: str | os.PathLike, figsize: tuple[float, float] = (6.0, 4.0)) -> Iterator[tuple[Any, Any]]:
-    """Yield (figure, axes) of a new matplotlib figure (Agg back end); on success it is saved atomically to
-    `path` (format from the suffix), and it is always closed."""
+def pyplot() -> Any:
+    """matplotlib.pyplot on the Agg back end (files only, no display needed)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    return plt
+
+
+@contextmanager
+def plot_to(path: str | os.PathLike, figsize: tuple[float, float] = (6.0, 4.0)) -> Iterator[tuple[Any, Any]]:
+    """Yield (figure, axes) of a new matplotlib figure (Agg back end); on success it is saved atomically to
+    `path` (format from the suffix), and it is always closed."""
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=figsize)
     try:
         yield fig, ax

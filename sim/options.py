@@ -5,6 +5,7 @@ exit code 2, nothing computed or written. Used by `sim.cli`, `bem_contact.cli` a
 
 * `figure_file`: a figure path whose suffix matplotlib can write (``--plot``); checked up front, so a long
   computation never ends in an unsupported format.
+* `figure_formats`, `level_list`: ``ies plot``'s formats (png,pdf) and levels (5.3,6.7).
 * `positive_int`: counts such as ``--jobs``, ``--reps``, ``--n``.
 * `clearance`, `hertz_constant`: g and k_H (Table 2) as SI numbers or with a unit (`sim.units`), with a warning
   line on stderr for an implausible magnitude.
@@ -35,6 +36,27 @@ def figure_file(text: str) -> str:
         what = f"unsupported figure format {suffix!r}" if suffix else "no file suffix"
         raise argparse.ArgumentTypeError(f"{text!r}: {what}; name the file with one of {', '.join(figure_suffixes())}")
     return text
+
+
+def figure_formats(text: str) -> tuple[str, ...]:
+    """A comma-separated list of figure formats matplotlib can write ("png,pdf" -> (".png", ".pdf"))."""
+    formats = tuple(f".{part.strip().lower().lstrip('.')}" for part in text.split(",") if part.strip())
+    unknown = [f for f in formats if f not in figure_suffixes()]
+    if not formats or unknown:
+        raise argparse.ArgumentTypeError(f"unsupported figure format(s) {', '.join(unknown) or repr(text)}; use "
+                                         f"{', '.join(s.lstrip('.') for s in figure_suffixes())}")
+    return formats
+
+
+def level_list(text: str) -> tuple[float, ...]:
+    """Excitation levels a_base/a_base* as a comma-separated list of positive numbers ("5.3,6.7")."""
+    try:
+        levels = tuple(float(part) for part in text.split(",") if part.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be numbers like 5.3,6.7, got {text!r}") from None
+    if not levels or any(not level > 0 for level in levels):
+        raise argparse.ArgumentTypeError(f"must be positive numbers like 5.3,6.7, got {text!r}")
+    return levels
 
 
 def positive_int(text: str) -> int:
