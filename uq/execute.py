@@ -305,3 +305,42 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                       "wall_time_s": elapsed, "per_level": per_level}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
     return result
+
+
+def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, scheduler: str | None = None,
+                       resume: bool = False, progress: bool = True, client: Any = None) -> StudyResult:
+    """Response study (Figs. 5 and 6): the frequency response of the nominal point at every level (mean and max
+    amplitude per eta with the spread of the runs, Sect. 5.2) and its resonant levels (Sect. 5.3), every
+    stepped-sine run a task of the store (resumable, parallel, on a cluster)."""
+    from sim.tables import OVERVIEW_COLUMNS, SWEEP_COLUMNS, overview_data, overview_rows, sweep_rows
+
+    model = _checked_model(study)
+    point = study.space.nominal()
+    model, result, results, ran, elapsed = _run_points(study, model, [point], out, resume, jobs, scheduler, progress,
+                                                       client)
+    folder = result.folder
+    n_failed = sum(1 for rec in results.values() if rec["error"])
+    if n_failed:
+        _warn(result, f"{n_failed} of {len(results)} runs failed (see the 'error' column of runs.csv)")
+    sweeps, levels = [], []
+    for level in study.levels:
+        records = [results[Task.make(point, level, r)] for r in range(study.repetitions)]
+        sweep = model.sweep_result([rec for rec in records if not rec["error"]])
+        if sweep is None:
+            _warn(result, f"every run failed at level {level:g}; the level is left out")
+            continue
+        sweeps.append(sweep)
+        levels.append(level)
+    if not sweeps:
+        raise StudyError("every run of the response study failed; see runs.csv")
+    overview = overview_data(levels, sweeps)
+    result.files.append(write_csv(folder / "runs.csv", [*parameter_columns(study.space), "level", "rep",
+                                                        *model.outputs, "error"],
+                                   _runs_rows(results, [point], study, model.outputs, study.space.names)))
+    result.files.append(write_csv(folder / "sweeps.csv", ["level", *SWEEP_COLUMNS],
+                                   [[s.level, *row] for s in sweeps for row in sweep_rows(s)]))
+    result.files.append(write_csv(folder / "overview.csv", OVERVIEW_COLUMNS, overview_rows(overview)))
+    result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
+                      "wall_time_s": elapsed, "points": 1}
+    result.files.append(_metadata(study, model, result, {"summary": result.summary, "overview": overview}))
+    return result

@@ -152,11 +152,10 @@ class IESModel:
         return {"mean": own.resonant_mean, "max": own.resonant_max, "apr": 1.0 if own.regime == "APR" else 0.0,
                 "trace": trace}
 
-    def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, tuple[float, float, int]]:
-        """Resonant levels over the repetitions of one (point, level), exactly as `sim.protocol.aggregate_runs`
-        (largest repetition-averaged mean / max over eta, Sect. 5.2-5.3), with the standard error of the
-        repetition samples at that eta (`SweepResult.resonant_spread`; NaN for a single sample: no noise
-        estimate): {output: (value, standard error, number of samples)} and "regime": the regime there."""
+    def sweep_result(self, records: list[Mapping[str, Any]]) -> Any:
+        """The frequency response (`sim.protocol.SweepResult`, Fig. 5) of the runs of one (point, level), rebuilt
+        from their traces and aggregated exactly as `ies sweep` does (`sim.protocol.aggregate_runs`); None
+        without runs."""
         import numpy as np
         from sim.protocol import SweepRun, aggregate_runs
 
@@ -167,9 +166,16 @@ class IESModel:
             arrays = {key: np.asarray(t[key], dtype=int if key in ("leg", "hold_periods") else float) for key in _TRACE}
             runs.append(SweepRun(**arrays, level=t["level"], a_base=t["a_base"], a_noabs=t["a_noabs"], seed=t["seed"],
                                  rep=t["rep"], protocol=protocol, impactor=None))
-        if not runs:
+        return aggregate_runs(runs) if runs else None
+
+    def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, Any]:
+        """Resonant levels over the repetitions of one (point, level), exactly as `sim.protocol.aggregate_runs`
+        (largest repetition-averaged mean / max over eta, Sect. 5.2-5.3), with the standard error of the
+        repetition samples at that eta (`SweepResult.resonant_spread`; NaN for a single sample: no noise
+        estimate): {output: (value, standard error, number of samples)} and "regime": the regime there."""
+        res = self.sweep_result(records)
+        if res is None:
             return {**{name: (float("nan"), float("nan"), 0) for name in self.outputs}, "regime": ""}
-        res = aggregate_runs(runs)
         n = int(res.n_samples)
         return {"mean": (res.resonant_mean, res.resonant_spread("mean")[2], n),
                 "max": (res.resonant_max, res.resonant_spread("max")[2], n),

@@ -4,7 +4,7 @@ Layout (every table and key is optional except where noted; SI units)::
 
     [study]
     name = "fig7"
-    kind = "interval"            # "interval" or "sobol" (required)
+    kind = "interval"            # "interval", "sobol" or "response" (required)
     model = "ies"                # "ies" (the simulator), "ishigami", or "package.module:function"
     modal_model = "rig.toml"     # optional, model "ies": a modal-model file (`ies modes --save`), relative to
                                  # this file, instead of the built-in rig
@@ -43,6 +43,9 @@ Layout (every table and key is optional except where noted; SI units)::
     bootstrap = 200
     confidence = 0.95
 
+    [response]                   # kind "response": the frequency responses and resonant levels of the nominal
+    figures = ["fig5", "fig6"]   # point (the parameters' nominal values) at every level, as Figs. 5 and 6
+
 Unknown tables or keys, unknown parameters, min > max, non-positive bounds and the like are refused with
 a `StudyError` whose one line names the file, the key and the fix.
 """
@@ -59,7 +62,9 @@ from uq.errors import StudyError
 from uq.models import make_model
 from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_H, resolve_value
 
-KINDS = ("interval", "sobol")
+KINDS = ("interval", "sobol", "response")
+#: the figures a response study draws (Figs. 5 and 6 of the seed paper)
+RESPONSE_FIGURES = ("fig5", "fig6")
 DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
     "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output"},
@@ -68,6 +73,7 @@ _KEYS = {
                    "start", "dt_scale"},
     "interval": {"designs", "interior", "z", "fix"},
     "sobol": {"n", "bootstrap", "confidence"},
+    "response": {"figures"},
 }
 _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
 
@@ -94,6 +100,7 @@ class Study:
     confidence: float = 0.95
     source: str = ""
     modal_model: Path | None = None
+    figures: tuple[str, ...] = RESPONSE_FIGURES
 
     def make_model(self) -> Any:
         return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
@@ -108,6 +115,7 @@ class Study:
             "levels": list(self.levels), "protocol": dict(self.protocol), "parameters": self.space.to_dict(),
             "interval": {"designs": list(self.designs), "interior": self.interior, "z": self.z, "fix": dict(self.fix)},
             "sobol": {"n": self.sobol_n, "bootstrap": self.bootstrap, "confidence": self.confidence},
+            "response": {"figures": list(self.figures)},
         }
 
 
@@ -209,9 +217,14 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError(f"[sobol] confidence must lie in (0, 1), got {confidence}")
     if kind == "sobol" and not space.varied:
         raise StudyError("no parameter is varied; give at least one [parameters.NAME] with min < max")
+    figures = data.get("response", {}).get("figures", list(RESPONSE_FIGURES))
+    if not isinstance(figures, list) or not figures or any(f not in RESPONSE_FIGURES for f in figures):
+        raise StudyError(f"[response] figures must be a list from {', '.join(RESPONSE_FIGURES)}, got {figures!r}")
+    if kind == "response" and model_spec != "ies":
+        raise StudyError("a response study runs the simulator: model = \"ies\"")
 
     study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
-                  sobol_n, bootstrap, confidence, source, modal_model)
+                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures))
     model = study.make_model()  # unknown model -> one line now
     if modal_model is not None:
         model.check()  # an unreadable modal file -> one line now
