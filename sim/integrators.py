@@ -50,8 +50,9 @@ def get_integrator(name: str, *, dt_scale: float | None = None) -> RunStep:
     return functools.partial(run_step, dt_scale=float(dt_scale))
 
 
-#: how long compiling the kernels of one integrator takes with a cold cache (`warm_up`): measured on the
-#: 2-core development machine, 75-100 s for "exact" and 20-30 s for "ode3", while other work shared the cores
+#: how long compiling the kernels of one integrator takes with a cold cache (`warm_up`), measured on the 2-core
+#: development machine while other work shared the cores (load average 6-8): "exact" 101 s in a fresh install
+#: (up to 390 s under heavier load), "ode3" 32 s
 COMPILE_MINUTES = {"exact": 2, "ode3": 1}
 #: seconds after which `warm_up` says that it is compiling: loading the cached kernels of "exact" takes 1-3 s
 #: (2.5-3 s measured with the machine's 2 cores shared by four engineers), compiling them minutes

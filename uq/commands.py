@@ -279,17 +279,20 @@ def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list
     from uq.space import K_H_STAR, calibrated_k_H
 
     out = args.out
-    uncertain = [s.kind == "interval" and "k_H" in s.space.names for s in studies]
-    if any(uncertain) and calibration is None and not args.no_calibration:
-        calibration = run_calibration(calibrate, out)
-    if any(uncertain) and calibration is not None:
-        k_cal = calibrated_k_H(calibration)
-        if k_cal < K_H_STAR:
-            raise StudyError(f"the calibrated k_H = {k_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; "
-                             "a crater should stiffen the contact: check the calibration or use --no-calibration")
-        print(f"calibrated k_H = {k_cal:.4g} N/m^1.5 = {k_cal / K_H_STAR:.3f} k_H* (upper bound of k_H)")
-        studies = [with_calibration(s, k_cal) if u else s for s, u in zip(studies, uncertain)]
+    calibrated = False
     for figure, study in zip(figures, studies):
+        if study.kind == "interval" and "k_H" in study.space.names:  # calibrated once, before the first such study
+            if not calibrated and calibration is None and not args.no_calibration:
+                calibration = run_calibration(calibrate, out)
+            if calibration is not None:
+                k_cal = calibrated_k_H(calibration)
+                if k_cal < K_H_STAR:
+                    raise StudyError(f"the calibrated k_H = {k_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; a "
+                                     "crater should stiffen the contact: check the calibration or use --no-calibration")
+                if not calibrated:
+                    print(f"calibrated k_H = {k_cal:.4g} N/m^1.5 = {k_cal / K_H_STAR:.3f} k_H* (upper bound of k_H)")
+                study = with_calibration(study, k_cal)
+            calibrated = True
         folder = out / figure
         print(f"{figure}: {study.source} -> {folder}/")
         run, draw = ((run_response_study, response_figures) if study.kind == "response"
