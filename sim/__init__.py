@@ -3,8 +3,10 @@ the stepped-sine protocol with its measures (seed paper Sects. 3 and 5).
 
 Pipeline: rig geometry / modal file -> sim.rig / sim.modal_file -> modal model -> **sim** (stepped sine,
 per-period amplitudes) -> uq. sim stands alone: it imports no other stage, which is why `sim.files`, the
-one way every stage writes a file, lives here. Its commands `ies modes`, `ies sweep`, `ies overview` live in
-`sim.cli`; independent references for tests in `sim.references`.
+one way every stage writes a file, lives here, with what every stage's command line shares: option types
+(`sim.options`, quantities with units from `sim.units`) and the redrawing of result folders (`sim.redraw`). Its
+commands `ies modes`, `ies sweep`, `ies overview` live in `sim.cli`; independent references for tests in
+`sim.references`.
 
 Public names, each imported from its module on first use, so that `import sim.errors` (done by the `ies`
 front door) stays light (importing all of them takes 0.6-0.8 s more):
@@ -12,6 +14,7 @@ front door) stays light (importing all of them takes 0.6-0.8 s more):
   rig:        seed_rig_model (the built-in Timoshenko beam model of the rig, Appendix A)
   modal_file: load_modal_model, save_modal_model (modes from any FE tool)
   protocol:   SteppedSine, SweepResult, run_sweep, sweep (Sects. 5.1-5.3)
+  tables:     overview_data (the resonant levels per excitation level, Fig. 6)
 """
 from __future__ import annotations
 
@@ -26,6 +29,7 @@ _MODULE_OF = {
     "seed_rig_model": "rig",
     "load_modal_model": "modal_file", "save_modal_model": "modal_file",
     "SteppedSine": "protocol", "SweepResult": "protocol", "run_sweep": "protocol", "sweep": "protocol",
+    "overview_data": "tables",
 }
 __all__ = ["SimulationDiverged", "SimulationInputError", *_MODULE_OF]
 
