@@ -25,6 +25,8 @@ import sys
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from sim.options import figure_file
+
 HELP = "calibrate the Hertzian spring constant k_H by BEM contact on a scanned crater or the flat wall (Sect. 4.1, Eq. 8, Fig. 3)"
 
 SPHERE_RADIUS = 7.92e-3  # m, Sect. 2
@@ -92,7 +94,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     numerics.add_argument("--points", type=int, default=20, help="indentations on the curve (default 20)")
     output = parser.add_argument_group("output")
     output.add_argument("--json", action="store_true", help="print one JSON object (SI units, k_H in N/m^1.5)")
-    output.add_argument("--plot", metavar="FILE", help="write the force-indentation plot (Fig. 3c style; for a scan beside the levelled crater map, Fig. 3b), e.g. k_H.png")
+    output.add_argument("--plot", type=figure_file, metavar="FILE", help="write the force-indentation plot (Fig. 3c style; for a scan beside the levelled crater map, Fig. 3b), e.g. k_H.png")
 
 
 @dataclass(frozen=True)
@@ -338,7 +340,7 @@ def scan_plot(data: dict[str, Any], source: GapSource, path: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """`ies calibrate`: calibrate, plot on request, print the summary (text or JSON)."""
-    from sim.files import dumps
+    from sim.files import dumps, report_written
 
     result, source, E_star = calibrate(args)
     data = summary(result, source, E_star)
@@ -347,6 +349,7 @@ def run(args: argparse.Namespace) -> int:
     elif args.plot:
         plot(data, source.label, args.plot)
     print(dumps(data) if args.json else _text(data, source.label))
+    report_written([args.plot] if args.plot else [], json_mode=args.json)
     return 0
 
 

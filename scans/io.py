@@ -118,9 +118,32 @@ def read_scan(path: str | os.PathLike, units: str = "mm", pixel_size: float | No
     return Scan(vertices * scale, faces, kind, path.name, units)
 
 
+def check_stl(path: Path) -> None:
+    """Refuse a binary STL whose size does not match the triangle count in its header (a truncated download or
+    copy), naming both; an ASCII STL (text starting with ``solid`` and holding ``facet``) is left to the reader.
+
+    Binary STL: an 80-byte header, a uint32 triangle count N, then N records of 50 bytes: 84 + 50 N bytes."""
+    size = path.stat().st_size
+    with open(path, "rb") as fh:
+        head = fh.read(1024)
+    if head.lstrip().lower().startswith(b"solid") and b"facet" in head.lower():
+        return
+    if size < 84:
+        raise ScanError(f"{path.name}: {size} bytes is too short for a binary STL (84-byte header) and it is not an "
+                        "ASCII STL; the file is truncated")
+    n = int(np.frombuffer(head[80:84], dtype="<u4")[0])
+    if size != 84 + 50 * n:
+        whole = (size - 84) // 50
+        raise ScanError(f"{path.name}: truncated or damaged binary STL: its header announces {n} triangles "
+                        f"({84 + 50 * n} bytes) but the file has {size} bytes ({whole} whole triangles); export or "
+                        "copy it again")
+
+
 def _read_mesh(path: Path, file_type: str) -> tuple[np.ndarray, np.ndarray | None, str]:
     import trimesh
 
+    if file_type == "stl":
+        check_stl(path)
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")  # corrupt numbers are caught below, not warned about

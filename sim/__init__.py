@@ -3,8 +3,10 @@ the stepped-sine protocol with its measures (seed paper Sects. 3 and 5).
 
 Pipeline: rig geometry / modal file -> sim.rig / sim.modal_file -> modal model -> **sim** (stepped sine,
 per-period amplitudes) -> uq. sim stands alone: it imports no other stage, which is why `sim.files`, the
-one way every stage writes a file, lives here. Its commands `ies modes`, `ies sweep`, `ies overview` live in
-`sim.cli`; independent references for tests in `sim.references`.
+one way every stage writes a file, lives here, with what every stage's command line shares: option types
+(`sim.options`, quantities with units from `sim.units`) and the redrawing of result folders (`sim.redraw`). Its
+commands `ies modes`, `ies sweep`, `ies overview` live in `sim.cli`; independent references for tests in
+`sim.references`.
 
 Public names, each imported from its module on first use, so that `import sim.errors` (done by the `ies`
 front door) stays light (importing all of them takes 0.6-0.8 s more):
@@ -15,6 +17,7 @@ front door) stays light (importing all of them takes 0.6-0.8 s more):
   signals:    Signal, read_signal, simulated_signal (measured or simulated time signals)
   impacts:    detect_impacts, ImpactDetection (impact detection, Appendix D.1)
   modal_fit:  fit_modes, ModalFit, plot_modal_fit (modal energies between impacts, Eq. 9, Figs. 9b/10b)
+  tables:     overview_data (the resonant levels per excitation level, Fig. 6)
 """
 from __future__ import annotations
 
@@ -32,6 +35,7 @@ _MODULE_OF = {
     "Signal": "signals", "read_signal": "signals", "simulated_signal": "signals",
     "detect_impacts": "impacts", "ImpactDetection": "impacts",
     "fit_modes": "modal_fit", "ModalFit": "modal_fit", "plot_modal_fit": "modal_fit",
+    "overview_data": "tables",
 }
 __all__ = ["SimulationDiverged", "SimulationInputError", *_MODULE_OF]
 

@@ -18,15 +18,13 @@ from pathlib import Path
 from typing import Any, Iterator, Sequence
 
 from sim.errors import SimulationInputError
+from sim.options import clearance, figure_file, hertz_constant, positive_int
 
 MODES_HELP = "modal model of the host structure: frequencies, damping, mode values, participation (built-in rig or file)"
 SWEEP_HELP = "stepped-sine frequency response (mean and max amplitude per eta, spread over repetitions; Fig. 5)"
 OVERVIEW_HELP = "resonant response level (largest mean and max over eta) vs excitation level a_base/a_base* (Fig. 6)"
 
 SEQUENCE_CHOICES = ("up", "down", "up-down-up", "up-down-up-down-up")
-SWEEP_COLUMNS = ("eta", "mean", "mean_lo", "mean_hi", "max", "max_lo", "max_hi", "cv", "impacts_per_period", "regime")
-OVERVIEW_COLUMNS = ("level", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "resonant_max", "resonant_max_lo",
-                    "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max", "impacts_per_period", "regime")
 
 
 # ---- ies modes ----------------------------------------------------------------------------------------------
@@ -180,8 +178,8 @@ def _external_model(args: argparse.Namespace) -> tuple[Any, dict | None, list[st
 def modes_command(args: argparse.Namespace) -> int:
     """`ies modes`: show (and with --save write) the built-in rig's model, a modal-model file, the 3D solid
     model or the modes of a CalculiX job."""
-    from sim.files import dumps
-    from sim.modal_file import load_modal_model, save_modal_model
+    from sim.files import dumps, report_written
+    from sim.modal_file import save_modal_model
 
     rig = provenance = None
     report: list[str] = []
@@ -195,7 +193,7 @@ def modes_command(args: argparse.Namespace) -> int:
     elif args.model:
         if args.variant is not None:
             raise SimulationInputError("--variant selects a built-in rig model; it cannot be used with --model")
-        model = load_modal_model(args.model)
+        model = model_file(args.model)
     else:
         from sim.rig import DEFAULT_VARIANT, rig_modes, seed_rig_model, variant_parameters
 
@@ -208,6 +206,7 @@ def modes_command(args: argparse.Namespace) -> int:
     if args.save:
         data["saved_to"] = str(save_modal_model(model, args.save, provenance))
     print(dumps(data) if args.json else "\n".join([*report, modes_table(data)]))
+    report_written([data["saved_to"]] if args.save else [], json_mode=args.json)
     return 0
 
 
@@ -217,9 +216,11 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
     """Model and impactor options (Table 2 parameters)."""
     parser.add_argument("--model", metavar="FILE", help="modal-model file (default: the built-in model of the seed rig)")
     parser.add_argument("--D", type=float, metavar="D1", help="modal damping ratio of mode 1 (-), default the model's (0.00085)")
-    parser.add_argument("--g", type=float, metavar="M", help="clearance g in m (default 0.58e-3 m)")
-    parser.add_argument("--k-H", dest="k_H", type=float, metavar="N/M^1.5",
-                        help="Hertz constant k_H in N/m^1.5 (default 282e3 N/mm^1.5 = 8.918e9 N/m^1.5)")
+    parser.add_argument("--g", type=clearance, metavar="G",
+                        help="clearance g in m, or with a unit: 0.58mm, 580um (default 0.58 mm)")
+    parser.add_argument("--k-H", dest="k_H", type=hertz_constant, metavar="K_H",
+                        help="Hertz constant k_H in N/m^1.5, or with a unit: 282e3N/mm^1.5 (default 282e3 N/mm^1.5 = "
+                             "8.918e9 N/m^1.5)")
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
 
 
@@ -238,11 +239,16 @@ def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int
     parser.add_argument("--wait", type=float, default=None, metavar="S",
                         help="wait time per frequency in s (default 3, or 15 with --no-impactor, Sect. 5.1)")
     parser.add_argument("--hold", type=float, default=5.0, metavar="S", help="hold time per frequency in s (default 5)")
-    parser.add_argument("--reps", type=int, default=default_reps, metavar="N",
-                        help=f"runs from rest, each with its own random frequency offsets (default {default_reps})")
+    parser.add_argument("--reps", type=positive_int, default=default_reps, metavar="N",
+                        help=f"stepped-sine runs, each from the initial conditions of --start with its own random "
+                             f"perturbation (--perturb) (default {default_reps})")
     parser.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
     parser.add_argument("--perturbation", type=float, default=5e-4, metavar="REL",
-                        help="half-width of the uniform relative frequency offset per point (default 5e-4)")
+                        help="half-width of the uniform random relative frequency offset (default 5e-4)")
+    parser.add_argument("--perturb", default="start", choices=("start", "each-point"),
+                        help="what the offset perturbs: the first wait of each run, every hold at the nominal "
+                             "frequency (default, the paper's Sect. 5.1), or every point, each sample interpolated "
+                             "back onto the grid from the frequencies simulated")
     parser.add_argument("--integrator", default="exact", metavar="NAME",
                         help="time integrator: exact (default; closed-form free flight, located contacts) or ode3 (the paper's fixed step)")
     parser.add_argument("--dt-scale", dest="dt_scale", type=float, default=1.0, metavar="X",
@@ -254,7 +260,8 @@ def add_simulation_arguments(parser: argparse.ArgumentParser, *, default_reps: i
     add_protocol_arguments(parser, default_reps=default_reps)
     add_system_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--plot", metavar="FILE", help=f"write a {figure}-like plot (PNG/PDF by suffix)")
+    parser.add_argument("--plot", type=figure_file, metavar="FILE",
+                        help=f"write a {figure}-like plot (format by suffix: .png, .pdf, .svg, ...)")
     parser.add_argument("--out", metavar="DIR", help=f"write {stem}.csv (data) and {stem}.json (data + metadata)")
 
 
@@ -294,13 +301,23 @@ def parse_levels(text: str) -> list[float]:
     return [check_level(v) for v in values]
 
 
+def model_file(path: str) -> Any:
+    """The modal model of a file (`sim.modal_file`), its source naming the file first: ``file PATH (what the file
+    says it holds)``, so that a saved built-in model is reported as the file it now is."""
+    import dataclasses
+
+    from sim.modal_file import load_modal_model
+
+    model = load_modal_model(path)
+    return dataclasses.replace(model, source=f"file {path} ({model.source})")
+
+
 def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     """(modal model, impactor or None) of the system and impactor options (Eqs. 3-7, Table 2)."""
-    from sim.modal_file import load_modal_model
     from sim.rig import seed_rig_model
     from sim.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor
 
-    model = load_modal_model(args.model) if args.model else seed_rig_model(n_modes=9)
+    model = model_file(args.model) if args.model else seed_rig_model(n_modes=9)
     if args.D is not None:
         model = model.with_damping(args.D)
     clearance = CLEARANCE_NOMINAL if args.g is None else args.g
@@ -316,7 +333,7 @@ def build_protocol(args: argparse.Namespace) -> Any:
     start, stop, n = parse_grid(args.eta, "--eta")
     wait = args.wait if args.wait is not None else (15.0 if args.no_impactor else 3.0)
     return SteppedSine(eta_start=start, eta_stop=stop, n_eta=n, sequence=args.sequence, wait=wait,
-                       hold=args.hold, perturbation=args.perturbation, repetition=args.repetition,
+                       hold=args.hold, perturbation=args.perturbation, perturb=args.perturb, repetition=args.repetition,
                        integrator=args.integrator, dt_scale=args.dt_scale, start=args.start)
 
 
@@ -340,30 +357,43 @@ def output_folder(path: str | None) -> Iterator[Path | None]:
         raise
 
 
+#: a single sweep shows a progress bar when it simulates more than this (s of simulated time, on a terminal)
+LONG_SWEEP_S = 60.0
+
+
 @contextmanager
-def simulation(args: argparse.Namespace, levels: Sequence[float], *, progress: str | None = None) -> Iterator[tuple]:
+def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str) -> Iterator[tuple]:
     """(--out folder or None, protocol, model, impactor, one `sim.protocol.sweep` result per level) of the
-    options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder;
-    `progress`: the label of a progress bar over the levels (on a terminal), None for none."""
+    options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder.
+    The integrator's kernels are warmed up (compiled on the first run) before one progress bar, `label`, counts
+    the stepped-sine points of every level and repetition (on a terminal; for one level only when it is long)."""
+    import sys
+
     from tqdm import tqdm
 
+    from sim.integrators import warm_up
     from sim.protocol import sweep
 
     protocol = build_protocol(args)
     model, impactor = build_system(args)
+    total = len(levels) * args.reps * len(protocol.legs) * protocol.n_eta
+    long_run = len(levels) > 1 or total * (protocol.wait + protocol.hold) > LONG_SWEEP_S
     with output_folder(args.out) as folder:
-        results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed)
-                   for level in tqdm(levels, desc=progress, unit="level", disable=None if progress else True, leave=False)]
+        warm_up(protocol.integrator)
+        with tqdm(total=total, desc=label, unit="pt", disable=not (long_run and sys.stderr.isatty()), leave=False,
+                  file=sys.stderr, dynamic_ncols=True) as bar:
+            results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed, progress=bar.update)
+                       for level in levels]
         yield folder, protocol, model, impactor, results
 
 
-def write_results(folder: Path | None, stem: str, header: Sequence[str], rows: Any, data: dict) -> None:
-    """With --out: the table as STEM.csv (data) and `data` as STEM.json (data + metadata)."""
+def write_results(folder: Path | None, stem: str, header: Sequence[str], rows: Any, data: dict) -> list[Path]:
+    """With --out: the table as STEM.csv (data) and `data` as STEM.json (data + metadata); the paths written."""
     from sim.files import dumps, write_csv, write_text
 
-    if folder is not None:
-        write_csv(folder / f"{stem}.csv", header, rows)
-        write_text(folder / f"{stem}.json", dumps(data) + "\n")
+    if folder is None:
+        return []
+    return [write_csv(folder / f"{stem}.csv", header, rows), write_text(folder / f"{stem}.json", dumps(data) + "\n")]
 
 
 # ---- ies sweep ----------------------------------------------------------------------------------------------
@@ -377,24 +407,26 @@ def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
 
 def sweep_command(args: argparse.Namespace) -> int:
     """`ies sweep`: one stepped-sine frequency response (Sects. 5.1, 5.2; Fig. 5)."""
-    from sim.figures import plot_sweep
-    from sim.files import dumps
+    from sim.figures import plot_sweep, sweep_title
+    from sim.files import dumps, report_written
     from sim.protocol import check_level
+    from sim.tables import SWEEP_COLUMNS, sweep_rows
 
     started = time.perf_counter()
     level = check_level(args.level)
-    with simulation(args, [level]) as (folder, protocol, model, impactor, (result,)):
+    with simulation(args, [level], label=f"sweep {level:g}") as (folder, protocol, model, impactor, (result,)):
         data = result.to_dict()
         data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps, model=model.source,
                     impactor=None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
                                                             "k_H_N_per_m1p5": impactor.k_H},
                     D1=float(model.damping_ratios[0]))
-        columns = [result.regime_per_eta if name == "regime" else getattr(result, name) for name in SWEEP_COLUMNS]
-        write_results(folder, "sweep", SWEEP_COLUMNS, zip(*columns), data)
+        written = write_results(folder, "sweep", SWEEP_COLUMNS, sweep_rows(result), data)
     if args.plot:
-        plot_sweep(result, args.plot, f"a_base/a_base* = {level:g}, {result.n_samples} samples ({protocol.integrator})")
+        plot_sweep(data, args.plot, sweep_title(data))
+        written.append(args.plot)
     if args.json:
         print(dumps(data))
+        report_written(written, json_mode=True)
         return 0
     print(f"# a_base/a_base* = {level:g}: {result.n_runs} runs, {result.n_samples} samples, {protocol.integrator}, "
           f"{data['wall_time_s']:.1f} s")
@@ -404,6 +436,7 @@ def sweep_command(args: argparse.Namespace) -> int:
               f"{result.impacts_per_period[i]:6.2f}  {result.regime_per_eta[i]}")
     print(f"resonant mean {result.resonant_mean:.4f} at eta {result.eta_resonant_mean:.4f} ({result.regime}); "
           f"resonant max {result.resonant_max:.4f} at eta {result.eta_resonant_max:.4f}")
+    report_written(written)
     return 0
 
 
@@ -418,39 +451,25 @@ def add_overview_arguments(parser: argparse.ArgumentParser) -> None:
 
 def overview_command(args: argparse.Namespace) -> int:
     """`ies overview`: the resonant level at each excitation level (Sect. 5.3; Fig. 6)."""
-    from sim.figures import plot_overview
-    from sim.files import dumps
+    from sim.figures import overview_title, plot_overview
+    from sim.files import dumps, report_written
+    from sim.tables import OVERVIEW_COLUMNS, overview_data, overview_rows, overview_text
 
     started = time.perf_counter()
     levels = parse_levels(args.levels)
-    with simulation(args, levels, progress="overview") as (folder, protocol, model, _, results):
-        data = {
-            "levels": levels,
-            "resonant_mean": [r.resonant_mean for r in results],
-            "resonant_max": [r.resonant_max for r in results],
-            "resonant_mean_lo": [float(r.resonant_mean_samples.min()) for r in results],
-            "resonant_mean_hi": [float(r.resonant_mean_samples.max()) for r in results],
-            "resonant_max_lo": [float(r.resonant_max_samples.min()) for r in results],
-            "resonant_max_hi": [float(r.resonant_max_samples.max()) for r in results],
-            "eta_resonant_mean": [r.eta_resonant_mean for r in results],
-            "eta_resonant_max": [r.eta_resonant_max for r in results],
-            "regime": [r.regime for r in results],
-            "impacts_per_period": [float(r.impacts_per_period[r.eta == r.eta_resonant_mean][0]) for r in results],
-            "sweeps": [r.to_dict() for r in results],
-            "reps": args.reps, "seed": args.seed, "model": model.source,
-            "wall_time_s": time.perf_counter() - started,
-        }
-        columns = [data["levels" if name == "level" else name] for name in OVERVIEW_COLUMNS]
-        write_results(folder, "overview", OVERVIEW_COLUMNS, zip(*columns), data)
+    with simulation(args, levels, label="overview") as (folder, protocol, model, _, results):
+        data = {**overview_data(levels, results), "sweeps": [r.to_dict() for r in results], "reps": args.reps,
+                "seed": args.seed, "model": model.source, "wall_time_s": time.perf_counter() - started}
+        written = write_results(folder, "overview", OVERVIEW_COLUMNS, overview_rows(data), data)
     if args.plot:
-        plot_overview(levels, results, args.plot, f"{protocol.sequence}, {args.reps} runs ({protocol.integrator})")
+        plot_overview(data, args.plot, overview_title(data))
+        written.append(args.plot)
     if args.json:
         print(dumps(data))
+        report_written(written, json_mode=True)
         return 0
-    print(f"{'level':>7} {'res.mean':>9} {'res.max':>9} {'eta(mean)':>9} {'imp/T':>6}  regime")
-    for i, level in enumerate(levels):
-        print(f"{level:7.3f} {data['resonant_mean'][i]:9.4f} {data['resonant_max'][i]:9.4f} "
-              f"{data['eta_resonant_mean'][i]:9.4f} {data['impacts_per_period'][i]:6.2f}  {data['regime'][i]}")
+    print(overview_text(data))
+    report_written(written)
     return 0
 
 

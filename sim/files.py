@@ -20,6 +20,7 @@ import json
 import math
 import os
 import secrets
+import sys
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterable, Iterator, Sequence
@@ -121,6 +122,14 @@ def write_csv(path: str | os.PathLike, header: Sequence[str], rows: Iterable[Seq
     return write_text(path, buffer.getvalue())
 
 
+def report_written(paths: Iterable[str | os.PathLike], *, json_mode: bool = False) -> None:
+    """One confirmation line ``wrote PATH`` per file a command wrote: on stdout after a text report, on stderr
+    when stdout carries one JSON object (`json_mode`)."""
+    stream = sys.stderr if json_mode else sys.stdout
+    for path in paths:
+        stream.write(f"wrote {path}\n")
+
+
 def save_figure(fig: Any, path: str | os.PathLike) -> Path:
     """Save a matplotlib figure atomically (format from the file suffix, e.g. .png, .pdf; 150 dpi)."""
     target = Path(path)
@@ -129,15 +138,21 @@ def save_figure(fig: Any, path: str | os.PathLike) -> Path:
     return target
 
 
-@contextmanager
-def plot_to(path: str | os.PathLike, figsize: tuple[float, float] = (6.0, 4.0)) -> Iterator[tuple[Any, Any]]:
-    """Yield (figure, axes) of a new matplotlib figure (Agg back end); on success it is saved atomically to
-    `path` (format from the suffix), and it is always closed."""
+def pyplot() -> Any:
+    """matplotlib.pyplot on the Agg back end (files only, no display needed)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    return plt
+
+
+@contextmanager
+def plot_to(path: str | os.PathLike, figsize: tuple[float, float] = (6.0, 4.0)) -> Iterator[tuple[Any, Any]]:
+    """Yield (figure, axes) of a new matplotlib figure (Agg back end); on success it is saved atomically to
+    `path` (format from the suffix), and it is always closed."""
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=figsize)
     try:
         yield fig, ax

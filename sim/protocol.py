@@ -7,12 +7,22 @@ seconds, both rounded to whole excitation periods (at least one hold period), an
 `sim.measures` over the hold.
 
 Frequencies: eta = Omega / omega_1 (omega_1 of the model = the nominal natural frequency omega*, Sect. 5.2).
-Random perturbation law (Sect. 5.1: "slightly different, randomly perturbed excitation frequencies in
-each stepped sine run"): every visited point k of a run gets its own relative offset,
-``eta_k' = eta_k (1 + e_k)``, e_k ~ Uniform(-perturbation, +perturbation), drawn in execution order from
-``np.random.default_rng([seed, rep])``; nothing else is random. A run is therefore reproducible from
-(seed, rep) alone, in any order and in any process. The default 5e-4 is a quarter of the default grid
-spacing (0.002), so the grid stays monotone.
+Random perturbation (Sect. 5.1: the simulations were repeated "starting at slightly different, randomly
+perturbed excitation frequencies in each stepped sine run"), `SteppedSine.perturb`:
+* ``"start"`` (default, the paper's): each run draws one relative offset e ~ Uniform(-perturbation,
+  +perturbation) and starts with a lead-in of one wait time at eta_0 (1 + e), eta_0 its first grid
+  frequency; then every point waits and holds at its nominal grid frequency. The runs differ by their start
+  only, every point is measured at the frequency it is reported at, and averaging runs does not blur a sharp
+  peak (without the IES the average is the analytic frequency response). The lead-in is a separate phase,
+  not the first point's wait: a hold right after the switch from eta_0 (1 + e) to eta_0 would still carry
+  the switch's transient (up to 8 % of the linear resonant amplitude after a 15 s wait at e = 5e-4).
+* ``"each-point"``: every visited point k gets its own offset, ``eta_k' = eta_k (1 + e_k)``, wait and hold at
+  eta_k'. Each repetition sample is then interpolated linearly in its simulated frequencies (`eta_actual`)
+  onto the nominal grid before the samples are averaged (at the grid's ends the nearest simulated point
+  is taken), so that the average is again reported at the frequency it belongs to.
+The offsets are drawn from ``np.random.default_rng([seed, rep])`` (one per run, or one per visited point in
+execution order); nothing else is random. A run is therefore reproducible from (seed, rep) alone, in any
+order and in any process. The default half-width 5e-4 is a quarter of the default grid spacing (0.002).
 
 Initial conditions (`SteppedSine.start`; the paper says only "homogeneous initial conditions", Sect. 5.1):
 * ``"base-velocity"`` (default): zero *relative* displacements and velocities of the host structure and
@@ -59,6 +69,8 @@ SEQUENCES: dict[str, tuple[str, ...]] = {
     "up-down-up-down-up": ("up", "down", "up", "down", "up"),
 }
 REPETITION_UNITS = ("leg", "run")
+#: How the frequencies of a run are perturbed (module docstring): its start only, or every visited point.
+PERTURB_MODES = ("start", "each-point")
 #: Initial conditions of a run: "rest" = y = 0 at excitation phase 0 (sphere centred, at rest relative to the
 #: base and, as the base velocity is zero there, in the inertial frame); "base-velocity" = homogeneous
 #: initial conditions in relative coordinates under q_base = a_base sin(Omega t), i.e. at the instant of peak
@@ -74,7 +86,8 @@ class SteppedSine:
 
     eta_start, eta_stop, n_eta: the grid of eta = Omega/omega_1 (linspace, start < stop, or n_eta = 1);
     sequence: one of SEQUENCES; wait, hold: s per frequency point (paper: 3 s and 5 s with the IES; 15 s
-    wait without); perturbation: half-width of the uniform relative frequency offset per visited point;
+    wait without); perturbation: half-width of the uniform relative frequency offset; perturb: what it
+    perturbs (PERTURB_MODES: the start of each run, default, or each visited point; module docstring);
     repetition: "leg" or "run" (module docstring); integrator: a name of `sim.integrators`;
     dt_scale: multiple of the paper's ode3 step (ode3 only); start: initial conditions of each run
     (STARTS; default "base-velocity", the reading of the paper's homogeneous initial conditions that
@@ -93,6 +106,7 @@ class SteppedSine:
     integrator: str = "exact"  # exact free flight (sim.exact); "ode3" is the paper's fixed-step scheme
     dt_scale: float = 1.0
     start: str = "base-velocity"
+    perturb: str = "start"
 
     def __post_init__(self) -> None:
         for name in ("eta_start", "eta_stop", "wait", "hold", "perturbation", "dt_scale"):
@@ -113,6 +127,8 @@ class SteppedSine:
             raise SimulationInputError(f"stepped sine: unknown sequence {self.sequence!r}; choose one of {', '.join(SEQUENCES)}")
         if self.repetition not in REPETITION_UNITS:
             raise SimulationInputError(f"stepped sine: repetition must be 'leg' or 'run', got {self.repetition!r}")
+        if self.perturb not in PERTURB_MODES:
+            raise SimulationInputError(f"stepped sine: perturb must be one of {', '.join(PERTURB_MODES)}, got {self.perturb!r}")
         if self.start not in STARTS:
             raise SimulationInputError(f"stepped sine: start must be one of {', '.join(STARTS)}, got {self.start!r}")
         if self.wait < 0:
@@ -185,9 +201,10 @@ class SweepResult:
     spread of Fig. 5); *_std = their standard deviation; cv = average amplitude spread std/mean;
     impacts_per_period = average contact onsets per period; regime per point ('APR', 'SMR', 'linear').
     resonant_mean, resonant_max: largest mean / max over eta (Sect. 5.2, 5.3); eta_resonant_mean/max where
-    they occur; regime: the regime at eta_resonant_mean; resonant_*_samples: the resonant levels of each
-    repetition sample (their spread, for the uncertainty layer); mean/max/cv/impacts_samples: the
-    (n_samples, n_eta) data behind the averages, samples ordered run by run, leg by leg.
+    they occur; regime: the regime at eta_resonant_mean; resonant_*_samples: the repetition samples at
+    eta_resonant_mean / eta_resonant_max, whose average the resonant level is (their range and standard error
+    are its spread: `resonant_spread`); mean/max/cv/impacts_samples: the (n_samples, n_eta) data behind the
+    averages, samples ordered run by run, leg by leg.
     """
 
     eta: np.ndarray
@@ -221,6 +238,15 @@ class SweepResult:
     protocol: SteppedSine
     wall_time_s: float
     extra: dict = field(default_factory=dict)
+
+    def resonant_spread(self, output: str) -> tuple[float, float, float]:
+        """(lo, hi, standard error) of the resonant level `output` ("mean" or "max"): the range of its repetition
+        samples (all taken at its eta, so lo <= level <= hi) and the standard error of their average (NaN for a
+        single sample: no noise estimate)."""
+        samples = self.resonant_mean_samples if output == "mean" else self.resonant_max_samples
+        level = self.resonant_mean if output == "mean" else self.resonant_max
+        se = float(np.std(samples, ddof=1) / np.sqrt(samples.size)) if samples.size >= 2 else math.nan
+        return min(float(samples.min()), level), max(float(samples.max()), level), se  # rounding of the average
 
     def to_dict(self) -> dict:
         """Plain data for JSON (see `sim.files.dumps`)."""
@@ -279,17 +305,25 @@ def run_sweep(model: ModalModel, impactor: Impactor | None, level: float, protoc
     protocol.periods(omega_1 * grid[0] * (1.0 - protocol.perturbation))  # refuse a too short hold up front
 
     rng = np.random.default_rng([seed, rep])
+    each_point = protocol.perturb == "each-point"
+    start_offset = 0.0 if each_point else float(rng.uniform(-protocol.perturbation, protocol.perturbation))
     started = time.perf_counter()
     y = np.zeros(2 * model.n_modes + 2)
     rows: list[tuple] = []
     for leg_index, direction in enumerate(protocol.legs):
         order = grid if direction == "up" else grid[::-1]
-        offsets = rng.uniform(-protocol.perturbation, protocol.perturbation, size=order.size)
+        offsets = (rng.uniform(-protocol.perturbation, protocol.perturbation, size=order.size) if each_point
+                   else np.zeros(order.size))
         for eta, offset in zip(order, offsets):
             eta_actual = float(eta) * (1.0 + float(offset))
             Omega = eta_actual * omega_1
-            if not rows and protocol.start == "base-velocity":
-                y[2 * model.n_modes + 1] = a_base * Omega
+            if not rows:
+                Omega_start = Omega * (1.0 + start_offset)
+                if protocol.start == "base-velocity":
+                    y[2 * model.n_modes + 1] = a_base * Omega_start
+                n_lead_in = protocol.periods(Omega_start)[0] if not each_point else 0
+                if n_lead_in:
+                    run_step(y, n_lead_in, Omega_start, a_base, sys, None)
             n_wait, n_hold = protocol.periods(Omega)
             if n_wait:
                 run_step(y, n_wait, Omega, a_base, sys, None)
@@ -313,12 +347,16 @@ def _samples(run: SweepRun, grid: np.ndarray) -> list[dict[str, np.ndarray]]:
     per_leg = []
     for leg in np.unique(run.leg):
         sel = run.leg == leg
-        idx = np.searchsorted(grid, run.eta[sel])
         sample = {}
-        for key in ("mean", "max", "std", "impacts_per_period", "hold_periods"):
-            arr = np.empty(n)
-            arr[idx] = getattr(run, key)[sel]
-            sample[key] = arr
+        if run.protocol.perturb == "each-point":  # back onto the grid from the frequencies simulated
+            order = np.argsort(run.eta_actual[sel])
+            for key in ("mean", "max", "std", "impacts_per_period", "hold_periods"):
+                sample[key] = np.interp(grid, run.eta_actual[sel][order], getattr(run, key)[sel][order])
+        else:
+            idx = np.searchsorted(grid, run.eta[sel])
+            for key in ("mean", "max", "std", "impacts_per_period", "hold_periods"):
+                sample[key] = np.empty(n)
+                sample[key][idx] = getattr(run, key)[sel]
         per_leg.append(sample)
     if run.protocol.repetition == "leg" or len(per_leg) == 1:
         return per_leg
@@ -359,17 +397,18 @@ def aggregate_runs(runs: list[SweepRun]) -> SweepResult:
         max_std=stack["max"].std(axis=0), cv=cv, impacts_per_period=impacts, regime_per_eta=regimes,
         resonant_mean=float(mean[i_mean]), resonant_max=float(mx[i_max]),
         eta_resonant_mean=float(grid[i_mean]), eta_resonant_max=float(grid[i_max]), regime=regimes[i_mean],
-        resonant_mean_samples=stack["mean"].max(axis=1), resonant_max_samples=stack["max"].max(axis=1),
+        resonant_mean_samples=stack["mean"][:, i_mean], resonant_max_samples=stack["max"][:, i_max],
         mean_samples=stack["mean"], max_samples=stack["max"], cv_samples=cv_samples,
         impacts_samples=stack["impacts_per_period"], n_samples=len(samples), n_runs=len(runs), level=first.level, a_base=first.a_base, a_noabs=first.a_noabs,
         protocol=first.protocol, wall_time_s=float(sum(r.wall_time_s for r in runs)))
 
 
 def sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *, reps: int,
-          seed: int, nominal: Nominal = Nominal(), progress: bool | None = None) -> SweepResult:
+          seed: int, nominal: Nominal = Nominal(), progress: bool | None | Callable[[], None] = None) -> SweepResult:
     """`reps` runs (rep = 0 .. reps-1) of `run_sweep`, aggregated (Sects. 5.1, 5.2).
 
-    progress: show a tqdm bar on stderr (None: only if stderr is a terminal and the sweep is long).
+    progress: show a tqdm bar on stderr (None: only if stderr is a terminal and the sweep is long), or a
+    callable called after every point (the caller's own progress bar).
     """
     import sys as _sys
 
@@ -381,9 +420,10 @@ def sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: 
     if progress is None:
         progress = _sys.stderr.isatty() and total * (protocol.wait + protocol.hold) > 60.0
     started = time.perf_counter()
-    with tqdm(total=total, disable=not progress, unit="pt", desc=f"sweep {level:g}", leave=False) as bar:
-        runs = [run_sweep(model, impactor, level, protocol, seed=seed, rep=rep, nominal=nominal, progress=bar.update)
-                for rep in range(int(reps))]
+    with tqdm(total=total, disable=callable(progress) or not progress, unit="pt", desc=f"sweep {level:g}",
+              leave=False) as bar:
+        runs = [run_sweep(model, impactor, level, protocol, seed=seed, rep=rep, nominal=nominal,
+                          progress=progress if callable(progress) else bar.update) for rep in range(int(reps))]
     result = aggregate_runs(runs)
     result.wall_time_s = time.perf_counter() - started
     return result

@@ -2,8 +2,6 @@
 import subprocess
 import sys
 
-import pytest
-
 from uq.cli import build_parser, main
 
 
@@ -12,9 +10,15 @@ def test_every_subcommand_has_help():
     actions = [a for a in parser._actions if a.dest == "command"]
     assert actions, "no subcommands registered"
     for name in actions[0].choices:
-        with pytest.raises(SystemExit) as exit_info:
-            main([name, "--help"])
-        assert exit_info.value.code == 0
+        assert main([name, "--help"]) == 0
+
+
+def test_version(capsys):
+    from importlib.metadata import version
+
+    assert main(["--version"]) == 0
+    line = capsys.readouterr().out.strip()
+    assert line.startswith(f"ies-workbench {version('ies-workbench')} (simulator code ") and len(line.splitlines()) == 1
 
 
 def test_unknown_command_is_one_line_and_exit_2():

@@ -1,17 +1,18 @@
 """The uncertainty stage: parameter spaces and study files, interval propagation and Sobol' indices of the
-simulated response, cached runs on local processes or a Dask cluster, result tables and figures (seed paper
-Sect. 5.4, Figs. 6-8).
+simulated response, response studies of the nominal point, cached runs on local processes or a Dask cluster,
+result tables and figures (seed paper Sects. 5.2-5.4, Figs. 5-8).
 
 Pipeline: k_H (bem_contact) and modal model (sim) -> **uq** -> bands, indices, figures. uq imports sim; of
 the other stages only the `ies` front door (`uq.cli`) imports them. Its commands `ies interval`, `ies sobol`,
-`ies reproduce` live in `uq.commands`; analytic test functions for studies in `uq.test_functions`.
+`ies response`, `ies reproduce`, `ies plot` live in `uq.commands`; analytic test functions for studies in
+`uq.test_functions`.
 
 Public names, each imported from its module on first use, so that `import uq.errors` stays light
 (importing all of them takes 0.2-0.3 s more), as in the other stages:
   study:   Study, load_study (study files; all keys in its docstring)
   space:   Parameter, ParameterSpace, table2_space (Table 2)
-  execute: run_interval_study, run_sobol_study -> StudyResult
-  figures: interval_figures, sobol_figure (Figs. 6-8)
+  execute: run_interval_study, run_sobol_study, run_response_study -> StudyResult
+  figures: interval_figures, sobol_figure, response_figures (Figs. 5-8)
 """
 from __future__ import annotations
 
@@ -23,8 +24,9 @@ from uq.errors import StudyError
 _MODULE_OF = {
     "Study": "study", "load_study": "study",
     "Parameter": "space", "ParameterSpace": "space", "table2_space": "space",
-    "run_interval_study": "execute", "run_sobol_study": "execute", "StudyResult": "execute",
-    "interval_figures": "figures", "sobol_figure": "figures",
+    "run_interval_study": "execute", "run_sobol_study": "execute", "run_response_study": "execute",
+    "StudyResult": "execute",
+    "interval_figures": "figures", "sobol_figure": "figures", "response_figures": "figures",
 }
 __all__ = ["StudyError", *_MODULE_OF]
 

@@ -48,6 +48,8 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     """Parser with the subcommands of every stage in `STAGES`."""
     parser = _Parser(prog="ies", description="Impact Energy Scatterer workbench: contact, simulation, uncertainty.")
+    parser.add_argument("--version", action="version", version=version_line(),
+                        help="print the version and the simulator's code version, then exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for module, handed in STAGES:
@@ -55,10 +57,27 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def version_line() -> str:
+    """``ies-workbench VERSION (simulator code HASH)``: the installed distribution's version and the hash of the
+    simulator's source (the code version in every study's task keys, `uq.models`)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    from uq.models import IESModel
+
+    try:
+        installed = version("ies-workbench")
+    except PackageNotFoundError:
+        installed = "(not installed)"
+    return f"ies-workbench {installed} (simulator code {IESModel().version()})"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run `ies` with `argv` (default: the process arguments) and return the exit code."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version (0) or a refused option (2, its line already written)
+        return int(exc.code or 0)
     prog = f"ies {args.command}"
     try:
         return int(args._run(args) or 0)

@@ -1,15 +1,19 @@
-"""The uncertainty stage's words of the `ies` command line: `interval`, `sobol`, `reproduce` (seed paper
-Sect. 5.4, Figs. 7 and 8).
+"""The uncertainty stage's words of the `ies` command line: `interval`, `sobol`, `response`, `reproduce`
+(seed paper Sects. 5.2-5.4, Figs. 5-8) and `plot`.
 
 * `ies interval STUDY.toml`: interval (vertex) bands of the resonant response, Figs. 7 and 8.
 * `ies sobol STUDY.toml [--n N]`: Sobol' indices (S1, ST) of the resonant response levels.
-* `ies reproduce fig7|fig8|all [--quick] [--out DIR]`: the paper's uncertainty studies, run from the shipped
-  study files (uq/studies/fig7.toml, fig8.toml, or their -quick variants) into DIR/fig7 and DIR/fig8.
-  Before that it calibrates k_H on the shipped crater (the calibration `ies calibrate --json` prints, kept in
-  DIR/calibration.json) and uses the calibrated k_H as the upper bound of k_H, as the paper does with its BEM
-  result 1.52 k_H* (Sect. 4.1); the best estimate stays 1.25 k_H* unless the calibration falls below it (then
-  the midpoint of k_H* and the calibrated value). A failed calibration is one warning line, and Table 2's
-  bounds are kept.
+* `ies response STUDY.toml`: the nominal point's frequency responses and resonant levels over the excitation
+  levels through the task store (resumable, parallel, on a cluster), Figs. 5 and 6.
+* `ies reproduce fig5|fig6|fig7|fig8|all [--quick] [--out DIR]`: the paper's figures, run from the shipped
+  study files (uq/studies/fig5.toml ... fig8.toml, or their -quick variants) into DIR/fig5 ... DIR/fig8.
+  Before Figs. 7 and 8 it calibrates k_H on the shipped crater (the calibration `ies calibrate --json` prints,
+  kept in DIR/calibration.json) and uses the calibrated k_H as the upper bound of k_H, as the paper does with
+  its BEM result 1.52 k_H* (Sect. 4.1); the best estimate stays 1.25 k_H* unless the calibration falls below
+  it (then the midpoint of k_H* and the calibrated value). A failed calibration is one warning line, and
+  Table 2's bounds are kept.
+* `ies plot DIR`: redraw the figures of a result folder from its data (`sim.redraw`), in other formats, another
+  matplotlib style or for a subset of the levels, without recomputing.
 
 `add_commands(subparsers, calibrate=...)` registers them with the front door (`uq.cli`), which hands over
 the calibration as a callable: this stage never imports the contact stage itself. Heavy imports stay
@@ -25,21 +29,30 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, Callable
 
+from sim.options import figure_formats, level_list, positive_int
+
 #: the calibration `ies reproduce` runs: no arguments, returns the JSON object of `ies calibrate --json`
 Calibrate = Callable[[], dict]
 
 INTERVAL_HELP = "interval bands of the resonant response level for D, g, k_H (paper Sect. 5.4, Figs. 7-8)"
 SOBOL_HELP = "Sobol' sensitivity indices of the resonant response level per excitation level (SALib)"
-REPRODUCE_HELP = "reproduce the paper's Figs. 7 and 8 (uncertainty of D, g, k_H) with the shipped studies"
+RESPONSE_HELP = ("frequency responses and resonant levels of the nominal point over the excitation levels, run as a "
+                 "resumable study (paper Sects. 5.2-5.3, Figs. 5-6)")
+REPRODUCE_HELP = "reproduce the paper's Figs. 5 and 6 (nominal response) and 7 and 8 (uncertainty of D, g, k_H)"
+PLOT_HELP = "redraw a result folder's figures from its saved data (formats, style, levels) without recomputing"
+#: the paper's figures that `ies reproduce` runs, in the order of `all`
+FIGURES = ("fig5", "fig6", "fig7", "fig8")
 
 
 def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
-    """Register `interval`, `sobol` and `reproduce` on the front door's subparsers (argparse); `calibrate` is
-    the calibration `reproduce` runs unless told otherwise."""
+    """Register `interval`, `sobol`, `response`, `reproduce` and `plot` on the front door's subparsers (argparse);
+    `calibrate` is the calibration `reproduce` runs unless told otherwise."""
     reproduce = functools.partial(reproduce_command, calibrate=calibrate)
     for name, help_text, add_arguments, run in (("interval", INTERVAL_HELP, add_interval_arguments, interval_command),
                                                 ("sobol", SOBOL_HELP, add_sobol_arguments, sobol_command),
-                                                ("reproduce", REPRODUCE_HELP, add_reproduce_arguments, reproduce)):
+                                                ("response", RESPONSE_HELP, add_response_arguments, response_command),
+                                                ("reproduce", REPRODUCE_HELP, add_reproduce_arguments, reproduce),
+                                                ("plot", PLOT_HELP, add_plot_arguments, plot_command)):
         parser = subparsers.add_parser(name, help=help_text, description=help_text)
         add_arguments(parser)
         parser.set_defaults(_run=run)
@@ -50,7 +63,7 @@ def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
 def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     """--out, --jobs, --scheduler, --resume, --no-figures, --quiet."""
     parser.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: the study's [study] output)")
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, metavar="N",
+    parser.add_argument("--jobs", type=positive_int, default=os.cpu_count() or 1, metavar="N",
                         help="local worker processes (default: the number of CPU cores; 1 runs in this process)")
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="run on a Dask cluster, e.g. tcp://host:8786 (needs dask.distributed)")
@@ -69,12 +82,18 @@ def add_interval_arguments(parser: argparse.ArgumentParser) -> None:
 def add_sobol_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies sobol`."""
     parser.add_argument("study", type=Path, metavar="STUDY.toml", help="study file ([study] kind = \"sobol\")")
-    parser.add_argument("--n", type=int, metavar="N", help="base sample size, a power of two (default: [sobol] n)")
+    parser.add_argument("--n", type=positive_int, metavar="N", help="base sample size, a power of two (default: [sobol] n)")
+    add_run_arguments(parser)
+
+
+def add_response_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies response`."""
+    parser.add_argument("study", type=Path, metavar="STUDY.toml", help="study file ([study] kind = \"response\")")
     add_run_arguments(parser)
 
 
 def interval_command(args: argparse.Namespace) -> int:
-    """`ies interval`: the study's interval bands (Sect. 5.4), then Figs. 6-8."""
+    """`ies interval`: the study's interval bands (Sect. 5.4), then Figs. 7-8; prints the bands."""
     from uq.execute import run_interval_study
     from uq.figures import interval_figures
 
@@ -82,23 +101,39 @@ def interval_command(args: argparse.Namespace) -> int:
     result = run_interval_study(study, out=args.out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
                                 progress=not args.quiet)
     _report(result, [] if args.no_figures else interval_figures(result.folder))
+    print_interval_result(result.folder, result.summary, study.name)
     return 0
 
 
 def sobol_command(args: argparse.Namespace) -> int:
-    """`ies sobol`: the study's Sobol' indices (SALib), then their figure."""
+    """`ies sobol`: the study's Sobol' indices (SALib), then their figure; prints the indices and the noise."""
     from uq.execute import run_sobol_study
     from uq.figures import sobol_figure
+    from uq.results import sobol_table
 
     study = _load_study(args.study, "sobol")
     result = run_sobol_study(study, out=args.out, n=args.n, jobs=args.jobs, scheduler=args.scheduler,
                              resume=args.resume, progress=not args.quiet)
     _report(result, [] if args.no_figures else sobol_figure(result.folder))
+    print(sobol_table(result.folder))
+    return 0
+
+
+def response_command(args: argparse.Namespace) -> int:
+    """`ies response`: the study's frequency responses and resonant levels (Sects. 5.2-5.3), then Figs. 5-6."""
+    from uq.execute import run_response_study
+    from uq.figures import response_figures
+
+    study = _load_study(args.study, "response")
+    result = run_response_study(study, out=args.out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
+                                progress=not args.quiet)
+    _report(result, [] if args.no_figures else response_figures(result.folder))
+    print_response_result(result.folder, study.name)
     return 0
 
 
 def _load_study(path: Path, kind: str) -> Any:
-    """The study file, refused (one line) when it is of the other kind."""
+    """The study file, refused (one line) when it is of another kind."""
     from uq.errors import StudyError
     from uq.study import load_study
 
@@ -109,7 +144,7 @@ def _load_study(path: Path, kind: str) -> Any:
 
 
 def _report(result: Any, figures: list[Path]) -> None:
-    """Short human summary on stdout."""
+    """Where the results are, and how many runs took how long, on stdout."""
     print(f"results in {result.folder}/")
     for path in [*result.files, *figures]:
         print(f"  {path.name}")
@@ -120,16 +155,44 @@ def _report(result: Any, figures: list[Path]) -> None:
         print(f"{len(result.warnings)} warning(s), listed in study.json", file=sys.stderr)
 
 
+def print_interval_result(folder: Path, summary: dict, name: str) -> None:
+    """The bands with their noise and checks, and for an individual variation the trends (Figs. 7, 8)."""
+    from uq.results import band_table, influence_line, trend_table
+
+    for key in summary["untested"]:
+        print(f"{name}: monotonicity could not be tested for {key} (one repetition: no noise estimate)")
+    if any(key.startswith("individual:") for key in summary["monotone"]):
+        print(f"{name}: change of the resonant level from each parameter's min to its max:")
+        print(trend_table(folder))
+        print(f"{name}: {influence_line(folder)}")
+    print(f"{name}: bands (lower, nominal, upper +- standard error) and their checks:")
+    print(band_table(folder))
+
+
+def print_response_result(folder: Path, name: str) -> None:
+    """The resonant levels per excitation level and the optimum (Fig. 6)."""
+    import json
+
+    from sim.tables import optimum_line, overview_text
+
+    overview = json.loads((folder / "study.json").read_text())["overview"]
+    print(f"{name}: resonant levels (a / a_noabs*) of the nominal point:")
+    print(overview_text(overview))
+    print(f"{name}: {optimum_line(overview)}")
+
+
 # ---- ies reproduce ------------------------------------------------------------------------------------------
 
 def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies reproduce`."""
-    parser.add_argument("figure", choices=("fig7", "fig8", "all"), help="which figure(s)")
+    parser.add_argument("figure", choices=(*FIGURES, "all"),
+                        help="which figure(s): fig5 (frequency responses), fig6 (resonant level vs excitation level), "
+                             "fig7 and fig8 (uncertainty of D, g, k_H), all")
     parser.add_argument("--quick", action="store_true",
                         help="reduced protocol (fewer levels, frequencies, repetitions, shorter holds); same trends")
     parser.add_argument("--out", type=Path, default=Path("ies-out/reproduce"), metavar="DIR",
                         help="output folder (default ies-out/reproduce)")
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, metavar="N",
+    parser.add_argument("--jobs", type=positive_int, default=os.cpu_count() or 1, metavar="N",
                         help="local worker processes (default: the number of CPU cores)")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://host:8786")
     parser.add_argument("--resume", action="store_true", help="continue an interrupted reproduction in --out")
@@ -184,12 +247,13 @@ def with_calibration(study: Any, k_H_cal: float) -> Any:
 
 
 def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
-    """`ies reproduce`: check every study first, connect to the cluster once, then calibrate (with
+    """`ies reproduce`: check every study first, connect to the cluster once, then calibrate (for Figs. 7-8, with
     `calibrate` unless --calibration FILE or --no-calibration) and run."""
     from uq.runner import check_writable, dask_client
+    from uq.space import calibrated_k_H
     from uq.study import load_study
 
-    figures = ("fig7", "fig8") if args.figure == "all" else (args.figure,)
+    figures = FIGURES if args.figure == "all" else (args.figure,)
     studies = [load_study(study_file(f, args.quick)) for f in figures]
     if args.integrator:
         studies = [replace(s, protocol={**s.protocol, "integrator": args.integrator}) for s in studies]
@@ -197,50 +261,83 @@ def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
         studies = [replace(s, modal_model=args.model) for s in studies]
     for s in studies:
         s.make_model().check()  # bad settings (e.g. an unknown integrator) fail here, before anything is written
+    calibration = None
+    if args.calibration is not None:  # a bad file fails here too
+        calibration = {"k_H": calibrated_k_H(args.calibration), "source": str(args.calibration)}
     with dask_client(args.scheduler) as client:  # connected once, first: a bad address leaves nothing behind
         check_writable(args.out)
-        return _reproduce(args, figures, studies, client, calibrate)
+        return _reproduce(args, figures, studies, client, calibrate, calibration)
 
 
 def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list, client: Any,
-               calibrate: Calibrate) -> int:
-    """Calibration (unless disabled), then each figure's interval study, its figures and its summary."""
+               calibrate: Calibrate, calibration: dict | None) -> int:
+    """Calibration (the given one, or run unless disabled) when an interval study needs it, then each figure's
+    study, its figures and its summary."""
     from uq.errors import StudyError
-    from uq.execute import run_interval_study
-    from uq.figures import interval_figures
-    from uq.results import band_table, influence_line, trend_table
+    from uq.execute import run_interval_study, run_response_study
+    from uq.figures import interval_figures, response_figures
     from uq.space import K_H_STAR, calibrated_k_H
 
     out = args.out
-    calibration = None
-    if args.calibration is not None:
-        calibration = {"k_H": calibrated_k_H(args.calibration), "source": str(args.calibration)}
-    elif not args.no_calibration:
-        calibration = run_calibration(calibrate, out)
-    if calibration is not None:
-        k_cal = calibrated_k_H(calibration)
-        if k_cal < K_H_STAR:
-            raise StudyError(f"the calibrated k_H = {k_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; "
-                             "a crater should stiffen the contact: check the calibration or use --no-calibration")
-        print(f"calibrated k_H = {k_cal:.4g} N/m^1.5 = {k_cal / K_H_STAR:.3f} k_H* (upper bound of k_H)")
-        studies = [with_calibration(s, k_cal) for s in studies]
+    calibrated = False
     for figure, study in zip(figures, studies):
+        if study.kind == "interval" and "k_H" in study.space.names:  # calibrated once, before the first such study
+            if not calibrated and calibration is None and not args.no_calibration:
+                calibration = run_calibration(calibrate, out)
+            if calibration is not None:
+                k_cal = calibrated_k_H(calibration)
+                if k_cal < K_H_STAR:
+                    raise StudyError(f"the calibrated k_H = {k_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; a "
+                                     "crater should stiffen the contact: check the calibration or use --no-calibration")
+                if not calibrated:
+                    print(f"calibrated k_H = {k_cal:.4g} N/m^1.5 = {k_cal / K_H_STAR:.3f} k_H* (upper bound of k_H)")
+                study = with_calibration(study, k_cal)
+            calibrated = True
         folder = out / figure
         print(f"{figure}: {study.source} -> {folder}/")
-        result = run_interval_study(study, out=folder, jobs=args.jobs, client=client, resume=args.resume,
-                                    progress=not args.quiet)
-        paths = interval_figures(result.folder)
+        run, draw = ((run_response_study, response_figures) if study.kind == "response"
+                     else (run_interval_study, interval_figures))
+        result = run(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet)
+        paths = draw(result.folder)
         s = result.summary
         print(f"{figure}: {s['tasks']} runs ({s['ran']} run now), {s['failed_runs']} failed, "
               f"{s['wall_time_s']:.1f} s; figures: {', '.join(p.name for p in paths)}")
-        for key, ok in s["monotone"].items():
-            if not ok:
-                print(f"{figure}: monotonicity check failed for {key} (band widened; see study.json)")
-        if any(d == "individual" for d in study.designs):
-            print(f"{figure}: change of the mean resonant level from each parameter's min to its max:")
-            print(trend_table(folder))
-            print(f"{figure}: {influence_line(folder)}")
+        if study.kind == "response":
+            print_response_result(folder, figure)
         else:
-            print(f"{figure}: bands of the mean resonant level (a / a_noabs*):")
-            print(band_table(folder))
+            print_interval_result(folder, s, figure)
+    return 0
+
+
+# ---- ies plot -----------------------------------------------------------------------------------------------
+
+def add_plot_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies plot`."""
+    parser.add_argument("folder", type=Path, metavar="DIR",
+                        help="a result folder: --out of ies sweep, overview, interval, sobol, response or reproduce")
+    parser.add_argument("--format", dest="formats", type=figure_formats, default=(".png", ".pdf"), metavar="F1,F2",
+                        help="figure formats, e.g. png,pdf,svg (default png,pdf)")
+    parser.add_argument("--style", metavar="NAME|FILE",
+                        help="a matplotlib style (e.g. seaborn-v0_8-paper, grayscale) or a .mplstyle file")
+    parser.add_argument("--levels", type=level_list, metavar="L1,L2,..",
+                        help="draw only these excitation levels a_base/a_base* (default: all)")
+    parser.add_argument("--out", type=Path, metavar="DIR", help="write the figures here (default: into DIR itself)")
+
+
+def plot_command(args: argparse.Namespace) -> int:
+    """`ies plot`: redraw the figures of a result folder from its data files (`sim.redraw`)."""
+    import sim.figures  # noqa: F401 - registers ies sweep's and ies overview's folders
+    import uq.figures  # noqa: F401 - registers the study folders
+    from sim.errors import SimulationInputError
+    from sim.files import report_written
+    from sim.redraw import PlotOptions, kind_of, redraw, style
+
+    kind_of(args.folder)  # what it is and whether the style exists, before any folder is made
+    style(args.style)
+    if args.out is not None:
+        if args.out.exists() and not args.out.is_dir():
+            raise SimulationInputError(f"--out {args.out} exists and is not a folder; choose another path")
+        args.out.mkdir(parents=True, exist_ok=True)
+    paths = redraw(args.folder, PlotOptions(args.formats, args.style, args.levels, args.out))
+    report_written(paths)
     return 0

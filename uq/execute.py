@@ -41,12 +41,15 @@ def _tasks(points: Sequence[dict], study: Study) -> list[Task]:
     return [Task.make(p, level, rep) for p in points for level in study.levels for rep in range(study.repetitions)]
 
 
-def statistics(model: Any, results: dict, points: Sequence[dict], study: Study) -> dict[str, tuple[np.ndarray, ...]]:
+def statistics(model: Any, results: dict, points: Sequence[dict],
+               study: Study) -> tuple[dict[str, tuple[np.ndarray, ...]], np.ndarray]:
     """Per output: (value, standard error, samples), arrays (n_points, n_levels), from the model's own
-    aggregation over the repetitions of each point and level; failed runs are left out (NaN if all)."""
+    aggregation over the repetitions of each point and level (failed runs left out, NaN if all), and the regime
+    of each point and level as the model classifies it ("" for models without regimes)."""
     outputs = list(model.outputs)
     shape = (len(points), len(study.levels))
     stats = {o: (np.full(shape, np.nan), np.full(shape, np.nan), np.zeros(shape, dtype=int)) for o in outputs}
+    regimes = np.full(shape, "", dtype=object)
     for i, p in enumerate(points):
         for j, level in enumerate(study.levels):
             records = [results[Task.make(p, level, r)] for r in range(study.repetitions)]
@@ -54,7 +57,13 @@ def statistics(model: Any, results: dict, points: Sequence[dict], study: Study) 
             for o in outputs:
                 for k in range(3):
                     stats[o][k][i, j] = agg[o][k]
-    return stats
+            regimes[i, j] = agg.get("regime", "")
+    return stats, regimes
+
+
+def parameter_columns(space: Any) -> list[str]:
+    """The CSV column of each parameter: its name with its unit, e.g. g_m, k_H_N_per_m1p5 (`Parameter.column`)."""
+    return [p.column for p in space.parameters]
 
 
 def _runs_rows(results: dict, points: Sequence[dict], study: Study, outputs: Sequence[str], names: Sequence[str]):
@@ -74,6 +83,19 @@ def _checked_model(study: Study) -> Any:
     return model
 
 
+def study_key(study: Study, model: Any) -> str:
+    """SHA-256 of what defines a study's results: the resolved study (without its output folder and file path)
+    and the model's settings. `--resume` continues a folder only with the same key."""
+    import hashlib
+    import json
+
+    from uq.runner import describe_model
+
+    data = {k: v for k, v in study.to_dict().items() if k not in ("output", "source")}
+    text = json.dumps({"study": data, "model": describe_model(model)}, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, resume: bool, jobs: int,
                 scheduler: str | None, progress: bool, client: Any) -> tuple[Any, StudyResult, dict, int, float]:
     """Connect to the cluster once (if any), then prepare the output folder and run every task of `points`.
@@ -82,7 +104,9 @@ def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, 
     with dask_client(scheduler, client) as client:
         if hasattr(model, "with_rig"):
             model = model.with_rig()
-        folder = prepare_output(out or study.output, resume=resume)
+        folder = prepare_output(out or study.output, resume=resume, study=(study.name, study_key(study, model)))
+        if hasattr(model, "warm_up"):
+            model.warm_up()  # compile the kernels before the progress bar (workers load them from the cache)
         t0 = time.perf_counter()
         results, ran = run_tasks(model, _tasks(points, study), study.seed, ResultStore(folder), jobs=jobs,
                                  progress=progress, client=client)
@@ -90,8 +114,9 @@ def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, 
 
 
 def _metadata(study: Study, model: Any, result: StudyResult, extra: dict) -> Path:
-    meta = {"study": study.to_dict(), "code_version": model.version(), "outputs": list(model.banded_outputs),
-            "warnings": result.warnings, **extra}
+    meta = {"study": {**study.to_dict(), "output": str(result.folder)}, "output_folder": str(result.folder.resolve()),
+            "code_version": model.version(), "outputs": list(model.banded_outputs), "warnings": result.warnings,
+            **extra}
     if hasattr(model, "resolved_protocol"):
         meta["study"]["protocol_resolved"] = model.resolved_protocol()
     path = result.folder / "study.json"
@@ -131,42 +156,81 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
     level_labels = [f"level {lv:g}" for lv in study.levels]
-    stats = statistics(model, results, points, study)
+    stats, regimes = statistics(model, results, points, study)
     n_failed = sum(1 for rec in results.values() if rec["error"])
     if n_failed:
         _warn(result, f"{n_failed} of {len(results)} runs failed (see the 'error' column of runs.csv)")
 
     point_rows, band_rows = [], []
     bands: dict[tuple[str, str], Band] = {}
+    i_nominal = index[nominal.key()]
     for d in [Design("nominal", "box", (nominal,))] + designs:
         rows_idx = [index[p.key()] for p in d.points]
         for o in model.outputs:
             mean, se, n = (a[rows_idx] for a in stats[o])
-            for p, i in zip(d.points, range(len(rows_idx))):
+            for row, (p, i) in enumerate(zip(d.points, rows_idx)):
                 for j, level in enumerate(study.levels):
-                    point_rows.append([d.name, p.label, p.role, *(p.values[k] for k in names), level, o,
-                                       mean[i, j], se[i, j], int(n[i, j])])
+                    point_rows.append([d.name, p.label, p.role, *(p.values[name] for name in names), level, o,
+                                       mean[row, j], se[row, j], int(n[row, j]), regimes[i, j]])
             if d.name == "nominal" or o not in outputs:
                 continue
             bd = _band_with_failures(d, mean, se, study.z, level_labels)
             bands[(d.name, o)] = bd
             for msg in bd.notes:
-                _warn(result, f"{o}: {msg} -> band widened")
+                _warn(result, f"{o}: {msg}")
+            lower_se, upper_se = _edge_errors(d, mean, se, bd)
+            nominal_value, nominal_se = stats[o][0][i_nominal], stats[o][1][i_nominal]
+            outside = _nominal_outside(d, study.space.nominal(), nominal_value, nominal_se, bd, lower_se, upper_se,
+                                       study.z)
             for j, level in enumerate(study.levels):
                 band_rows.append([d.name, o, level, bd.lower[j], bd.upper[j], bd.corner_lower[j], bd.corner_upper[j],
-                                  int(bd.flagged[j]), bd.violation[j]])
-    result.files.append(write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
+                                  int(bd.flagged[j]), bd.violation[j], int(bd.tested[j]), lower_se[j], upper_se[j],
+                                  nominal_value[j], nominal_se[j], outside[j]])
+    columns = parameter_columns(study.space)
+    result.files.append(write_csv(folder / "runs.csv", [*columns, "level", "rep", *model.outputs, "error"],
                                    _runs_rows(results, points, study, model.outputs, names)))
-    result.files.append(write_csv(folder / "points.csv", ["design", "point", "role", *names, "level", "output",
-                                                           "mean", "se", "n_samples"], point_rows))
-    result.files.append(write_csv(folder / "bands.csv", ["design", "output", "level", "lower", "upper",
-                                                          "corner_lower", "corner_upper", "flagged", "violation"],
-                                   band_rows))
+    result.files.append(write_csv(folder / "points.csv", ["design", "point", "role", *columns, "level", "output",
+                                                           "mean", "se", "n_samples", "regime"], point_rows))
+    result.files.append(write_csv(folder / "bands.csv", BAND_COLUMNS, band_rows))
     monotone = {f"{d}/{o}": bd.monotone for (d, o), bd in bands.items()}
+    untested = [f"{d}/{o}" for (d, o), bd in bands.items() if not bd.fully_tested]
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
-                      "wall_time_s": elapsed, "monotone": monotone, "points": len(points)}
+                      "wall_time_s": elapsed, "monotone": monotone, "untested": untested, "points": len(points)}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
     return result
+
+
+#: the columns of bands.csv (README, "Output reference")
+BAND_COLUMNS = ("design", "output", "level", "lower", "upper", "corner_lower", "corner_upper", "flagged", "violation",
+                "tested", "lower_se", "upper_se", "nominal", "nominal_se", "nominal_outside")
+
+
+def _edge_errors(design: Design, mean: np.ndarray, se: np.ndarray, bd: Band) -> tuple[np.ndarray, np.ndarray]:
+    """The standard errors of the points that give each level's lower and upper band edge (the corners, or every
+    evaluated point where the band was widened); NaN where the band has no value."""
+    corner = np.array([p.role == "corner" for p in design.points])
+    lower_se, upper_se = np.full(mean.shape[1], np.nan), np.full(mean.shape[1], np.nan)
+    for j in range(mean.shape[1]):
+        candidates = np.isfinite(mean[:, j]) & (corner | bool(bd.flagged[j]))
+        if candidates.any():
+            values = np.where(candidates, mean[:, j], np.nan)
+            lower_se[j], upper_se[j] = se[np.nanargmin(values), j], se[np.nanargmax(values), j]
+    return lower_se, upper_se
+
+
+def _nominal_outside(design: Design, nominal: dict, value: np.ndarray, se: np.ndarray, bd: Band, lower_se: np.ndarray,
+                     upper_se: np.ndarray, z: float) -> np.ndarray:
+    """Per level: 1 where the nominal value lies outside the band by more than z combined standard errors (its own
+    and the edge's), 0 where not or where a standard error is unknown, -1 where the nominal point lies outside the
+    design's parameter box (e.g. the residual band, whose k_H is fixed at its best estimate)."""
+    box = {name: (min(p.values[name] for p in design.points), max(p.values[name] for p in design.points))
+           for name in nominal}
+    if any(not lo <= nominal[name] <= hi for name, (lo, hi) in box.items()):
+        return np.full(value.shape, -1)
+    with np.errstate(invalid="ignore"):
+        below = bd.lower - value > z * np.hypot(se, lower_se)
+        above = value - bd.upper > z * np.hypot(se, upper_se)
+    return (below | above).astype(int)
 
 
 def _band_with_failures(design: Design, mean: np.ndarray, se: np.ndarray, z: float, labels: list[str]) -> Band:
@@ -181,7 +245,7 @@ def _band_with_failures(design: Design, mean: np.ndarray, se: np.ndarray, z: flo
         kept = tuple(p for p, keep in zip(design.points, ok) if keep)
         if not any(p.role == "corner" for p in kept):
             nan = np.array([np.nan])
-            parts.append(Band(design.name, nan, nan, nan, nan, np.array([True]), nan))
+            parts.append(Band(design.name, nan, nan, nan, nan, np.array([False]), nan, np.array([False])))
             notes.append(f"{design.name}: every corner failed at {labels[j]}; no band")
             continue
         sub = Design(design.name, design.kind, kept, design.parameter)
@@ -191,7 +255,7 @@ def _band_with_failures(design: Design, mean: np.ndarray, se: np.ndarray, z: flo
     for b in parts:
         notes.extend(b.notes)
     return Band(design.name, cat("lower"), cat("upper"), cat("corner_lower"), cat("corner_upper"), cat("flagged"),
-                cat("violation"), notes)
+                cat("violation"), cat("tested"), notes)
 
 
 def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = None, jobs: int = 1,
@@ -202,7 +266,7 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     from uq.sobol import sobol_indices, sobol_sample
 
     model = _checked_model(study)
-    n = n or study.sobol_n
+    n = study.sobol_n if n is None else n
     X = sobol_sample(study.space, n, seed=study.seed)
     points = [study.space.from_values(x) for x in X]
     model, result, results, ran, elapsed = _run_points(study, model, points, out, resume, jobs, scheduler, progress,
@@ -210,7 +274,7 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
     rows, summary_rows, per_level = [], [], {}
-    stats = statistics(model, results, points, study)
+    stats, _ = statistics(model, results, points, study)
     n_failed = sum(1 for rec in results.values() if rec["error"])
     if n_failed:
         _warn(result, f"{n_failed} of {len(results)} runs failed (see the 'error' column of runs.csv); points "
@@ -229,7 +293,8 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
             summary_rows.append([o, level, res.variance, res.noise_variance, res.noise_share, res.failed_runs,
                                  res.message])
             per_level[f"{o}@{level:g}"] = {"noise_share": res.noise_share, "failed_runs": res.failed_runs}
-    result.files.append(write_csv(folder / "runs.csv", [*names, "level", "rep", *model.outputs, "error"],
+    result.files.append(write_csv(folder / "runs.csv", [*parameter_columns(study.space), "level", "rep",
+                                                        *model.outputs, "error"],
                                    _runs_rows(results, points, study, model.outputs, names)))
     result.files.append(write_csv(folder / "sobol.csv", ["output", "level", "parameter", "S1", "S1_conf", "ST",
                                                           "ST_conf"], rows))
@@ -239,4 +304,43 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                       "base_sample": n, "points": len(points),
                       "wall_time_s": elapsed, "per_level": per_level}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
+    return result
+
+
+def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, scheduler: str | None = None,
+                       resume: bool = False, progress: bool = True, client: Any = None) -> StudyResult:
+    """Response study (Figs. 5 and 6): the frequency response of the nominal point at every level (mean and max
+    amplitude per eta with the spread of the runs, Sect. 5.2) and its resonant levels (Sect. 5.3), every
+    stepped-sine run a task of the store (resumable, parallel, on a cluster)."""
+    from sim.tables import OVERVIEW_COLUMNS, SWEEP_COLUMNS, overview_data, overview_rows, sweep_rows
+
+    model = _checked_model(study)
+    point = study.space.nominal()
+    model, result, results, ran, elapsed = _run_points(study, model, [point], out, resume, jobs, scheduler, progress,
+                                                       client)
+    folder = result.folder
+    n_failed = sum(1 for rec in results.values() if rec["error"])
+    if n_failed:
+        _warn(result, f"{n_failed} of {len(results)} runs failed (see the 'error' column of runs.csv)")
+    sweeps, levels = [], []
+    for level in study.levels:
+        records = [results[Task.make(point, level, r)] for r in range(study.repetitions)]
+        sweep = model.sweep_result([rec for rec in records if not rec["error"]])
+        if sweep is None:
+            _warn(result, f"every run failed at level {level:g}; the level is left out")
+            continue
+        sweeps.append(sweep)
+        levels.append(level)
+    if not sweeps:
+        raise StudyError("every run of the response study failed; see runs.csv")
+    overview = overview_data(levels, sweeps)
+    result.files.append(write_csv(folder / "runs.csv", [*parameter_columns(study.space), "level", "rep",
+                                                        *model.outputs, "error"],
+                                   _runs_rows(results, [point], study, model.outputs, study.space.names)))
+    result.files.append(write_csv(folder / "sweeps.csv", ["level", *SWEEP_COLUMNS],
+                                   [[s.level, *row] for s in sweeps for row in sweep_rows(s)]))
+    result.files.append(write_csv(folder / "overview.csv", OVERVIEW_COLUMNS, overview_rows(overview)))
+    result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
+                      "wall_time_s": elapsed, "points": 1}
+    result.files.append(_metadata(study, model, result, {"summary": result.summary, "overview": overview}))
     return result

@@ -1,12 +1,18 @@
-"""Figures drawn from a study's data files, in the style of the seed paper's Figs. 6, 7 and 8.
+"""Figures drawn from a study's data files, in the style of the seed paper's Figs. 5-8.
 
-* Fig. 6 style: nominal resonant response levels (mean and max over the repetitions' mean) vs the
-  excitation level a_base / a_base*, APR/SMR marked (model "ies").
-* Fig. 7 style: individual variation, one panel per parameter: the band (shaded), the curves at the
-  parameter's min and max, and the nominal curve.
-* Fig. 8 style: joint variation (light band) and the residual band with k_H fixed (dark band).
+* Fig. 7 (individual variation, one panel per parameter) and Fig. 8 (joint band, and the residual band with k_H
+  fixed at its best estimate), interval studies: every curve and band edge carries the standard error of its
+  repetition mean as error bars; marks show where the nominal value lies outside its band (beyond the noise,
+  or within it) and where the monotonicity check failed or could not be made; the legend explains them.
+  "Nominal" is the point (D*, g*, k_H*) of Table 2 (k_H* = 282e3 N/mm^1.5), named so on the figure.
+* nominal-levels: the nominal point's resonant mean and max against the excitation level with the regime of
+  each level (an interval study's by-product; not the paper's Fig. 6, which a response study draws).
+* Fig. 5 (frequency responses, one panel per level) and Fig. 6 (resonant levels against the excitation level,
+  the paper's optimum marked), response studies, through `sim.figures`.
 * Sobol': S1 and ST with their confidence intervals vs level, and the repetition-noise share.
-Every figure is written as PNG and PDF (atomically). Only the data files are read, never the runs.
+
+Only the data files are read, never the runs, so `ies plot` redraws any of them (`sim.redraw`: the study kinds
+are registered here). Every figure is written in the formats of the plot options (PNG and PDF by default).
 """
 from __future__ import annotations
 
@@ -14,149 +20,218 @@ import csv
 import json
 from collections import defaultdict
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from sim.files import save_figure
+from sim.errors import SimulationInputError
+from sim.files import pyplot, save_figure
+from sim.redraw import KINDS, PlotOptions, kind_of, register, selected
+from uq.results import nominal_regimes
 
 _YLABEL = {"mean": "mean resonant level  a / a_noabs*", "max": "max resonant level  a / a_noabs*",
            "value": "response"}
+_LEVEL = "excitation level  a_base / a_base*"
+_NOISE_NOTE = "error bars: standard error of the repetition mean ({n} runs per point)"
 
 
-def _rows(path: Path) -> list[dict]:
+def _rows(path: Path, options: PlotOptions | None = None) -> list[dict]:
+    """A CSV file's rows; with `options`, only the rows of the chosen levels."""
     with open(path, newline="") as fh:
-        return list(csv.DictReader(fh))
+        rows = list(csv.DictReader(fh))
+    if options is not None and rows and "level" in rows[0]:
+        rows = [r for r in rows if options.keeps(float(r["level"]))]
+    return rows
 
 
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _save(fig, folder: Path, stem: str) -> list[Path]:
-    paths = []
-    for suffix in (".png", ".pdf"):
-        path = folder / f"{stem}{suffix}"
+def _save(fig: Any, folder: Path, stem: str, options: PlotOptions) -> list[Path]:
+    paths = options.paths(folder, stem)
+    for path in paths:
         save_figure(fig, path)
-        paths.append(path)
     return paths
 
 
-def _curves(points: list[dict], design: str, output: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Per point label: (levels, means) of one design and output."""
-    by = defaultdict(list)
-    for r in points:
-        if r["design"] == design and r["output"] == output:
-            by[r["point"]].append((float(r["level"]), float(r["mean"])))
-    return {k: tuple(np.array(v).T) for k, v in by.items()}
+def _study(folder: Path) -> dict:
+    return json.loads((folder / "study.json").read_text())
 
 
-def _band(bands: list[dict], design: str, output: str):
-    rows = [r for r in bands if r["design"] == design and r["output"] == output]
-    lv = np.array([float(r["level"]) for r in rows])
-    lo, hi = (np.array([float(r[k]) for r in rows]) for k in ("lower", "upper"))
-    flagged = np.array([r["flagged"] == "1" for r in rows], dtype=bool)
-    return lv, lo, hi, flagged
+def _kind_is(kind: str):
+    def detect(folder: Path) -> bool:
+        path = folder / "study.json"
+        return path.is_file() and json.loads(path.read_text()).get("study", {}).get("kind") == kind
+
+    return detect
 
 
-def interval_figures(folder: str | Path) -> list[Path]:
-    """Draw Figs. 6, 7 and 8 (as far as the study has the designs) from folder/*.csv."""
+def _curve(points: list[dict], design: str, point: str, output: str) -> tuple[np.ndarray, ...]:
+    """(levels, values, standard errors) of one point of a design, ordered by level."""
+    rows = sorted((r for r in points if r["design"] == design and r["point"] == point and r["output"] == output),
+                  key=lambda r: float(r["level"]))
+    return tuple(np.array([float(r[k]) for r in rows]) for k in ("level", "mean", "se"))
+
+
+def _band(bands: list[dict], design: str, output: str) -> dict[str, np.ndarray]:
+    rows = sorted((r for r in bands if r["design"] == design and r["output"] == output), key=lambda r: float(r["level"]))
+    out = {k: np.array([float(r[k]) for r in rows]) for k in ("level", "lower", "upper", "lower_se", "upper_se",
+                                                               "nominal", "nominal_se")}
+    for k in ("flagged", "tested", "nominal_outside"):
+        out[k] = np.array([int(r[k]) for r in rows])
+    return out
+
+
+def nominal_label(parameters: dict) -> str:
+    """'nominal (D* = 0.085 %, g* = 0.58 mm, k_H* = 282e3 N/mm^1.5)' for the simulator's Table 2 point; the
+    parameters' nominal values for other models."""
+    parts = []
+    for name, p in parameters.items():
+        if name.startswith("_"):
+            continue
+        value = p["nominal"]
+        if name == "D":
+            parts.append(f"D* = {100 * value:.3g} %")
+        elif name == "g":
+            parts.append(f"g* = {1e3 * value:.3g} mm")
+        elif name == "k_H":
+            parts.append(f"k_H* = {value / 1e3**1.5 / 1e3:.0f}e3 N/mm^1.5")
+        else:
+            parts.append(f"{name} = {value:.4g}")
+    return "nominal (" + ", ".join(parts) + ")"
+
+
+def _errorbar(ax: Any, x: np.ndarray, y: np.ndarray, se: np.ndarray, fmt: str, **kwargs: Any) -> None:
+    """A curve with standard-error bars (no bar where the error is unknown, NaN)."""
+    ax.errorbar(x, y, yerr=np.nan_to_num(se, nan=0.0), fmt=fmt, capsize=2, ms=4, lw=1.2, elinewidth=0.8, **kwargs)
+
+
+def _band_with_noise(ax: Any, band: dict, color: str, alpha: float, label: str) -> None:
+    """The band (shaded) and the standard errors of its edges (bars at both edges)."""
+    ax.fill_between(band["level"], band["lower"], band["upper"], color=color, alpha=alpha, lw=0, label=label)
+    for edge in ("lower", "upper"):
+        ax.errorbar(band["level"], band[edge], yerr=np.nan_to_num(band[f"{edge}_se"], nan=0.0), fmt="none",
+                    ecolor=color, elinewidth=0.8, capsize=2, alpha=0.9)
+
+
+def _marks(ax: Any, band: dict, prefix: str = "") -> None:
+    """Where the nominal value lies outside the band (beyond or within the noise), where the monotonicity check
+    failed (band widened) and where it could not be made; each explained in the legend."""
+    lv = band["level"]
+    applies = band["nominal_outside"] >= 0
+    beyond = applies & (band["nominal_outside"] == 1)
+    outside = applies & ((band["nominal"] < band["lower"]) | (band["nominal"] > band["upper"]))
+    within = outside & ~beyond
+    if beyond.any():
+        ax.plot(lv[beyond], band["nominal"][beyond], "o", ms=11, mfc="none", mec="m", mew=2,
+                label=f"{prefix}nominal outside its band, beyond the noise")
+    if within.any():
+        ax.plot(lv[within], band["nominal"][within], "o", ms=11, mfc="none", mec="0.5", mew=1.2, ls="none",
+                label=f"{prefix}nominal outside its band, within the noise")
+    flagged = band["flagged"] == 1
+    if flagged.any():
+        ax.plot(lv[flagged], band["upper"][flagged], "rx", ms=9, mew=2,
+                label=f"{prefix}monotonicity check failed (band widened to all points)")
+    untested = band["tested"] == 0
+    if untested.any():
+        ax.plot(lv[untested], band["upper"][untested], ls="none", marker="$?$", color="0.3", ms=9,
+                label=f"{prefix}monotonicity not tested (no noise estimate)")
+
+
+def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
+    """Draw Figs. 7 and 8 (as far as the study has the designs) and the nominal levels from folder/*.csv."""
     folder = Path(folder)
-    plt = _pyplot()
-    meta = json.loads((folder / "study.json").read_text())
-    points, bands = _rows(folder / "points.csv"), _rows(folder / "bands.csv")
+    options = options or PlotOptions()
+    plt = pyplot()
+    meta = _study(folder)
+    points, bands = _rows(folder / "points.csv", options), _rows(folder / "bands.csv", options)
+    selected(sorted({float(r["level"]) for r in _rows(folder / "bands.csv")}), options, folder)
     output = meta["outputs"][0]  # "mean" for the simulator: the paper's Figs. 7-8 show the mean only
     designs = list(dict.fromkeys(r["design"] for r in bands))
     params = meta["study"]["parameters"]
-    nominal = _curves(points, "nominal", output).get("nominal")
+    nominal = _curve(points, "nominal", "nominal", output)
+    nominal_text = nominal_label(params)
+    note = _NOISE_NOTE.format(n=meta["study"]["repetitions"])
     paths: list[Path] = []
 
     individual = [d for d in designs if d.startswith("individual:")]
     if individual:
-        fig, axes = plt.subplots(1, len(individual), figsize=(4.2 * len(individual), 3.6), squeeze=False, sharey=True)
+        fig, axes = plt.subplots(1, len(individual), figsize=(4.6 * len(individual), 4.4), squeeze=False, sharey=True)
         for ax, d in zip(axes[0], individual):
             pname = d.split(":", 1)[1]
-            lv, lo, hi, flagged = _band(bands, d, output)
-            ax.fill_between(lv, lo, hi, color="tab:blue", alpha=0.25, label="band")
-            curves = _curves(points, d, output)
-            lo_label, hi_label = min(curves, key=_value_of), max(curves, key=_value_of)
-            ax.plot(*curves[lo_label], "v-", color="tab:blue", label=f"{pname} min")
-            ax.plot(*curves[hi_label], "^-", color="tab:red", label=f"{pname} max")
-            if nominal is not None:
-                ax.plot(*nominal, "k.--", label="nominal")
-            if flagged.any():
-                ax.plot(lv[flagged], hi[flagged], "rx", ms=9, label="not monotone")
+            band = _band(bands, d, output)
+            _band_with_noise(ax, band, "tab:blue", 0.2, "band (+- SE of its edges)")
+            corners = sorted({r["point"] for r in points if r["design"] == d and r["role"] == "corner"},
+                             key=lambda label: float(label.split("=", 1)[1]))
+            for label, fmt, color, end in ((corners[0], "v-", "tab:blue", "min"), (corners[-1], "^-", "tab:red", "max")):
+                _errorbar(ax, *_curve(points, d, label, output), fmt, color=color, label=f"{pname} {end}")
+            _errorbar(ax, *nominal, "k.--", label="nominal")
+            _marks(ax, band)
             unit = params.get(pname, {}).get("unit", "")
             ax.set_title(f"{params.get(pname, {}).get('label', pname)} ({unit})", fontsize=9)
-            ax.set_xlabel("excitation level  a_base / a_base*")
+            ax.set_xlabel(_LEVEL)
             ax.grid(alpha=0.3)
-            ax.legend(fontsize=7)
+            ax.legend(fontsize=6)
         axes[0][0].set_ylabel(_YLABEL.get(output, output))
-        fig.suptitle("Individual variation (cf. Fig. 7)", fontsize=10)
-        paths += _save(fig, folder, "fig7")
+        fig.suptitle(f"Individual variation (cf. Fig. 7); {nominal_text}", fontsize=9)
+        fig.text(0.5, 0.005, note, ha="center", fontsize=7)
+        fig.tight_layout(rect=(0, 0.03, 1, 1))
+        paths += _save(fig, folder, "fig7", options)
         plt.close(fig)
 
     box = [d for d in designs if d in ("joint", "residual")]
     if box:
-        fig, ax = plt.subplots(figsize=(5.5, 4))
+        fig, ax = plt.subplots(figsize=(6.4, 4.8))
         styles = {"joint": ("tab:blue", 0.2, "all parameters (joint)"),
-                  "residual": ("tab:blue", 0.5, "residual, k_H fixed at best estimate")}
+                  "residual": ("tab:orange", 0.45, "residual, k_H fixed at its best estimate")}
         for d in box:
-            lv, lo, hi, flagged = _band(bands, d, output)
             color, alpha, label = styles[d]
-            ax.fill_between(lv, lo, hi, color=color, alpha=alpha, label=label)
-            if flagged.any():
-                ax.plot(lv[flagged], hi[flagged], "rx", ms=9, label=f"{d}: not monotone")
-        if nominal is not None:
-            ax.plot(*nominal, "k.--", label="nominal")
-        ax.set_xlabel("excitation level  a_base / a_base*")
+            band = _band(bands, d, output)
+            _band_with_noise(ax, band, color, alpha, f"{label} (+- SE of its edges)")
+            _marks(ax, band, prefix=f"{d}: ")
+        _errorbar(ax, *nominal, "k.--", label=nominal_text)
+        ax.set_xlabel(_LEVEL)
         ax.set_ylabel(_YLABEL.get(output, output))
         ax.set_title("Joint variation (cf. Fig. 8)", fontsize=10)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-        paths += _save(fig, folder, "fig8")
+        ax.legend(fontsize=6)
+        fig.text(0.5, 0.005, note, ha="center", fontsize=7)
+        fig.tight_layout(rect=(0, 0.03, 1, 1))
+        paths += _save(fig, folder, "fig8", options)
         plt.close(fig)
 
     if {"mean", "max"} <= set(meta["outputs"]):
-        paths += _overview(folder, points, plt)
+        paths += _nominal_levels(folder, points, nominal_text, note, options)
     return paths
 
 
-def _value_of(label: str) -> float:
-    return float(label.split("=", 1)[1]) if "=" in label else 0.0
-
-
-def _overview(folder: Path, points: list[dict], plt) -> list[Path]:
-    """Fig. 6 style: nominal resonant mean and max vs level, with the regime (APR/SMR) where the
-    repetition-averaged resonant mean is reached (as `sim.protocol.aggregate_runs` classifies it)."""
-    apr = {float(r["level"]): float(r["mean"]) for r in points if r["design"] == "nominal" and r["output"] == "apr"}
-    fig, ax = plt.subplots(figsize=(5.5, 4))
-    for output, style in (("mean", "o-"), ("max", "s--")):
-        curve = _curves(points, "nominal", output).get("nominal")
-        if curve is not None:
-            ax.plot(*curve, style, label=f"{output} (nominal)")
-    top = ax.get_ylim()[1]
-    for level, flag in sorted(apr.items()):
-        ax.annotate("APR" if flag >= 0.5 else "SMR", (level, top), ha="center", va="bottom", fontsize=7)
-    ax.set_xlabel("excitation level  a_base / a_base*")
+def _nominal_levels(folder: Path, points: list[dict], nominal_text: str, note: str, options: PlotOptions) -> list[Path]:
+    """The nominal point's resonant mean and max against the excitation level, with their standard errors and the
+    regime of each level (`uq.results.nominal_regimes`)."""
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(6.0, 4.4))
+    for output, fmt, color in (("max", "s--", "tab:red"), ("mean", "o-", "tab:blue")):
+        _errorbar(ax, *_curve(points, "nominal", "nominal", output), fmt, color=color, label=f"resonant {output}")
+    for level, regime in sorted(nominal_regimes(points).items()):
+        ax.annotate(regime, (level, 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom", fontsize=7,
+                    rotation=90)
+    ax.set_xlabel(_LEVEL)
     ax.set_ylabel("resonant response level  a / a_noabs*")
-    ax.set_title("Resonant response level (cf. Fig. 6)", fontsize=10, pad=14)
+    ax.set_title(f"Resonant levels of the {nominal_text}", fontsize=8, pad=28)
+    ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    paths = _save(fig, folder, "fig6")
+    ax.legend(fontsize=7)
+    fig.text(0.5, 0.005, note, ha="center", fontsize=7)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    paths = _save(fig, folder, "nominal-levels", options)
     plt.close(fig)
     return paths
 
 
-def sobol_figure(folder: str | Path) -> list[Path]:
+def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
     """S1 and ST (with confidence bars) per parameter vs level, and the noise share, per output."""
     folder = Path(folder)
-    plt = _pyplot()
-    rows, var = _rows(folder / "sobol.csv"), _rows(folder / "variance.csv")
+    options = options or PlotOptions()
+    plt = pyplot()
+    rows, var = _rows(folder / "sobol.csv", options), _rows(folder / "variance.csv", options)
+    selected(sorted({float(r["level"]) for r in _rows(folder / "sobol.csv")}), options, folder)
     outputs = list(dict.fromkeys(r["output"] for r in rows))
     fig, axes = plt.subplots(1, len(outputs), figsize=(5 * len(outputs), 3.8), squeeze=False)
     for ax, o in zip(axes[0], outputs):
@@ -174,13 +249,99 @@ def sobol_figure(folder: str | Path) -> list[Path]:
                        color=f"C{k}", alpha=0.8 if m == 0 else 0.45, label=f"{idx} {pname}", capsize=2)
         noise = [float(r["noise_share"]) for r in sorted((r for r in var if r["output"] == o),
                                                          key=lambda r: float(r["level"]))]
-        ax.plot(x, noise, "kd:", label="noise share")
+        ax.plot(x, noise, "kd:", label="noise share of the variance")
         ax.set_xticks(x, [f"{lv:g}" for lv in levels])
-        ax.set_xlabel("excitation level  a_base / a_base*")
+        ax.set_xlabel(_LEVEL)
         ax.set_ylabel("Sobol' index / variance share")
         ax.set_title(f"output: {o}", fontsize=9)
         ax.grid(alpha=0.3, axis="y")
         ax.legend(fontsize=6, ncol=2)
-    paths = _save(fig, folder, "sobol")
+    paths = _save(fig, folder, "sobol", options)
     plt.close(fig)
     return paths
+
+
+def _overview_of(rows: list[dict]) -> dict[str, list]:
+    """overview.csv as `sim.tables.overview_data` keys (numbers as floats, the regime as text)."""
+    data: dict[str, list] = defaultdict(list)
+    for r in rows:
+        for key, value in r.items():
+            data["levels" if key == "level" else key].append(value if key == "regime" else float(value))
+    return dict(data)
+
+
+def response_figures(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
+    """Fig. 5 (the frequency response at every level, a panel each) and Fig. 6 (resonant levels against the
+    excitation level, the paper's optimum marked), as the study's [response] figures ask, from sweeps.csv and
+    overview.csv."""
+    from sim.figures import plot_overview, plot_sweeps
+
+    folder = Path(folder)
+    options = options or PlotOptions()
+    meta = _study(folder)
+    overview = _overview_of(_rows(folder / "overview.csv", options))
+    selected([float(r["level"]) for r in _rows(folder / "overview.csv")], options, folder)
+    protocol = meta["study"]["protocol_resolved"]
+    runs = f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold"
+    paths: list[Path] = []
+    if "fig5" in meta["study"]["response"]["figures"]:
+        by_level: dict[float, dict[str, list]] = defaultdict(lambda: defaultdict(list))
+        for r in _rows(folder / "sweeps.csv", options):
+            for key, value in r.items():
+                by_level[float(r["level"])][key].append(value if key == "regime" else float(value))
+        regime = dict(zip(overview["levels"], overview["regime"]))
+        panels = [(data, f"a_base/a_base* = {level:g} (resonance: {regime.get(level, '?')})")
+                  for level, data in sorted(by_level.items())]
+        paths += options.paths(folder, "fig5")
+        for path in options.paths(folder, "fig5"):
+            plot_sweeps(panels, path, f"Frequency responses (cf. Fig. 5), nominal parameters, {runs}; bands: "
+                                      "range of the runs")
+    if "fig6" in meta["study"]["response"]["figures"]:
+        paths += options.paths(folder, "fig6")
+        for path in options.paths(folder, "fig6"):
+            plot_overview(overview, path, f"Resonant level vs excitation level (cf. Fig. 6), nominal parameters, {runs}",
+                          paper_optimum=True)
+    return paths
+
+
+register("ies interval", _kind_is("interval"))(interval_figures)
+register("ies sobol", _kind_is("sobol"))(sobol_figure)
+register("response study (ies reproduce fig5, fig6)", _kind_is("response"))(response_figures)
+
+
+def _result_children(folder: Path) -> list[Path]:
+    """The subfolders of `folder` that are result folders of another registered kind (e.g. ies reproduce's)."""
+    children = []
+    for child in sorted(p for p in folder.iterdir() if p.is_dir()):
+        if any(kind.name != REPRODUCE and kind.detect(child) for kind in KINDS):
+            children.append(child)
+    return children
+
+
+REPRODUCE = "ies reproduce --out"
+
+
+@register(REPRODUCE, lambda folder: bool(_result_children(folder)))
+def redraw_children(folder: Path, options: PlotOptions) -> list[Path]:
+    """Every result subfolder (fig5, fig6, fig7, fig8 of `ies reproduce`), each into its own folder (or into
+    OUT/NAME with --out)."""
+    from dataclasses import replace
+
+    paths: list[Path] = []
+    for child in _result_children(folder):
+        child_options = options if options.out is None else replace(options, out=options.out / child.name)
+        levels = _levels_of(child)
+        if levels and not any(options.keeps(level) for level in levels):
+            continue  # another figure's levels
+        if child_options.out is not None:
+            child_options.out.mkdir(parents=True, exist_ok=True)
+        paths += kind_of(child).redraw(child, child_options)
+    if not paths:
+        raise SimulationInputError(f"no result in {folder} has the levels {', '.join(f'{v:g}' for v in options.levels)}")
+    return paths
+
+
+def _levels_of(folder: Path) -> list[float]:
+    """The excitation levels of a study folder (from study.json; [] for other folders)."""
+    path = folder / "study.json"
+    return list(json.loads(path.read_text())["study"]["levels"]) if path.is_file() else []

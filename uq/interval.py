@@ -110,7 +110,9 @@ class Band:
 
     lower/upper: the corner band, widened to the envelope of all evaluated points where the check failed;
     corner_lower/corner_upper: the paper's vertex band (interval limits only);
-    flagged: where monotonicity failed beyond the noise tolerance; violation: by how much.
+    flagged: where monotonicity failed beyond the noise tolerance; violation: by how much (NaN where untested);
+    tested: where the check could be made (False where the values have no noise estimate, e.g. one repetition
+    of a chaotic response: a difference cannot be judged against an unknown noise).
     """
 
     design: str
@@ -120,11 +122,17 @@ class Band:
     corner_upper: np.ndarray
     flagged: np.ndarray
     violation: np.ndarray
+    tested: np.ndarray
     notes: list[str] = field(default_factory=list)
 
     @property
     def monotone(self) -> bool:
+        """No significant violation where the check was made."""
         return not bool(np.any(self.flagged))
+
+    @property
+    def fully_tested(self) -> bool:
+        return bool(np.all(self.tested))
 
 
 def _as_2d(values: np.ndarray | Sequence) -> np.ndarray:
@@ -137,13 +145,14 @@ def band(design: Design, values: np.ndarray, noise: np.ndarray | None = None, *,
     """Band of `values` (n_points x n_outputs, rows in `design.points` order) with the monotonicity check.
 
     `noise` (same shape) is the standard error of each value (repetition noise of a chaotic response;
-    zero for a deterministic function); two values differ significantly when their difference exceeds
-    z * sqrt(se_a^2 + se_b^2). Box designs: an interior value outside the corner envelope is a
-    violation. Axis designs: the sequence along the axis must be monotone (all steps >= -tol or all
-    <= +tol). Non-finite values are refused (catch failed runs before).
-    pool: use the RMS standard error of all the design's points (per output column) for every point: a
-    chaotic response scatters alike at nearby parameters, and the standard error of 2-5 repetitions of
-    one point is itself too uncertain to judge by.
+    zero for a deterministic function, None = all zero; NaN = unknown, e.g. one repetition); two values differ
+    significantly when their difference exceeds z * sqrt(se_a^2 + se_b^2). Box designs: an interior value
+    outside the corner envelope is a violation. Axis designs: the sequence along the axis must be monotone
+    (all steps >= -tol or all <= +tol). Non-finite values are refused (catch failed runs before). A column
+    whose noise is unknown is not tested (`Band.tested`): its band is the corner band, and a note says so.
+    pool: use the RMS standard error of the design's points with a noise estimate (per output column) for
+    every point: a chaotic response scatters alike at nearby parameters, and the standard error of 2-5
+    repetitions of one point is itself too uncertain to judge by.
     """
     y = _as_2d(values)
     if y.shape[0] != len(design.points):
@@ -153,9 +162,12 @@ def band(design: Design, values: np.ndarray, noise: np.ndarray | None = None, *,
     se = np.zeros_like(y) if noise is None else _as_2d(noise)
     if se.shape != y.shape:
         raise StudyError(f"noise has shape {se.shape} but values have shape {y.shape}")
-    se = np.nan_to_num(se, nan=0.0)
     if pool:
-        se = np.broadcast_to(np.sqrt(np.mean(se**2, axis=0)), se.shape)
+        known = np.isfinite(se)
+        mean_square = np.sum(np.where(known, se, 0.0) ** 2, axis=0) / np.maximum(known.sum(axis=0), 1)
+        se = np.broadcast_to(np.where(known.any(axis=0), np.sqrt(mean_square), np.nan), se.shape)
+    tested = np.isfinite(se).all(axis=0)
+    se = np.nan_to_num(se, nan=0.0)
     corner = np.array([p.role == "corner" for p in design.points])
     labels = output_labels or [str(j) for j in range(y.shape[1])]
     corner_lo, corner_hi = y[corner].min(axis=0), y[corner].max(axis=0)
@@ -169,24 +181,29 @@ def band(design: Design, values: np.ndarray, noise: np.ndarray | None = None, *,
             tol_hi = z * np.hypot(se[i], se[idx_hi, cols])
             excess = np.maximum(corner_lo - tol_lo - y[i], y[i] - corner_hi - tol_hi)
             violation = np.maximum(violation, np.maximum(excess, 0.0))
-            for j in np.where(excess > 0)[0]:
+            for j in np.where((excess > 0) & tested)[0]:
                 notes.append(f"{design.name}: {design.points[i].label} gives {y[i, j]:.4g} outside the corner band "
-                             f"[{corner_lo[j]:.4g}, {corner_hi[j]:.4g}] at {labels[j]}")
+                             f"[{corner_lo[j]:.4g}, {corner_hi[j]:.4g}] at {labels[j]} -> band widened")
     elif design.kind == "axis":
         steps = np.diff(y, axis=0)
         tol = z * np.hypot(se[1:], se[:-1])
         down = np.maximum(-steps - tol, 0.0).max(axis=0)  # worst significant decrease
         up = np.maximum(steps - tol, 0.0).max(axis=0)  # worst significant increase
         violation = np.minimum(up, down)  # both directions significant -> not monotone
-        for j in np.where(violation > 0)[0]:
+        for j in np.where((violation > 0) & tested)[0]:
             notes.append(f"{design.name}: response is not monotone in {design.parameter} at {labels[j]} "
-                         f"(rises by {up[j]:.4g} and falls by {down[j]:.4g} beyond the noise)")
+                         f"(rises by {up[j]:.4g} and falls by {down[j]:.4g} beyond the noise) -> band widened")
     else:
         raise StudyError(f"unknown design kind '{design.kind}'")
-    flagged = violation > 0
+    if not tested.all():
+        where = ", ".join(labels[j] for j in np.where(~tested)[0])
+        notes.append(f"{design.name}: monotonicity could not be tested at {where}: no noise estimate (one "
+                     "repetition per point); run repetitions >= 2")
+    flagged = (violation > 0) & tested
+    violation = np.where(tested, violation, np.nan)
     lower = np.where(flagged, np.minimum(corner_lo, y.min(axis=0)), corner_lo)
     upper = np.where(flagged, np.maximum(corner_hi, y.max(axis=0)), corner_hi)
-    return Band(design.name, lower, upper, corner_lo, corner_hi, flagged, violation, notes)
+    return Band(design.name, lower, upper, corner_lo, corner_hi, flagged, violation, tested, notes)
 
 
 def propagate(func: Callable[[Mapping[str, float]], float | np.ndarray], design: Design, *,

@@ -119,6 +119,12 @@ class IESModel:
         except SimulationInputError as exc:
             raise StudyError(f"[study] modal_model: {exc}") from None
 
+    def warm_up(self) -> None:
+        """Compile the integrator's kernels in this process (`sim.integrators.warm_up`; minutes on a first run)."""
+        from sim.integrators import warm_up
+
+        warm_up(self._stepped_sine().integrator)
+
     def with_rig(self) -> "IESModel":
         """This model carrying the rig's modal model (built here, used unchanged by every worker)."""
         return self if self.rig is not None else replace(self, rig=self._rig())
@@ -146,10 +152,10 @@ class IESModel:
         return {"mean": own.resonant_mean, "max": own.resonant_max, "apr": 1.0 if own.regime == "APR" else 0.0,
                 "trace": trace}
 
-    def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, tuple[float, float, int]]:
-        """Resonant levels over the repetitions of one (point, level), exactly as `sim.protocol.aggregate_runs`
-        (largest repetition-averaged mean / max over eta, Sect. 5.2-5.3), with the standard error from the
-        spread of the repetition samples: {output: (value, standard error, number of samples)}."""
+    def sweep_result(self, records: list[Mapping[str, Any]]) -> Any:
+        """The frequency response (`sim.protocol.SweepResult`, Fig. 5) of the runs of one (point, level), rebuilt
+        from their traces and aggregated exactly as `ies sweep` does (`sim.protocol.aggregate_runs`); None
+        without runs."""
         import numpy as np
         from sim.protocol import SweepRun, aggregate_runs
 
@@ -160,14 +166,20 @@ class IESModel:
             arrays = {key: np.asarray(t[key], dtype=int if key in ("leg", "hold_periods") else float) for key in _TRACE}
             runs.append(SweepRun(**arrays, level=t["level"], a_base=t["a_base"], a_noabs=t["a_noabs"], seed=t["seed"],
                                  rep=t["rep"], protocol=protocol, impactor=None))
-        if not runs:
-            return {name: (float("nan"), float("nan"), 0) for name in self.outputs}
-        res = aggregate_runs(runs)
+        return aggregate_runs(runs) if runs else None
+
+    def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, Any]:
+        """Resonant levels over the repetitions of one (point, level), exactly as `sim.protocol.aggregate_runs`
+        (largest repetition-averaged mean / max over eta, Sect. 5.2-5.3), with the standard error of the
+        repetition samples at that eta (`SweepResult.resonant_spread`; NaN for a single sample: no noise
+        estimate): {output: (value, standard error, number of samples)} and "regime": the regime there."""
+        res = self.sweep_result(records)
+        if res is None:
+            return {**{name: (float("nan"), float("nan"), 0) for name in self.outputs}, "regime": ""}
         n = int(res.n_samples)
-        se = lambda samples: float(np.std(samples, ddof=1) / np.sqrt(n)) if n >= 2 else 0.0  # noqa: E731
-        return {"mean": (res.resonant_mean, se(res.resonant_mean_samples), n),
-                "max": (res.resonant_max, se(res.resonant_max_samples), n),
-                "apr": (1.0 if res.regime == "APR" else 0.0, 0.0, n)}
+        return {"mean": (res.resonant_mean, res.resonant_spread("mean")[2], n),
+                "max": (res.resonant_max, res.resonant_spread("max")[2], n),
+                "apr": (1.0 if res.regime == "APR" else 0.0, 0.0, n), "regime": res.regime}
 
 
 _TRACE = ("eta", "eta_actual", "leg", "mean", "max", "min", "std", "impacts_per_period", "hold_periods")
@@ -178,8 +190,10 @@ def _protocol_dict(protocol: Any) -> dict:
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in out.items()}
 
 
-def mean_over_repetitions(outputs: tuple[str, ...], records: list[Mapping[str, Any]]) -> dict[str, tuple[float, float, int]]:
-    """Plain repetition statistics of scalar outputs: {output: (mean, standard error, count)}."""
+def mean_over_repetitions(outputs: tuple[str, ...], records: list[Mapping[str, Any]], *,
+                          deterministic: bool = False) -> dict[str, tuple[float, float, int]]:
+    """Plain repetition statistics of scalar outputs: {output: (mean, standard error, count)}; the standard error
+    of a single value is NaN (unknown) unless the model is `deterministic` (then 0)."""
     import numpy as np
 
     out = {}
@@ -188,7 +202,7 @@ def mean_over_repetitions(outputs: tuple[str, ...], records: list[Mapping[str, A
         values = values[np.isfinite(values)]
         n = values.size
         mean = float(values.mean()) if n else float("nan")
-        se = float(values.std(ddof=1) / np.sqrt(n)) if n >= 2 else 0.0
+        se = float(values.std(ddof=1) / np.sqrt(n)) if n >= 2 else (0.0 if deterministic and n else float("nan"))
         out[name] = (mean, se, n)
     return out
 
@@ -222,7 +236,7 @@ class IshigamiModel:
         return None
 
     def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, tuple[float, float, int]]:
-        return mean_over_repetitions(self.outputs, records)
+        return mean_over_repetitions(self.outputs, records, deterministic=True)
 
     def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, float]:
         x1, x2, x3 = (params[n] for n in self.parameters)

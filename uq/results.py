@@ -1,14 +1,16 @@
-"""Reading a finished interval study back and summarising the paper's trends (Sect. 5.4, Figs. 7, 8).
+"""Reading a finished study back and summarising it (Sect. 5.4, Figs. 7, 8; Sobol' indices).
 
 `effects(folder)` gives, per parameter and excitation level, the change of the repetition-mean resonant
 level from the parameter's min to its max (others nominal), relative to the nominal level, with its
 noise (the standard errors combined) and the nominal regime. `trend_table` formats it; `influence` ranks
 the parameters by their mean effect over the almost periodic levels (the band widths of Fig. 7);
-`band_table` lists the joint and residual bands. All read only the study's CSV files.
+`band_table` lists the bands with their noise and checks; `sobol_table` the Sobol' indices with their
+confidence intervals and the noise share. All read only the study's files.
 """
 from __future__ import annotations
 
 import csv
+import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -20,7 +22,7 @@ class Effect:
     """Change of the resonant level from a parameter's min to its max at one excitation level.
 
     delta: value(max) - value(min) (a / a_noabs*); relative: delta / nominal value; noise: the
-    combined standard error of the two values; regime: "APR" or "SMR" at the nominal point.
+    combined standard error of the two values; regime: the nominal point's regime ("APR", "SMR", "linear").
     """
 
     parameter: str
@@ -37,19 +39,35 @@ def _rows(path: Path) -> list[dict]:
         return list(csv.DictReader(fh))
 
 
+def nominal_regimes(points: list[dict], output: str = "mean") -> dict[float, str]:
+    """{level: regime} of the nominal point in points.csv: the regime where its repetition-averaged resonant level
+    is reached, as the simulator classifies it (`sim.protocol.aggregate_runs`, `sim.measures.classify_regime`:
+    APR, SMR or linear); the one source of every regime label of a study's tables and figures."""
+    return {float(r["level"]): r.get("regime", "") for r in points
+            if r["design"] == "nominal" and r["output"] == output}
+
+
+def parameter_value(row: dict, name: str) -> float:
+    """The value of parameter `name` in a row of runs.csv or points.csv, whose column carries the unit (g_m,
+    k_H_N_per_m1p5, `uq.space.column_name`) or is the bare name (dimensionless parameters)."""
+    if name in row:
+        return float(row[name])
+    (column,) = [c for c in row if c.startswith(f"{name}_")]
+    return float(row[column])
+
+
 def effects(folder: str | Path, output: str = "mean") -> list[Effect]:
     """Effects of the individual variation (designs "individual:NAME") in a study folder."""
     points = _rows(Path(folder) / "points.csv")
     nominal = {float(r["level"]): float(r["mean"]) for r in points if r["design"] == "nominal" and r["output"] == output}
-    regime = {float(r["level"]): ("APR" if float(r["mean"]) >= 0.5 else "SMR")
-              for r in points if r["design"] == "nominal" and r["output"] == "apr"}
+    regime = nominal_regimes(points, output)
     out = []
     designs = sorted({r["design"] for r in points if r["design"].startswith("individual:")})
     for design in designs:
         name = design.split(":", 1)[1]
         rows = [r for r in points if r["design"] == design and r["output"] == output and r["role"] == "corner"]
         for level in sorted({float(r["level"]) for r in rows}):
-            at = sorted((r for r in rows if float(r["level"]) == level), key=lambda r: float(r[name]))
+            at = sorted((r for r in rows if float(r["level"]) == level), key=lambda r: parameter_value(r, name))
             lo, hi = at[0], at[-1]
             delta = float(hi["mean"]) - float(lo["mean"])
             noise = float(np.hypot(float(hi["se"]), float(lo["se"])))
@@ -109,15 +127,65 @@ def influence_line(folder: str | Path, output: str = "mean") -> str:
             + " > ".join(f"{i.parameter} {i.mean_change:.1%} (noise {i.mean_noise:.1%})" for i in ranked))
 
 
-def band_table(folder: str | Path, output: str = "mean") -> str:
-    """Text table of the box bands (joint, residual) and the nominal value per level."""
+def _with_se(value: float, se: float) -> str:
+    """'0.2136 +- 0.0042' (no error part where the standard error is unknown)."""
+    return f"{value:.4f} +- {se:.4f}" if np.isfinite(se) else f"{value:.4f}        "
+
+
+def band_checks(row: dict) -> str:
+    """The checks of one row of bands.csv in words: the monotonicity check (ok, failed: band widened, not tested)
+    and where the nominal value lies outside the band (beyond or within the noise)."""
+    words = ["not tested" if row["tested"] == "0" else ("NOT MONOTONE (band widened)" if row["flagged"] == "1" else "ok")]
+    nominal, lower, upper = (float(row[k]) for k in ("nominal", "lower", "upper"))
+    if row["nominal_outside"] != "-1" and not lower <= nominal <= upper:
+        side = "above" if nominal > upper else "below"
+        words.append(f"nominal {side} the band" + (" BEYOND THE NOISE" if row["nominal_outside"] == "1"
+                                                   else " (within the noise)"))
+    return "; ".join(words)
+
+
+def band_table(folder: str | Path, output: str | None = None) -> str:
+    """Text table of the bands of `output` (default the study's first output) per design and level, with the
+    standard errors of the band edges and of the nominal value, and the checks (`band_checks`)."""
     folder = Path(folder)
-    bands = [r for r in _rows(folder / "bands.csv") if r["output"] == output and not r["design"].startswith("individual")]
-    points = _rows(folder / "points.csv")
-    nominal = {float(r["level"]): float(r["mean"]) for r in points if r["design"] == "nominal" and r["output"] == output}
-    lines = [f"{'design':>9} {'level':>6} {'lower':>8} {'nominal':>8} {'upper':>8} {'flagged':>7}"]
+    if output is None:
+        output = json.loads((folder / "study.json").read_text())["outputs"][0]
+    bands = [r for r in _rows(folder / "bands.csv") if r["output"] == output]
+    width = max([len(r["design"]) for r in bands] + [6])
+    lines = [f"{'design':>{width}} {'level':>6} {'lower +- SE':>16} {'nominal +- SE':>16} {'upper +- SE':>16}  checks"]
     for r in bands:
-        lv = float(r["level"])
-        lines.append(f"{r['design']:>9} {lv:6.2f} {float(r['lower']):8.4f} {nominal.get(lv, np.nan):8.4f} "
-                     f"{float(r['upper']):8.4f} {r['flagged']:>7}")
+        cells = [_with_se(float(r[k]), float(r[f"{k}_se"])) for k in ("lower", "nominal", "upper")]
+        lines.append(f"{r['design']:>{width}} {float(r['level']):6.2f} " + " ".join(f"{c:>16}" for c in cells)
+                     + f"  {band_checks(r)}")
+    return "\n".join(lines)
+
+
+#: the noise share of the output variance above which `sobol_table` says that the indices describe noise
+NOISE_DOMINATES = 0.5
+
+
+def sobol_table(folder: str | Path) -> str:
+    """Text table of S1 and ST with their confidence intervals per output, level and parameter, the repetition
+    noise's share of the variance per level, and, where noise dominates, what it means and what to change."""
+    folder = Path(folder)
+    meta = json.loads((folder / "study.json").read_text())
+    confidence = meta["study"]["sobol"]["confidence"]
+    repetitions = meta["study"]["repetitions"]
+    rows, variance = _rows(folder / "sobol.csv"), _rows(folder / "variance.csv")
+    lines = [f"Sobol' indices ({confidence:.0%} confidence intervals; S1 first order, ST total):"]
+    for v in variance:
+        o, level = v["output"], float(v["level"])
+        share = float(v["noise_share"])
+        noise = "unknown (one repetition)" if not np.isfinite(share) else f"{share:.0%}"
+        lines.append(f"{o} at level {level:g}: repetition noise {noise} of the variance"
+                     + (f"; not analysed: {v['message']}" if v["message"] else ""))
+        for r in (r for r in rows if r["output"] == o and float(r["level"]) == level):
+            lines.append(f"  {r['parameter']:>6}  S1 {float(r['S1']):6.3f} +- {float(r['S1_conf']):5.3f}   "
+                         f"ST {float(r['ST']):6.3f} +- {float(r['ST_conf']):5.3f}")
+        if np.isfinite(share) and share >= NOISE_DOMINATES:
+            lines.append(f"  -> the repetition noise dominates ({share:.0%} of the variance; 100 % or more: no parameter "
+                         "effect is resolved): these indices mostly describe noise. The noise variance falls as "
+                         f"1/repetitions (now {repetitions}): raise [study] repetitions or the hold time, or choose "
+                         "levels away from the switch between the strongly modulated and the almost periodic response, "
+                         "where the response is chaotic.")
     return "\n".join(lines)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import math
 import os
 import sys
@@ -40,7 +41,8 @@ class Task:
         return Task(tuple(sorted((k, float(v)) for k, v in params.items())), float(level), int(rep))
 
 
-def _describe(model: Any) -> Any:
+def describe_model(model: Any) -> Any:
+    """The model's settings as plain data (part of every task key)."""
     if hasattr(model, "describe"):
         return model.describe()
     if is_dataclass(model):
@@ -55,7 +57,7 @@ def task_key(task: Task, model: Any, seed: int, version: str) -> str:
 
 def _keyer(model: Any, seed: int, version: str) -> Callable[[Task], str]:
     """Key function with the study-wide part (model settings, seed, version) hashed once."""
-    common = hashlib.sha256(json.dumps({"seed": seed, "model": _describe(model), "version": version},
+    common = hashlib.sha256(json.dumps({"seed": seed, "model": describe_model(model), "version": version},
                                        sort_keys=True, default=str).encode())
 
     def key(task: Task) -> str:
@@ -103,14 +105,30 @@ def check_writable(folder: str | Path) -> Path:
     return folder
 
 
-def prepare_output(folder: str | Path, *, resume: bool) -> Path:
-    """Create the output folder and check it can be written; refuse to overwrite finished results."""
+#: the file in OUT/tasks naming the study whose tasks the folder holds: its name, then its key
+STUDY_MARK = "STUDY.txt"
+
+
+def prepare_output(folder: str | Path, *, resume: bool, study: tuple[str, str] | None = None) -> Path:
+    """Create the output folder and check it can be written; refuse to overwrite finished results, and refuse
+    `resume` into a folder that holds the tasks of another study. `study`: (name, key) of the study to run
+    (`uq.execute.study_key`), kept in OUT/tasks/STUDY.txt."""
     folder = Path(folder)
-    check_writable(folder / "tasks")
-    if not resume and ResultStore(folder).count():
+    store = ResultStore(folder)
+    if not resume and store.count():
         raise StudyError(f"output folder {folder} already holds task results; pass --resume to continue that study "
                          "or choose another --out")
-    for stale in (folder / "tasks").glob(".*.json"):  # a temporary file of a write cut off by SIGKILL
+    mark = store.folder / STUDY_MARK
+    if resume and study is not None and mark.is_file():
+        name, key = (mark.read_text().splitlines() + ["", ""])[:2]
+        if key != study[1] and store.count():
+            raise StudyError(f"output folder {folder} holds the tasks of another study ('{name}', key {key[:12]}), not "
+                             f"of '{study[0]}' (key {study[1][:12]}); --resume continues only the same study: choose "
+                             "another --out")
+    check_writable(store.folder)
+    if study is not None:
+        write_text(mark, f"{study[0]}\n{study[1]}\n")
+    for stale in store.folder.glob(".*.json"):  # a temporary file of a write cut off by SIGKILL
         stale.unlink(missing_ok=True)
     return folder
 
@@ -143,15 +161,23 @@ def _run_one(model: Callable, key: str, task: Task, seed: int) -> tuple[str, dic
 @contextmanager
 def dask_client(scheduler: str | None, client: Any = None) -> Iterator[Any]:
     """The Dask client of a study, connected once for all its tasks: `client` as given, else a connection to
-    `scheduler` (an unreachable address is a one-line StudyError; closed on exit), else None (local)."""
+    `scheduler` (an unreachable address is a one-line StudyError; closed on exit), else None (local).
+    While it is open, the distributed library's own log lines stay quiet: a lost scheduler is reported once,
+    by `run_tasks`."""
     if client is not None or scheduler is None:
         yield client
         return
     own = _connect(scheduler)
+    logging.disable(logging.ERROR)  # distributed logs (with tracebacks) every failed reconnection attempt
     try:
         yield own
     finally:
-        own.close()
+        try:
+            own.close(timeout=5)
+        except (OSError, TimeoutError):  # a lost scheduler cannot be told goodbye
+            pass
+        finally:
+            logging.disable(logging.NOTSET)
 
 
 def _connect(address: str):
@@ -172,8 +198,9 @@ def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultSt
     """Run every task whose result is not in `store`; return all results by task and how many ran now.
 
     jobs: local worker processes (joblib/loky; 1 = in this process). scheduler: a Dask scheduler
-    address, used through joblib's Dask backend (`client` may be passed instead, e.g. in tests).
-    Each result is saved as it arrives, so an interruption loses only the tasks in flight.
+    address (`client` may be passed instead, e.g. in tests): every task is submitted to the cluster, whatever
+    its size. Each result is saved as it arrives, so an interruption (Ctrl-C, a killed process, a lost
+    scheduler) loses only the tasks in flight; a lost scheduler is one StudyError line that names `--resume`.
     """
     from tqdm import tqdm
 
@@ -191,36 +218,61 @@ def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultSt
     bar = tqdm(total=total, initial=total - len(pending), desc="tasks", unit="run",
                disable=not progress, file=sys.stderr, dynamic_ncols=True)
     try:
-        for key, task, result in _dispatch(model, pending, seed, jobs, scheduler, client):
-            store.save(key, task, result)
-            bar.update(1)
+        if scheduler is not None and client is None:
+            with dask_client(scheduler) as own:
+                _run_and_store(model, pending, seed, jobs, own, store, bar, total)
+        else:
+            _run_and_store(model, pending, seed, jobs, client, store, bar, total)
     finally:
         bar.close()
     return {task: store.load(key) for task, key in keys.items()}, len(pending)
 
 
-def _dispatch(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int, scheduler: str | None,
+def _run_and_store(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int, client: Any,
+                   store: ResultStore, bar: Any, total: int) -> None:
+    """Save each result as it arrives; a lost Dask scheduler becomes one StudyError line."""
+    done = total - len(pending)
+    try:
+        for key, task, result in _dispatch(model, pending, seed, jobs, client):
+            store.save(key, task, result)
+            done += 1
+            bar.update(1)
+    except Exception as exc:
+        if client is None or client.status == "running":
+            raise
+        address = getattr(client.scheduler, "address", "") or "the scheduler"
+        raise StudyError(f"lost the Dask scheduler {address} after {done} of {total} tasks ({type(exc).__name__}); "
+                         f"the finished tasks are kept in {store.folder}: start the scheduler (and workers) again "
+                         "and rerun the same command with --resume") from None
+
+
+def _dispatch(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int,
               client: Any) -> Iterable[tuple[str, Task, dict]]:
+    """(key, task, result) of every pending task as it finishes: in this process (jobs 1, no client), in `jobs`
+    local processes (joblib/loky) or on a Dask cluster (`client`: one future per task, the model scattered once
+    to every worker)."""
     if not pending:
         return
     by_key = {k: t for k, t in pending}
-    if scheduler is None and client is None and jobs == 1:
+    if client is not None:
+        from distributed import as_completed
+
+        remote_model = client.scatter(model, broadcast=True)
+        futures = [client.submit(_run_one, remote_model, key, task, seed, pure=False) for key, task in pending]
+        try:
+            for future in as_completed(futures):
+                key, result = future.result()
+                yield key, by_key[key], result
+        finally:
+            if client.status == "running":
+                client.cancel(futures)
+        return
+    if jobs == 1:
         for key, task in pending:
             yield key, task, evaluate(model, task, seed)
         return
-    from joblib import Parallel, delayed, parallel_config
+    from joblib import Parallel, delayed
 
     calls = (delayed(_run_one)(model, key, task, seed) for key, task in pending)
-    if scheduler is not None or client is not None:
-        own = client is None
-        client = _connect(scheduler) if own else client
-        try:
-            with parallel_config(backend="dask", wait_for_workers_timeout=30):
-                for key, result in Parallel(n_jobs=-1, return_as="generator_unordered")(calls):
-                    yield key, by_key[key], result
-        finally:
-            if own:
-                client.close()
-        return
     for key, result in Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(calls):
         yield key, by_key[key], result

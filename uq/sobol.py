@@ -84,7 +84,8 @@ def sobol_indices(space: ParameterSpace, X: np.ndarray, Y: np.ndarray, *, num_re
 
     Repetitions (columns) are averaged; the noise estimate needs >= 2 finite repetitions per point.
     Alternatively Y is already a repetition statistic (1-D) and `noise` gives the variance of each
-    value due to the repetition scatter (e.g. the squared standard error).
+    value due to the repetition scatter (e.g. the squared standard error; NaN where unknown); 1-D Y without
+    `noise` is a deterministic function's (no noise).
     """
     from SALib.analyze import sobol as sobol_analyzer
 
@@ -113,11 +114,16 @@ def sobol_indices(space: ParameterSpace, X: np.ndarray, Y: np.ndarray, *, num_re
         s2 = dev2 / (counts - 1)
     usable = counts >= 2
     if noise is not None:
-        noise_variance = float(np.mean(noise[np.isfinite(noise)])) if np.isfinite(noise).any() else 0.0
+        noise_variance = float(np.mean(noise[np.isfinite(noise)])) if np.isfinite(noise).any() else np.nan
+    elif Y.shape[1] == 1:
+        noise_variance = 0.0  # one value per point, no noise given: a deterministic function
     else:
-        noise_variance = float(np.mean(s2[usable] / counts[usable])) if usable.any() else 0.0
+        noise_variance = float(np.mean(s2[usable] / counts[usable])) if usable.any() else np.nan
     if noise is None and not usable.all() and usable.any():
         notes.append(f"noise estimated from {int(usable.sum())} of {usable.size} points with >= 2 finite runs")
+    if np.isnan(noise_variance):
+        notes.append("no noise estimate (one repetition per point): how much of the variance is repetition noise is "
+                     "unknown; run repetitions >= 2")
     if variance <= 0:
         return SobolResult(problem["names"], nan, nan, nan, nan, variance, noise_variance, np.nan,
                            int((~finite).sum()), confidence, "the output does not vary over the sample", notes)

@@ -19,7 +19,9 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
+from sim.errors import SimulationInputError
 from sim.system import CLEARANCE_NOMINAL, D1_NOMINAL, K_H_NOMINAL
+from sim.units import CLEARANCE, K_H, implausible, parse_quantity
 from uq.errors import StudyError
 
 # Table 2 of the seed paper (SI units); the nominal values are the simulator's (sim.system).
@@ -34,6 +36,15 @@ TABLE2 = {
     "k_H": dict(nominal=K_H_STAR, min=K_H_STAR, max=428e3 * N_PER_MM15, unit="N/m^1.5",
                 label="Hertzian spring constant k_H"),
 }
+
+
+def column_name(name: str, unit: str) -> str:
+    """A CSV column for a quantity and its unit: ``g`` in ``m`` -> ``g_m``, ``k_H`` in ``N/m^1.5`` ->
+    ``k_H_N_per_m1p5``, a dimensionless quantity (unit "-", "1" or "") keeps its name."""
+    if unit in ("", "-", "1"):
+        return name
+    token = unit.replace("/", "_per_").replace("^", "").replace(".", "p").replace(" ", "_")
+    return f"{name}_{token}"
 
 
 @dataclass(frozen=True)
@@ -76,6 +87,12 @@ class Parameter:
     def varied(self) -> bool:
         """True when the interval has a positive width."""
         return self.max > self.min
+
+    @property
+    def column(self) -> str:
+        """Its name in CSV headers: the name with the unit in machine-friendly form (g_m, k_H_N_per_m1p5); the
+        bare name for a dimensionless parameter (D)."""
+        return column_name(self.name, self.unit)
 
     def at(self, t: float | np.ndarray) -> float | np.ndarray:
         """Map a unit-interval coordinate t in [0, 1] to the parameter value min + t (max - min)."""
@@ -197,8 +214,31 @@ def resolve_k_H(value: object, *, base_dir: Path | None = None) -> float:
             if base_dir is not None and not path.is_absolute():
                 path = base_dir / path
             return calibrated_k_H(path)
-    raise StudyError(f"cannot read k_H = {value!r}: give N/m^1.5, a ratio like \"1.25 k_H*\" "
-                     "or \"calibrated:FILE.json\" (the output of `ies calibrate --json`)")
+        try:
+            return parse_quantity(value, K_H)
+        except SimulationInputError:
+            pass
+    raise StudyError(f"cannot read k_H = {value!r}: give N/m^1.5, a value with its unit like \"282e3 N/mm^1.5\", "
+                     "a ratio like \"1.25 k_H*\" or \"calibrated:FILE.json\" (the output of `ies calibrate --json`)")
+
+
+def resolve_value(name: str, value: object, *, base_dir: Path | None = None) -> object:
+    """A parameter value of a study file in SI units: k_H through `resolve_k_H`, the clearance g as a number in m
+    or a string with its unit ("0.58 mm", `sim.units`); other parameters unchanged (checked by `Parameter`)."""
+    if name == "k_H":
+        return resolve_k_H(value, base_dir=base_dir)
+    if name == "g" and isinstance(value, str):
+        try:
+            return parse_quantity(value, CLEARANCE)
+        except SimulationInputError as exc:
+            raise StudyError(str(exc)) from None
+    return value
+
+
+def plausibility_warning(name: str, value: float) -> str | None:
+    """`sim.units.implausible` for g and k_H (a clearance above 10 mm, a k_H below 1e6 N/m^1.5, ...)."""
+    quantity = {"g": CLEARANCE, "k_H": K_H}.get(name)
+    return None if quantity is None else implausible(float(value), quantity)
 
 
 def calibrated_k_H(source: str | Path | Mapping) -> float:

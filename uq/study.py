@@ -4,7 +4,7 @@ Layout (every table and key is optional except where noted; SI units)::
 
     [study]
     name = "fig7"
-    kind = "interval"            # "interval" or "sobol" (required)
+    kind = "interval"            # "interval", "sobol" or "response" (required)
     model = "ies"                # "ies" (the simulator), "ishigami", or "package.module:function"
     modal_model = "rig.toml"     # optional, model "ies": a modal-model file (`ies modes --save`), relative to
                                  # this file, instead of the built-in rig
@@ -25,6 +25,8 @@ Layout (every table and key is optional except where noted; SI units)::
     eta = { start = 0.95, stop = 1.01, n = 25 }   # Omega / omega_1*
     repetition = "leg"           # "leg" or "run": what counts as one repetition sample (sim.protocol)
     start = "base-velocity"      # initial conditions of each run: "rest" or "base-velocity" (sim.protocol)
+    perturbation = 5e-4          # half-width of the random relative frequency offset of each run (sim.protocol)
+    perturb = "start"            # what it perturbs: "start" (each run's first wait) or "each-point"
     wait = 3.0                   # s
     hold = 5.0                   # s
     sequence = "up-down-up"
@@ -41,12 +43,16 @@ Layout (every table and key is optional except where noted; SI units)::
     bootstrap = 200
     confidence = 0.95
 
+    [response]                   # kind "response": the frequency responses and resonant levels of the nominal
+    figures = ["fig5", "fig6"]   # point (the parameters' nominal values) at every level, as Figs. 5 and 6
+
 Unknown tables or keys, unknown parameters, min > max, non-positive bounds and the like are refused with
 a `StudyError` whose one line names the file, the key and the fix.
 """
 from __future__ import annotations
 
 import math
+import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -54,17 +60,20 @@ from typing import Any, Mapping
 
 from uq.errors import StudyError
 from uq.models import make_model
-from uq.space import Parameter, ParameterSpace, resolve_k_H
+from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_H, resolve_value
 
-KINDS = ("interval", "sobol")
+KINDS = ("interval", "sobol", "response")
+#: the figures a response study draws (Figs. 5 and 6 of the seed paper)
+RESPONSE_FIGURES = ("fig5", "fig6")
 DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
     "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output"},
     "parameters": None,  # one sub-table per parameter
-    "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "repetition", "start",
-                   "dt_scale"},
+    "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "perturb", "repetition",
+                   "start", "dt_scale"},
     "interval": {"designs", "interior", "z", "fix"},
     "sobol": {"n", "bootstrap", "confidence"},
+    "response": {"figures"},
 }
 _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
 
@@ -91,6 +100,7 @@ class Study:
     confidence: float = 0.95
     source: str = ""
     modal_model: Path | None = None
+    figures: tuple[str, ...] = RESPONSE_FIGURES
 
     def make_model(self) -> Any:
         return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
@@ -105,6 +115,7 @@ class Study:
             "levels": list(self.levels), "protocol": dict(self.protocol), "parameters": self.space.to_dict(),
             "interval": {"designs": list(self.designs), "interior": self.interior, "z": self.z, "fix": dict(self.fix)},
             "sobol": {"n": self.sobol_n, "bootstrap": self.bootstrap, "confidence": self.confidence},
+            "response": {"figures": list(self.figures)},
         }
 
 
@@ -170,7 +181,7 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
             raise StudyError(f"[study] modal_model must be the path of a modal-model file (`ies modes --save`), got {modal_model!r}")
         modal_model = base_dir / modal_model
 
-    space = _parse_parameters(data.get("parameters"), model_spec, base_dir)
+    space = _parse_parameters(data.get("parameters"), model_spec, base_dir, source)
 
     exc = dict(data.get("excitation", {}))
     levels_raw = exc.pop("levels", [1.0] if model_spec != "ies" else None)
@@ -192,7 +203,7 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
     if interior < 0:
         raise StudyError(f"[interval] interior must be >= 0, got {interior}")
     z = float(_number("interval", "z", iv.get("z", 2.0), positive=False))
-    fix = _parse_fix(iv.get("fix", {"k_H": "best_estimate"} if "k_H" in space.names else {}), space, base_dir)
+    fix = _parse_fix(iv.get("fix", {"k_H": "best_estimate"} if "k_H" in space.names else {}), space, base_dir, source)
     if "residual" in designs and not fix:
         raise StudyError("[interval] the residual design needs fixed parameters: fix = { k_H = \"best_estimate\" }")
 
@@ -206,16 +217,21 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError(f"[sobol] confidence must lie in (0, 1), got {confidence}")
     if kind == "sobol" and not space.varied:
         raise StudyError("no parameter is varied; give at least one [parameters.NAME] with min < max")
+    figures = data.get("response", {}).get("figures", list(RESPONSE_FIGURES))
+    if not isinstance(figures, list) or not figures or any(f not in RESPONSE_FIGURES for f in figures):
+        raise StudyError(f"[response] figures must be a list from {', '.join(RESPONSE_FIGURES)}, got {figures!r}")
+    if kind == "response" and model_spec != "ies":
+        raise StudyError("a response study runs the simulator: model = \"ies\"")
 
     study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
-                  sobol_n, bootstrap, confidence, source, modal_model)
+                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures))
     model = study.make_model()  # unknown model -> one line now
     if modal_model is not None:
         model.check()  # an unreadable modal file -> one line now
     return study
 
 
-def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir: Path) -> ParameterSpace:
+def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir: Path, source: str) -> ParameterSpace:
     model = make_model(model_spec, parameters=tuple(table or {}))
     default = model.default_space()
     if default is None:  # a user's function: every parameter must be given in full
@@ -244,8 +260,8 @@ def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir
         spec = _check_param_table(p.name, table[p.name])
         values = {}
         for key in ("nominal", "min", "max"):
-            raw = spec.get(key, getattr(p, key))
-            values[key] = resolve_k_H(raw, base_dir=base_dir) if p.name == "k_H" else raw
+            values[key] = resolve_value(p.name, spec.get(key, getattr(p, key)), base_dir=base_dir)
+            _warn_implausible(source, f"[parameters.{p.name}] {key}", p.name, values[key])
         if "best_estimate" in spec:
             if p.name != "k_H":
                 raise StudyError(f"[parameters.{p.name}] best_estimate is only defined for k_H")
@@ -257,6 +273,15 @@ def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir
     return ParameterSpace(tuple(params), extras)
 
 
+def _warn_implausible(source: str, where: str, name: str, value: object) -> None:
+    """One warning line on stderr when a value of g or k_H in study file `source` has an implausible magnitude
+    (probably a unit slip)."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        warning = plausibility_warning(name, value)
+        if warning:
+            sys.stderr.write(f"warning: {source + ': ' if source else ''}{where}: {warning}\n")
+
+
 def _check_param_table(name: str, spec: Any) -> Mapping[str, Any]:
     if not isinstance(spec, Mapping):
         raise StudyError(f"[parameters.{name}] must be a table with nominal, min, max")
@@ -266,7 +291,7 @@ def _check_param_table(name: str, spec: Any) -> Mapping[str, Any]:
     return spec
 
 
-def _parse_fix(fix: Any, space: ParameterSpace, base_dir: Path) -> dict[str, float]:
+def _parse_fix(fix: Any, space: ParameterSpace, base_dir: Path, source: str) -> dict[str, float]:
     if not isinstance(fix, Mapping):
         raise StudyError(f"[interval] fix must be a table like {{ k_H = \"best_estimate\" }}, got {fix!r}")
     out = {}
@@ -277,8 +302,9 @@ def _parse_fix(fix: Any, space: ParameterSpace, base_dir: Path) -> dict[str, flo
             if f"{pname}_best_estimate" not in space.extras:
                 raise StudyError(f"[interval] fix: '{pname}' has no best estimate; give a number")
             value = space.extras[f"{pname}_best_estimate"]
-        elif pname == "k_H":
-            value = resolve_k_H(raw, base_dir=base_dir)
+        elif pname in ("k_H", "g"):
+            value = resolve_value(pname, raw, base_dir=base_dir)
+            _warn_implausible(source, f"[interval] fix.{pname}", pname, value)
         else:
             value = float(_number("interval", f"fix.{pname}", raw, positive=space[pname].positive))
         out[pname] = float(value)
@@ -291,7 +317,7 @@ def _parse_protocol(exc: Mapping[str, Any]) -> dict[str, Any]:
     for key in ("wait", "hold", "perturbation", "dt_scale"):
         if key in exc:
             out[key] = float(_number("excitation", key, exc[key]))
-    for key in ("sequence", "integrator", "repetition", "start"):
+    for key in ("sequence", "integrator", "repetition", "start", "perturb"):
         if key in exc:
             if not isinstance(exc[key], str):
                 raise StudyError(f"[excitation] {key} must be a string, got {exc[key]!r}")

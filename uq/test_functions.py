@@ -6,6 +6,8 @@ failed-run reporting without the simulator.
 * `noisy_linear`: a + 2 b + level plus seeded Gaussian noise (standard deviation SIGMA per repetition): over
   a, b in [0, 1] its band at a level is [level, level + 3], it is monotone in a and b, and the repetition
   noise variance of an r-repetition mean is SIGMA^2 / r against Var(a + 2 b) = 5/12 of uniform a, b.
+* `pure_noise`: seeded Gaussian noise of standard deviation SIGMA whatever a and b: every index it gets
+  describes noise (its noise share of the variance is about 1).
 * `failing`: a + b, except that it diverges (`sim.errors.SimulationDiverged`) for a > 0.9 in repetition 0 and
   returns NaN for b > 0.95: every run there is a failed run that a study must report, not hide.
 """
@@ -25,6 +27,12 @@ def noisy_linear(params: Mapping[str, float], level: float, rep: int, seed: int)
     """a + 2 b + level plus seeded Gaussian noise of standard deviation SIGMA per repetition."""
     rng = np.random.default_rng([seed, rep, int(1e6 * params["a"]), int(1e6 * params["b"])])
     return params["a"] + 2.0 * params["b"] + level + SIGMA * rng.standard_normal()
+
+
+def pure_noise(params: Mapping[str, float], level: float, rep: int, seed: int) -> float:
+    """Seeded Gaussian noise of standard deviation SIGMA, independent of the parameters."""
+    rng = np.random.default_rng([seed, rep, int(1e6 * params["a"]), int(1e6 * params["b"])])
+    return level + SIGMA * rng.standard_normal()
 
 
 def failing(params: Mapping[str, float], level: float, rep: int, seed: int) -> float:

@@ -1,5 +1,5 @@
-"""Wall time of the paper's uncertainty studies (Figs. 7, 8): quick (target <= 5 min each on 2 cores)
-and, with IES_FULL=1, the full protocol (goal <= 10 min for both). Prints the times, the machine load
+"""Wall time of the paper's studies (Figs. 5-8): quick (target <= 5 min each on 2 cores) and, with IES_FULL=1,
+the full protocol of all four. Prints the times, the machine load
 and the trend / band tables. Run: `pytest -m benchmark tests/benchmarks/test_uq_reproduce.py -s`."""
 import os
 import time
@@ -15,7 +15,7 @@ def _load() -> str:
 
 
 @pytest.mark.benchmark
-@pytest.mark.parametrize("figure", ["fig7", "fig8"])
+@pytest.mark.parametrize("figure", ["fig5", "fig6", "fig7", "fig8"])
 def test_quick_reproduction_time(figure, tmp_path, capsys):
     before = _load()
     start = time.perf_counter()
@@ -36,4 +36,4 @@ def test_full_reproduction_time(tmp_path, capsys):
     seconds = time.perf_counter() - start
     out = capsys.readouterr().out
     with capsys.disabled():
-        print(f"\nfig7 + fig8 full protocol: {seconds:.1f} s wall ({before} before, {_load()} after)\n{out}")
+        print(f"\nfigs. 5-8, full protocol: {seconds:.1f} s wall ({before} before, {_load()} after)\n{out}")

@@ -130,3 +130,34 @@ def test_no_impactor_waits_15_s_by_default_and_reaches_a_noabs(tmp_path, three_m
     assert data["protocol"]["wait"] == 15.0
     assert data["resonant_mean"] == pytest.approx(1.0, rel=5e-3)
     assert data["regime"] == "linear"
+
+
+def test_the_linear_response_at_default_settings_is_the_analytic_one(capsys):
+    """`ies sweep --no-impactor --level 1 --eta 0.999:1.001:21` with every other default (built-in rig, 5 runs with
+    perturbed starts, 15 s wait) is the analytic frequency response of Eq. 7 within 0.5 % at every point, though
+    the grid (step 1e-4) lies inside the perturbation (+-5e-4) and the peak's half-power width (+-8.5e-4)."""
+    from sim.measures import linear_tip_amplitude
+    from sim.rig import seed_rig_model
+    from sim.system import a_base_star, a_noabs_star
+
+    assert main(["sweep", "--no-impactor", "--level", "1", "--eta", "0.999:1.001:21", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    model = seed_rig_model(n_modes=9)
+    a_base = a_base_star(model)
+    exact = linear_tip_amplitude(model, np.array(data["eta"]) * model.omega[0], a_base) / a_noabs_star(model, a_base)
+    np.testing.assert_allclose(data["mean"], exact, rtol=5e-3)
+    assert data["resonant_mean"] == pytest.approx(1.0, rel=5e-3) and data["eta_resonant_mean"] == pytest.approx(1.0)
+
+
+def test_every_spread_contains_its_value(tmp_path, model_file, capsys):
+    """lo <= value <= hi in sweep.csv and overview.csv, for every point and level (resonant levels included)."""
+    out = tmp_path / "ov"
+    assert main(["overview", "--levels", "3,4,5,6", "--eta", "0.97:1.0:7", "--wait", "0.05", "--hold", "0.05",
+                 "--reps", "3", "--model", model_file, "--out", str(out)]) == 0
+    capsys.readouterr()
+    table = np.genfromtxt(out / "overview.csv", delimiter=",", names=True, dtype=None, encoding=None)
+    for name in ("resonant_mean", "resonant_max"):
+        assert np.all(table[f"{name}_lo"] <= table[name]) and np.all(table[name] <= table[f"{name}_hi"])
+    for sweep in json.loads((out / "overview.json").read_text())["sweeps"]:
+        for name in ("mean", "max"):
+            assert np.all(np.array(sweep[f"{name}_lo"]) <= sweep[name]) and np.all(np.array(sweep[name]) <= sweep[f"{name}_hi"])

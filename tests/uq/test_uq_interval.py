@@ -90,3 +90,21 @@ def test_noise_is_pooled_over_the_design_points():
     noise = np.array([[0.06], [0.0], [0.0], [0.0]])  # RMS 0.03: steps of 0.05-0.06 are within 2 sqrt(2) 0.03
     assert band(design, values, noise, pool=True).monotone
     assert not band(design, values, noise, pool=False).monotone
+
+
+def test_without_a_noise_estimate_monotonicity_is_not_tested():
+    """One repetition of a chaotic response has no noise estimate (NaN): a wiggle cannot be judged, so nothing is
+    flagged or widened and a note says that the check could not be made; a deterministic function (noise 0) is
+    still checked."""
+    space = ParameterSpace((Parameter("x0", 0.1, 0.1, 1.0),))
+    design = axis_design(space, "x0", n_interior=1)
+    values = np.array([[1.0, 1.0], [1.5, 1.5], [0.9, 0.9]])  # not monotone in either column
+    noise = np.array([[np.nan, 0.0], [np.nan, 0.0], [np.nan, 0.0]])
+    result = band(design, values, noise, output_labels=["level 5", "level 6"])
+    np.testing.assert_array_equal(result.tested, [False, True])
+    np.testing.assert_array_equal(result.flagged, [False, True])
+    assert np.isnan(result.violation[0]) and result.violation[1] > 0
+    assert result.upper[0] == result.corner_upper[0] == 1.0  # the corner band, not widened
+    assert not result.fully_tested and not result.monotone
+    assert any("could not be tested at level 5: no noise estimate" in note for note in result.notes)
+    assert not any("level 5" in note and "not monotone" in note for note in result.notes)

@@ -1,0 +1,69 @@
+"""Tables of stepped-sine results: a frequency response (Fig. 5, Sect. 5.2) and the resonant level against the
+excitation level (Fig. 6, Sect. 5.3), as `ies sweep`, `ies overview` and the uq response studies write and print
+them. Amplitudes are a / a_noabs* and levels a_base / a_base* (dimensionless, Sect. 5); a column with a unit
+says it in its name (a_base_m). The columns are documented in the README's output reference.
+"""
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+from sim.protocol import SweepResult
+
+#: sweep.csv: one row per eta of the grid (`SweepResult` arrays)
+SWEEP_COLUMNS = ("eta", "mean", "mean_lo", "mean_hi", "max", "max_lo", "max_hi", "cv", "impacts_per_period", "regime")
+#: overview.csv: one row per excitation level (`overview_data`)
+OVERVIEW_COLUMNS = ("level", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "resonant_max", "resonant_max_lo",
+                    "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max", "impacts_per_period", "regime",
+                    "a_base_m", "resonant_mean_se", "resonant_max_se")
+
+
+def sweep_rows(result: SweepResult) -> list[list[Any]]:
+    """The rows of sweep.csv (SWEEP_COLUMNS) of one frequency response."""
+    columns = [result.regime_per_eta if name == "regime" else getattr(result, name) for name in SWEEP_COLUMNS]
+    return [list(row) for row in zip(*columns)]
+
+
+def overview_data(levels: Sequence[float], results: Sequence[SweepResult]) -> dict[str, list]:
+    """The resonant levels (Sect. 5.3) of one frequency response per excitation level, as lists by key: the
+    OVERVIEW_COLUMNS ("levels" for the column "level"); spreads from `SweepResult.resonant_spread`."""
+    spread = {name: [r.resonant_spread(name) for r in results] for name in ("mean", "max")}
+    return {
+        "levels": [float(level) for level in levels],
+        "resonant_mean": [r.resonant_mean for r in results],
+        "resonant_max": [r.resonant_max for r in results],
+        "resonant_mean_lo": [s[0] for s in spread["mean"]],
+        "resonant_mean_hi": [s[1] for s in spread["mean"]],
+        "resonant_max_lo": [s[0] for s in spread["max"]],
+        "resonant_max_hi": [s[1] for s in spread["max"]],
+        "resonant_mean_se": [s[2] for s in spread["mean"]],
+        "resonant_max_se": [s[2] for s in spread["max"]],
+        "a_base_m": [r.a_base for r in results],
+        "eta_resonant_mean": [r.eta_resonant_mean for r in results],
+        "eta_resonant_max": [r.eta_resonant_max for r in results],
+        "regime": [r.regime for r in results],
+        "impacts_per_period": [float(r.impacts_per_period[r.eta == r.eta_resonant_mean][0]) for r in results],
+    }
+
+
+def overview_rows(data: dict[str, list]) -> list[list[Any]]:
+    """The rows of overview.csv (OVERVIEW_COLUMNS) of `overview_data`."""
+    return [list(row) for row in zip(*(data["levels" if name == "level" else name] for name in OVERVIEW_COLUMNS))]
+
+
+def overview_text(data: dict[str, list]) -> str:
+    """The table `ies overview` prints: resonant mean and max per level, where they occur, impacts, regime."""
+    lines = [f"{'level':>7} {'res.mean':>9} {'res.max':>9} {'eta(mean)':>9} {'imp/T':>6}  regime"]
+    for i, level in enumerate(data["levels"]):
+        lines.append(f"{level:7.3f} {data['resonant_mean'][i]:9.4f} {data['resonant_max'][i]:9.4f} "
+                     f"{data['eta_resonant_mean'][i]:9.4f} {data['impacts_per_period'][i]:6.2f}  {data['regime'][i]}")
+    return "\n".join(lines)
+
+
+def optimum_line(data: dict[str, list]) -> str:
+    """Where the resonant mean level is lowest (the optimum, Sect. 5.3) and the reductions there, 1 / level (the
+    levels are normalised by the linear resonant amplitude a_noabs* at the same excitation)."""
+    i = min(range(len(data["levels"])), key=lambda k: data["resonant_mean"][k])
+    return (f"optimum: a_base/a_base* = {data['levels'][i]:g} ({data['regime'][i]}), resonant mean "
+            f"{data['resonant_mean'][i]:.4f} and max {data['resonant_max'][i]:.4f} of a_noabs*: reduced "
+            f"{1 / data['resonant_mean'][i]:.0f}x (mean) and {1 / data['resonant_max'][i]:.0f}x (max); the paper: "
+            "6.7, 20x and 10x")

@@ -1,0 +1,96 @@
+"""Response studies (Figs. 5 and 6 through the task store): the same numbers as `ies overview`, serial or parallel,
+resumable, drawn, printed, and part of `ies reproduce all`."""
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from uq.cli import main
+
+TINY = ("[study]\nkind = 'response'\nseed = 3\nrepetitions = 2\n[excitation]\nlevels = [1.26, 6.7]\n"
+        "eta = {{ start = 0.975, stop = 0.985, n = 3 }}\nwait = 0.1\nhold = 0.1\n{extra}")
+
+
+def rows(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def tiny(tmp_path, extra=""):
+    path = tmp_path / "response.toml"
+    path.write_text(TINY.format(extra=extra))
+    return path
+
+
+def test_a_response_study_gives_what_ies_overview_gives(tmp_path, capsys):
+    """One code path for the numbers: the study's runs are tasks, aggregated exactly as `ies overview` aggregates
+    its sweeps (same seed, same repetitions)."""
+    assert main(["response", str(tiny(tmp_path)), "--out", str(tmp_path / "study"), "--quiet", "--jobs", "1"]) == 0
+    printed = capsys.readouterr().out
+    assert main(["overview", "--levels", "1.26,6.7", "--eta", "0.975:0.985:3", "--wait", "0.1", "--hold", "0.1",
+                 "--reps", "2", "--seed", "3", "--out", str(tmp_path / "overview")]) == 0
+    study, direct = rows(tmp_path / "study" / "overview.csv"), rows(tmp_path / "overview" / "overview.csv")
+    assert list(study[0]) == list(direct[0])  # the same columns
+    for a, b in zip(study, direct):
+        for key in a:
+            if key == "regime":
+                assert a[key] == b[key]
+            else:
+                assert float(a[key]) == pytest.approx(float(b[key]), rel=1e-12, abs=1e-15), key
+    sweeps = rows(tmp_path / "study" / "sweeps.csv")
+    assert len(sweeps) == 2 * 3 and {float(r["level"]) for r in sweeps} == {1.26, 6.7}
+    for name in ("fig5.png", "fig5.pdf", "fig6.png", "fig6.pdf", "runs.csv", "study.json"):
+        assert (tmp_path / "study" / name).is_file(), name
+    assert "resonant levels (a / a_noabs*) of the nominal point" in printed and "optimum: a_base/a_base* = " in printed
+    meta = json.loads((tmp_path / "study" / "study.json").read_text())
+    assert meta["overview"]["levels"] == [1.26, 6.7] and meta["output_folder"] == str((tmp_path / "study").resolve())
+
+
+def test_a_response_study_in_parallel_and_resumed_is_byte_identical(tmp_path, capsys):
+    study = tiny(tmp_path, "[response]\nfigures = ['fig6']\n")
+    assert main(["response", str(study), "--out", str(tmp_path / "serial"), "--quiet", "--jobs", "1"]) == 0
+    assert main(["response", str(study), "--out", str(tmp_path / "parallel"), "--quiet", "--jobs", "2"]) == 0
+    tasks = sorted((tmp_path / "parallel" / "tasks").glob("*.json"))
+    tasks[0].unlink()  # as if interrupted: one run missing
+    assert main(["response", str(study), "--out", str(tmp_path / "parallel"), "--quiet", "--jobs", "1", "--resume"]) == 0
+    assert "(1 run now, 3 reused)" in capsys.readouterr().out
+    for name in ("runs.csv", "sweeps.csv", "overview.csv"):
+        assert (tmp_path / "serial" / name).read_bytes() == (tmp_path / "parallel" / name).read_bytes(), name
+    assert not (tmp_path / "serial" / "fig5.png").exists() and (tmp_path / "serial" / "fig6.png").is_file()
+
+
+def test_reproduce_all_runs_figures_5_to_8(tmp_path, monkeypatch, capsys):
+    import uq.commands as commands
+
+    response = tiny(tmp_path, "[response]\nfigures = ['fig5', 'fig6']\n")
+    interval = tmp_path / "interval.toml"
+    interval.write_text("[study]\nkind = 'interval'\nrepetitions = 2\n[parameters.k_H]\n[excitation]\nlevels = [7.4]\n"
+                        "eta = { start = 0.975, stop = 0.98, n = 2 }\nwait = 0.1\nhold = 0.1\n[interval]\ninterior = 0\n")
+    monkeypatch.setattr(commands, "study_file", lambda figure, quick: response if figure in ("fig5", "fig6") else interval)
+    out = tmp_path / "o"
+    assert main(["reproduce", "all", "--no-calibration", "--out", str(out), "--quiet", "--jobs", "1"]) == 0
+    text = capsys.readouterr().out
+    for figure in ("fig5", "fig6", "fig7", "fig8"):
+        assert f"{figure}: " in text and (out / figure / "study.json").is_file(), figure
+    assert (out / "fig6" / "fig6.png").is_file() and (out / "fig7" / "fig7.png").is_file()
+    assert (out / "fig7" / "nominal-levels.png").is_file() and not (out / "fig7" / "fig6.png").exists()
+    assert "optimum: a_base/a_base* = " in text and "lower +- SE" in text
+
+
+def test_regime_labels_come_from_the_simulator(tmp_path, capsys):
+    """points.csv carries the regime that sim.protocol.aggregate_runs classifies; the tables and figures read it."""
+    from uq.results import nominal_regimes
+
+    path = tmp_path / "i.toml"
+    path.write_text("[study]\nkind = 'interval'\nrepetitions = 2\nseed = 3\n[parameters.k_H]\n[excitation]\n"
+                    "levels = [1.26, 6.7]\neta = { start = 0.975, stop = 0.985, n = 3 }\nwait = 0.1\nhold = 0.1\n")
+    assert main(["interval", str(path), "--out", str(tmp_path / "i"), "--quiet", "--jobs", "1", "--no-figures"]) == 0
+    assert main(["response", str(tiny(tmp_path)), "--out", str(tmp_path / "r"), "--quiet", "--jobs", "1",
+                 "--no-figures"]) == 0
+    capsys.readouterr()
+    regimes = nominal_regimes(rows(tmp_path / "i" / "points.csv"))
+    overview = rows(tmp_path / "r" / "overview.csv")
+    assert regimes == {float(r["level"]): r["regime"] for r in overview}  # the same runs, the same label
+    assert set(regimes.values()) <= {"APR", "SMR", "linear"}
+    assert np.isfinite([float(r["resonant_mean_se"]) for r in overview]).all()
