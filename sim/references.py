@@ -133,3 +133,21 @@ def ringing_energy_drift(**run_step_options: Any) -> tuple[float, int, dict]:
         _, imp = exact.run_step(y, 20, 2 * math.pi * 100.0, 0.0, sys, stats=stats, **run_step_options)
         impacts += int(imp.sum())
     return abs(energy_parts(y, sys)["total"][0] - e0) / e0, impacts, stats
+
+
+def rebound_error(v0: float, runner, a_base: float = 0.0) -> float:
+    """Relative error of the sphere's velocity after one impact against DOP853 (`reference_run`, rtol 1e-12,
+    events): the sphere 20 um from the left wall closing at v0 (m/s), the cantilever-like beam at rest, one
+    period of 1 ms (one impact). runner(y, sys, Omega, a_base) advances y in place over that period."""
+    sys = system_arrays(cantilever_like_model(), Impactor())
+    n = sys.omega.size
+    y0 = np.zeros(2 * n + 2)
+    y0[2 * n] = -sys.g + 2e-5
+    y0[2 * n + 1] = -v0
+    Omega = 2 * math.pi * 1000.0
+    y_ref, onsets, releases, _ = reference_run(y0, 2 * math.pi / Omega, Omega, a_base, sys)
+    if onsets.size != 1 or releases.size != 1:
+        raise AssertionError(f"the reference run has {onsets.size} onsets and {releases.size} releases, not one impact")
+    y = y0.copy()
+    runner(y, sys, Omega, a_base)
+    return abs(y[2 * n + 1] - y_ref[2 * n + 1]) / v0

@@ -8,7 +8,7 @@ Run: pytest -m benchmark tests/benchmarks/test_exact_accuracy.py -s
 import pytest
 
 from sim import exact, ode3
-from tests.sim.test_exact import per_impact_errors
+from sim.references import rebound_error
 
 pytestmark = pytest.mark.benchmark
 
@@ -16,13 +16,13 @@ pytestmark = pytest.mark.benchmark
 def test_accuracy_table():
     speeds = (0.1, 0.5, 1.0)
     rows = []
-    rows.append(("exact (collocation)", [per_impact_errors(v, lambda y, s, Om, a: exact.run_step(y, 1, Om, a, s))
+    rows.append(("exact (collocation)", [rebound_error(v, lambda y, s, Om, a: exact.run_step(y, 1, Om, a, s))
                                          for v in speeds]))
     for rtol in (1e-7, 1e-8, 1e-10):
-        rows.append((f"dopri5 rtol {rtol:g}", [per_impact_errors(
+        rows.append((f"dopri5 rtol {rtol:g}", [rebound_error(
             v, lambda y, s, Om, a: exact.run_step(y, 1, Om, a, s, rtol=rtol, contacts="dopri5")) for v in speeds]))
     for scale, label in ((1, "dt"), (1 / 2, "dt/2"), (1 / 4, "dt/4"), (1 / 8, "dt/8")):
-        rows.append((f"ode3 {label}", [per_impact_errors(v, lambda y, s, Om, a: ode3.run_step(y, 1, Om, a, s, dt_scale=scale))
+        rows.append((f"ode3 {label}", [rebound_error(v, lambda y, s, Om, a: ode3.run_step(y, 1, Om, a, s, dt_scale=scale))
                                        for v in speeds]))
     print("\nrelative error of the rebound velocity, per impact (v0 = " + ", ".join(f"{v} m/s" for v in speeds) + ")")
     for label, errs in rows:

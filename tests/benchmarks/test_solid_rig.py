@@ -1,7 +1,7 @@
 """The rig as a 3D solid model (sim/solid.py): cost, mesh convergence and comparison with the Timoshenko beam model.
 
 Run with `pytest -m benchmark tests/benchmarks/test_solid_rig.py -s` (about 5 min on the shared 2-core machine).
-Targets (issue 17): a coarse rig model solves in under 3 minutes and 4 GB; coarse and medium meshes agree within
+Targets: a coarse rig model solves in under 3 minutes and 4 GB; coarse and medium meshes agree within
 0.5 % in f1..f9 and the contact values. The comparison with sim.rig.seed_rig_model() (frequencies, wall values at
 the contact height, 2 mm higher and at the wall's top edge, tip values, participation, masses) is printed.
 """

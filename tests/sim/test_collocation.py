@@ -1,4 +1,4 @@
-"""Contacts by exponential Gauss collocation (sim.collocation, issue 5): the tables against a finer quadrature,
+"""Contacts by exponential Gauss collocation (sim.collocation): the tables against a finer quadrature,
 the backward series against an independent forward step, the observed order of a step, and whole impacts
 against scipy's DOP853 (rtol 1e-12, restarted at the contact events)."""
 import math
