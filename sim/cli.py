@@ -396,6 +396,19 @@ def write_results(folder: Path | None, stem: str, header: Sequence[str], rows: A
     return [write_csv(folder / f"{stem}.csv", header, rows), write_text(folder / f"{stem}.json", dumps(data) + "\n")]
 
 
+def report(args: argparse.Namespace, data: dict, written: list, plot: Any, text: str) -> int:
+    """End of `ies sweep`/`ies overview`: draw `--plot` with plot(path), then print the JSON object (`--json`)
+    or the text table, and a `wrote PATH` line per file written; exit code 0."""
+    from sim.files import dumps, report_written
+
+    if args.plot:
+        plot(args.plot)
+        written.append(args.plot)
+    print(dumps(data) if args.json else text)
+    report_written(written, json_mode=args.json)
+    return 0
+
+
 # ---- ies sweep ----------------------------------------------------------------------------------------------
 
 def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
@@ -408,7 +421,6 @@ def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
 def sweep_command(args: argparse.Namespace) -> int:
     """`ies sweep`: one stepped-sine frequency response (Sects. 5.1, 5.2; Fig. 5)."""
     from sim.figures import plot_sweep, sweep_title
-    from sim.files import dumps, report_written
     from sim.protocol import check_level
     from sim.tables import SWEEP_COLUMNS, sweep_rows
 
@@ -421,23 +433,15 @@ def sweep_command(args: argparse.Namespace) -> int:
                                                             "k_H_N_per_m1p5": impactor.k_H},
                     D1=float(model.damping_ratios[0]))
         written = write_results(folder, "sweep", SWEEP_COLUMNS, sweep_rows(result), data)
-    if args.plot:
-        plot_sweep(data, args.plot, sweep_title(data))
-        written.append(args.plot)
-    if args.json:
-        print(dumps(data))
-        report_written(written, json_mode=True)
-        return 0
-    print(f"# a_base/a_base* = {level:g}: {result.n_runs} runs, {result.n_samples} samples, {protocol.integrator}, "
-          f"{data['wall_time_s']:.1f} s")
-    print(f"{'eta':>7} {'mean':>8} {'max':>8} {'cv':>6} {'imp/T':>6}  regime")
+    lines = [f"# a_base/a_base* = {level:g}: {result.n_runs} runs, {result.n_samples} samples, "
+             f"{protocol.integrator}, {data['wall_time_s']:.1f} s",
+             f"{'eta':>7} {'mean':>8} {'max':>8} {'cv':>6} {'imp/T':>6}  regime"]
     for i, eta in enumerate(result.eta):
-        print(f"{eta:7.4f} {result.mean[i]:8.4f} {result.max[i]:8.4f} {result.cv[i]:6.3f} "
-              f"{result.impacts_per_period[i]:6.2f}  {result.regime_per_eta[i]}")
-    print(f"resonant mean {result.resonant_mean:.4f} at eta {result.eta_resonant_mean:.4f} ({result.regime}); "
-          f"resonant max {result.resonant_max:.4f} at eta {result.eta_resonant_max:.4f}")
-    report_written(written)
-    return 0
+        lines.append(f"{eta:7.4f} {result.mean[i]:8.4f} {result.max[i]:8.4f} {result.cv[i]:6.3f} "
+                     f"{result.impacts_per_period[i]:6.2f}  {result.regime_per_eta[i]}")
+    lines.append(f"resonant mean {result.resonant_mean:.4f} at eta {result.eta_resonant_mean:.4f} ({result.regime}); "
+                 f"resonant max {result.resonant_max:.4f} at eta {result.eta_resonant_max:.4f}")
+    return report(args, data, written, lambda path: plot_sweep(data, path, sweep_title(data)), "\n".join(lines))
 
 
 # ---- ies overview -------------------------------------------------------------------------------------------
@@ -452,7 +456,6 @@ def add_overview_arguments(parser: argparse.ArgumentParser) -> None:
 def overview_command(args: argparse.Namespace) -> int:
     """`ies overview`: the resonant level at each excitation level (Sect. 5.3; Fig. 6)."""
     from sim.figures import overview_title, plot_overview
-    from sim.files import dumps, report_written
     from sim.tables import OVERVIEW_COLUMNS, overview_data, overview_rows, overview_text
 
     started = time.perf_counter()
@@ -461,16 +464,8 @@ def overview_command(args: argparse.Namespace) -> int:
         data = {**overview_data(levels, results), "sweeps": [r.to_dict() for r in results], "reps": args.reps,
                 "seed": args.seed, "model": model.source, "wall_time_s": time.perf_counter() - started}
         written = write_results(folder, "overview", OVERVIEW_COLUMNS, overview_rows(data), data)
-    if args.plot:
-        plot_overview(data, args.plot, overview_title(data))
-        written.append(args.plot)
-    if args.json:
-        print(dumps(data))
-        report_written(written, json_mode=True)
-        return 0
-    print(overview_text(data))
-    report_written(written)
-    return 0
+    return report(args, data, written, lambda path: plot_overview(data, path, overview_title(data)),
+                  overview_text(data))
 
 
 # ---- registration with the front door -------------------------------------------------------------------------

@@ -31,6 +31,22 @@ import numpy as np
 NEW_FILE_MODE = 0o666
 
 
+def read_text(path: str | os.PathLike, kind: str, fmt: str, hint: str = "") -> str:
+    """The UTF-8 text of a user's input file; a missing file, a folder or a binary file is one line
+    (SimulationInputError) naming the file, its `kind` (e.g. "modal file"), the format `fmt` and a `hint`."""
+    from sim.errors import SimulationInputError
+
+    path = Path(path)
+    try:
+        return path.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise SimulationInputError(f"{kind} {path} not found{hint}") from None
+    except IsADirectoryError:
+        raise SimulationInputError(f"{path} is a folder, not a {kind}") from None
+    except UnicodeDecodeError:
+        raise SimulationInputError(f"{path}: not a text (UTF-8 {fmt}) file") from None
+
+
 @contextmanager
 def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a new empty temporary file beside `path` for the caller to write (by its name); on success it

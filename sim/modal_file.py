@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from sim.errors import SimulationInputError
-from sim.files import write_text
+from sim.files import read_text, write_text
 from sim.system import ModalModel
 
 FORMAT_NAME = "ies-modal-model"
@@ -70,14 +70,7 @@ def load_modal_model(path: str | os.PathLike) -> ModalModel:
     not positive and strictly ascending, or damping ratios outside (0, 1).
     """
     path = Path(path)
-    try:
-        text = path.read_bytes().decode("utf-8")
-    except FileNotFoundError:
-        raise SimulationInputError(f"modal file {path} not found; give the path of a .toml modal-model file") from None
-    except IsADirectoryError:
-        raise SimulationInputError(f"{path} is a folder, not a modal-model file") from None
-    except UnicodeDecodeError:
-        raise SimulationInputError(f"{path}: not a text (UTF-8 TOML) file") from None
+    text = read_text(path, "modal file", "TOML", "; give the path of a .toml modal-model file")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

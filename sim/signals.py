@@ -14,6 +14,7 @@ simulated trace and a measurement go through the same analyses.
 """
 from __future__ import annotations
 
+import io
 import os
 import re
 import warnings
@@ -24,6 +25,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from sim.errors import SimulationInputError
+from sim.files import read_text
 from sim.system import SystemArrays
 
 #: Largest deviation of a time step from the mean step (relative) that still counts as uniform sampling.
@@ -109,15 +111,8 @@ def read_signal(path: str | os.PathLike, required: Sequence[str] = ()) -> Signal
     column, a non-numeric or non-finite value, or t that is not strictly increasing and uniform.
     """
     path = Path(path)
-    try:
-        with path.open("r", encoding="utf-8") as handle:
-            header, skipped = _header(handle)
-    except FileNotFoundError:
-        raise SimulationInputError(f"signal file {path} not found") from None
-    except IsADirectoryError:
-        raise SimulationInputError(f"{path} is a folder, not a signal file") from None
-    except UnicodeDecodeError:
-        raise SimulationInputError(f"{path}: not a text (UTF-8 CSV) file") from None
+    text = read_text(path, "signal file", "CSV")
+    header, skipped = _header(io.StringIO(text))
     if header is None:
         raise SimulationInputError(f"{path} is empty; a signal file has a header line such as "
                                    f"'t,{','.join(required) or 'a_left'}' and one row per sample")
@@ -131,8 +126,8 @@ def read_signal(path: str | os.PathLike, required: Sequence[str] = ()) -> Signal
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # "input contained no data": reported below
-            data = np.loadtxt(path, delimiter=",", comments="#", skiprows=skipped + 1, usecols=columns, ndmin=2,
-                              encoding="utf-8")
+            data = np.loadtxt(io.StringIO(text), delimiter=",", comments="#", skiprows=skipped + 1,
+                              usecols=columns, ndmin=2)
     except ValueError as exc:
         text = str(exc).strip().splitlines()[-1]
         cell = re.search(r"could not convert string '(.*)' to float64 at row (\d+), column (\d+)", text)
