@@ -220,3 +220,31 @@ def test_rig_mesh_is_symmetric_conforming_and_weighs_what_the_geometry_does():
     locs = solid.basis.doflocs[:, solid.free]
     for point in (g.wall_point("left"), g.wall_point("right"), g.measurement_point):
         assert np.min(np.linalg.norm(locs.T - point, axis=1)) < 1e-12
+
+
+def test_quarter_model_is_the_full_models_x_bending_class():
+    """The quarter model with the mirror conditions gives the full model's x-bending modes: frequencies, values at
+    both walls (patch average across y = 0), tip and participation, to round-off; a quarter of the DOFs."""
+    g = SolidGeometry()
+    full, quarter = (solid_modal_model(solve_solid_modes(solid_mesh(g, element_size=0.016, symmetry=s), n_modes=9),
+                                       patch_radius=0.5e-3) for s in ("full", "quarter"))
+    for key in ("frequencies_hz", "phi_wall_left", "phi_wall_right", "phi_tip", "participation"):
+        np.testing.assert_allclose(getattr(quarter, key), getattr(full, key), rtol=1e-8, err_msg=key)
+    with pytest.raises(SimulationInputError, match="unknown symmetry 'half'"):
+        solid_mesh(g, element_size=0.016, symmetry="half")
+
+
+def test_stretched_grid_follows_the_geometry():
+    """A grid built for one neck and stretched onto another has the same element count, weighs what the new
+    geometry weighs, and its frequencies differ from the new geometry's own grid by mesh error only."""
+    g0 = SolidGeometry()
+    g1 = SolidGeometry(neck_length=0.12, neck_width_y=0.013)
+    stretched = solid_mesh(g1, element_size=0.016, symmetry="quarter", grid_from=g0)
+    own = solid_mesh(g1, element_size=0.016, symmetry="quarter")
+    assert stretched.mesh.t.shape[1] == solid_mesh(g0, element_size=0.016, symmetry="quarter").mesh.t.shape[1]
+    assert stretched.total_mass == pytest.approx(RHO * (g1.block_edge**3 + g1.beam_volume), rel=1e-12)
+    f_stretched = solve_solid_modes(stretched, n_modes=4).frequencies_hz
+    f_own = solve_solid_modes(own, n_modes=4).frequencies_hz
+    np.testing.assert_allclose(f_stretched, f_own, rtol=2e-3)
+    with pytest.raises(SimulationInputError, match="do not correspond one to one"):
+        solid_mesh(SolidGeometry(neck_length=0.0), element_size=0.016, grid_from=g0)
