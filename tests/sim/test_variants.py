@@ -24,6 +24,7 @@ def fake_sweep(level: float, peaks: list[float], cvs: list[float], peak_eta: flo
     mean = mean_samples.mean(axis=0)
     maxes = [2 * p for p in peaks] if maxes is None else maxes
     return SimpleNamespace(level=level, eta=ETA, mean_samples=mean_samples, cv_samples=cv_samples,
+                           impacts_samples=np.full_like(mean_samples, 2.0),
                            resonant_mean=float(mean.max()), resonant_max=float(np.mean(maxes)),
                            resonant_mean_samples=np.array(peaks), resonant_max_samples=np.array(maxes),
                            regime="APR" if np.mean(cvs) <= 0.1 else "SMR", impacts_per_period=np.full(ETA.size, 2.0))
@@ -33,14 +34,15 @@ def test_switch_optimum_and_levels_of_an_overview():
     results = [
         fake_sweep(7.4, [0.20, 0.19, 0.21], [0.05, 0.04, 0.06]),
         fake_sweep(5.0, [0.05, 0.06, 0.05], [0.4, 0.3, 0.5], peak_eta=0.99),
-        fake_sweep(6.0, [0.05, 0.15, 0.05], [0.4, 0.05, 0.5]),  # mixed: one sample APR
+        fake_sweep(6.0, [0.05, 0.15, 0.05], [0.4, 0.05, 0.5]),  # mostly SMR: one sample APR
         fake_sweep(6.7, [0.12, 0.12, 0.12], [0.05, 0.05, 0.05]),
+        fake_sweep(8.0, [0.22, 0.21, 0.20], [0.05, 0.15, 0.05]),  # one sample at the APR branch's edge
         fake_sweep(4.0, [0.06, 0.06, 0.06], [0.4, 0.4, 0.4], peak_eta=0.99),
     ]
     lm = landmarks(results)
-    assert lm.levels.tolist() == [4.0, 5.0, 6.0, 6.7, 7.4]
-    assert lm.last_smr == 5.0 and lm.first_apr == 6.7
-    assert lm.apr_samples.tolist() == pytest.approx([0, 0, 1 / 3, 1, 1])
+    assert lm.levels.tolist() == [4.0, 5.0, 6.0, 6.7, 7.4, 8.0]
+    assert lm.last_smr == 6.0 and lm.first_apr == 6.7
+    assert lm.apr_samples.tolist() == pytest.approx([0, 0, 1 / 3, 1, 1, 2 / 3])
     assert lm.optimum_level == 5.0
     assert lm.reduction_mean == pytest.approx(1 / np.mean([0.05, 0.06, 0.05]))
     assert lm.reduction_max == pytest.approx(1 / np.mean([0.10, 0.12, 0.10]))
@@ -52,6 +54,14 @@ def test_switch_optimum_and_levels_of_an_overview():
 def test_no_switch_when_the_highest_level_is_not_apr():
     lm = landmarks([fake_sweep(5.0, [0.05], [0.4]), fake_sweep(9.0, [0.05], [0.3])])
     assert lm.first_apr is None and lm.last_smr == 9.0
+
+
+def test_a_linear_response_is_not_apr():
+    """Without impacts the amplitude does not vary either (cv = 0), but that is the linear branch, not APR."""
+    quiet = fake_sweep(7.4, [0.1, 0.1], [0.0, 0.0])
+    quiet.impacts_samples[:] = 0.0
+    lm = landmarks([quiet])
+    assert lm.apr_samples.tolist() == [0.0] and lm.first_apr is None
 
 
 def test_rolling_mass_factor_is_the_kinetic_energy_of_rolling():
@@ -74,3 +84,16 @@ def test_higher_mode_damping():
     assert np.all(changed.damping_ratios[4:] == 0.002)
     with pytest.raises(SimulationInputError, match="damping of the higher modes"):
         with_higher_mode_damping(model, 1.5)
+
+
+def test_solid_variants_name_their_contact_points():
+    from sim.variants import SOLID_VARIANTS, solid_variant_model
+
+    up = SOLID_VARIANTS["updated-contact+2mm"]
+    left, right = up.wall_points()
+    g = up.geometry
+    assert left[2] == right[2] == pytest.approx(g.contact_height + 0.002)
+    assert right[0] == -left[0] == pytest.approx(0.5 * g.cavity_x)
+    assert all(v.justification for v in SOLID_VARIANTS.values())
+    with pytest.raises(SimulationInputError, match="unknown solid variant 'best'; choose one of beam-neck"):
+        solid_variant_model("best")
