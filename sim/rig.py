@@ -175,8 +175,23 @@ class RigParameters:
         return out
 
 
+class ContactHeights:
+    """The heights a rig geometry derives from its free length, the sphere centre's depth below the free end
+    (`contact_below_top`) and the measurement point's distance below the contact (m)."""
+
+    @property
+    def contact_height(self) -> float:
+        """z of the contact (sphere centre) above the clamped section, the block's top face (m)."""
+        return self.free_length - self.contact_below_top
+
+    @property
+    def measurement_height(self) -> float:
+        """z of the measurement point (accelerometer) below the contact (m)."""
+        return self.contact_height - self.measurement_below_contact
+
+
 @dataclass(frozen=True)
-class RigGeometry:
+class RigGeometry(ContactHeights):
     """Geometry of the seed rig (Sect. 2), SI units; z is measured from the block's top face (the clamped
     section of the beam model). Defaults are the paper's values."""
 
@@ -197,16 +212,6 @@ class RigGeometry:
         """Depth of the sphere centre (contact height) below the free end (m)."""
         half = 0.5 * self.groove_width
         return self.cavity_z - math.sqrt(max(self.sphere_radius**2 - half**2, 0.0))
-
-    @property
-    def contact_height(self) -> float:
-        """z of the contact (sphere centre) above the clamped section (m)."""
-        return self.free_length - self.contact_below_top
-
-    @property
-    def measurement_height(self) -> float:
-        """z of the measurement point (accelerometer), 12 mm below the contact (m)."""
-        return self.contact_height - self.measurement_below_contact
 
     def segments(self, params: RigParameters) -> list[Segment]:
         """Prismatic segments from the clamped section upward, split at the contact and measurement heights."""

@@ -52,7 +52,7 @@ import scipy.sparse.linalg
 
 from sim.errors import SimulationInputError
 from sim.files import to_jsonable
-from sim.rig import JOINT_SPRING_PARAMETERS, NU_STEEL, RHO_STEEL, RigGeometry, damping_ratios
+from sim.rig import JOINT_SPRING_PARAMETERS, NU_STEEL, RHO_STEEL, ContactHeights, RigGeometry, damping_ratios
 from sim.system import ModalModel
 
 INSTALL_HINT = "the 3D solid model needs scikit-fem: pip install '.[solid]'"
@@ -81,7 +81,7 @@ def _require_skfem():
 
 
 @dataclass(frozen=True)
-class SolidGeometry:
+class SolidGeometry(ContactHeights):
     """Dimensions of the rig's host structure for the 3D model (m); see the module docstring.
 
     A zero neck_length, cavity_z, groove_depth or block_edge leaves that feature out; measurement_on_face puts
@@ -154,16 +154,6 @@ class SolidGeometry:
             return 0.0
         return RigGeometry(cavity_z=self.cavity_z, groove_width=self.groove_width,
                            sphere_radius=self.sphere_radius).contact_below_top
-
-    @property
-    def contact_height(self) -> float:
-        """z of the contact points (sphere centre) above the block's top face (m)."""
-        return self.free_length - self.contact_below_top
-
-    @property
-    def measurement_height(self) -> float:
-        """z of the measurement point (m)."""
-        return self.contact_height - self.measurement_below_contact
 
     def wall_point(self, side: str, height: float | None = None) -> np.ndarray:
         """Centre of the left (x < 0) or right inner wall face at `height` (default: the contact height), m;
