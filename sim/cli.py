@@ -41,7 +41,9 @@ def add_modes_arguments(parser: argparse.ArgumentParser) -> None:
                         help="mode shapes of a CalculiX *FREQUENCY job (ASCII .frd; with --mesh JOB.inp and the node "
                              "sets --wall-left, --wall-right, --tip; participation from JOB.dat)")
     parser.add_argument("--variant", default=None, metavar="NAME",
-                        help="updating variant of the built-in rig: joint-spring (default) or effective-modulus")
+                        help="updating variant of the built-in rig: joint-spring (default) or effective-modulus; "
+                             "with --solid a variant of the solid model (sim.variants.SOLID_VARIANTS: beam-neck, "
+                             "updated, updated-400, updated-contact+2mm, updated-contact+4mm)")
     parser.add_argument("--n-modes", dest="n_modes", type=int, default=9, metavar="N",
                         help="x-bending modes to keep (default 9, as the paper; built-in rig, --solid, --from-calculix)")
     solid = parser.add_argument_group("3D solid model (--solid) and CalculiX (--from-calculix)")
@@ -148,21 +150,30 @@ def _external_model(args: argparse.Namespace) -> tuple[Any, dict | None, list[st
     """(model, provenance, report lines) of --solid or --from-calculix."""
     import sys
 
-    if args.variant is not None:
-        raise SimulationInputError("--variant selects a built-in rig model; it cannot be used with --solid or "
-                                   "--from-calculix")
+    if args.variant is not None and not args.solid:
+        raise SimulationInputError("--variant with --from-calculix: the job defines the model; drop --variant")
     if args.solid:
         from sim.solid import MESH_LEVELS, solid_rig_model
+        from sim.variants import SOLID_VARIANTS, solid_variant_model
 
         level = args.mesh or "coarse"
         if level not in MESH_LEVELS:
             raise SimulationInputError(f"--mesh {level!r}: with --solid give a mesh level ({', '.join(MESH_LEVELS)})")
         if not (args.patch_radius >= 0):
             raise SimulationInputError(f"--patch-radius must be >= 0 (m), got {args.patch_radius!r}")
-        geometry, material = _solid_geometry(args.geometry)
+        if args.variant is not None and args.variant not in SOLID_VARIANTS:
+            raise SimulationInputError(f"--variant {args.variant!r} is not a solid-model variant; choose one of "
+                                       f"{', '.join(SOLID_VARIANTS)}")
+        if args.variant is not None and (args.geometry or args.patch_radius):
+            raise SimulationInputError("--variant fixes the solid model's geometry and contact point; drop --geometry "
+                                       "and --patch-radius, or drop --variant")
+        geometry, material = _solid_geometry(args.geometry)  # a bad geometry file: one line before any work
         sys.stderr.write(f"solving the 3D solid model ({level} mesh and a coarser one for the convergence check; "
                          "about 1-3 min) ...\n")
-        result = solid_rig_model(level, geometry, material, n_modes=args.n_modes, patch_radius=args.patch_radius)
+        if args.variant is not None:
+            result = solid_variant_model(args.variant, level, n_modes=args.n_modes)
+        else:
+            result = solid_rig_model(level, geometry, material, n_modes=args.n_modes, patch_radius=args.patch_radius)
         return result.model, result.provenance, result.report
     from sim.calculix import calculix_modal_model
 

@@ -163,7 +163,7 @@ SOLID_VARIANTS: dict[str, SolidVariant] = {
 }
 
 
-def solid_variant_model(name: str, mesh: str | float = "medium", convergence: bool = True):
+def solid_variant_model(name: str, mesh: str | float = "medium", convergence: bool = True, n_modes: int = 9):
     """The modal model of a SOLID_VARIANTS entry (Sect. 3.1, Eq. 7) by sim.solid.solid_rig_model on the quarter
     model (same modes as the full one), with the variant's name and justification in the provenance. Returns a
     sim.solid.SolidResult; medium mesh: about 20 s with the convergence partner."""
@@ -174,8 +174,8 @@ def solid_variant_model(name: str, mesh: str | float = "medium", convergence: bo
     if name not in SOLID_VARIANTS:
         raise SimulationInputError(f"unknown solid variant {name!r}; choose one of {', '.join(SOLID_VARIANTS)}")
     variant = SOLID_VARIANTS[name]
-    result = solid_rig_model(mesh, variant.geometry, wall_points=variant.wall_points(), convergence=convergence,
-                             symmetry="quarter")
+    result = solid_rig_model(mesh, variant.geometry, n_modes=n_modes, wall_points=variant.wall_points(),
+                             convergence=convergence, symmetry="quarter")
     provenance = dict(result.provenance, variant=name, justification=variant.justification,
                       contact_offset_m=variant.contact_offset)
     model = replace(result.model, source=f"{result.model.source}, variant {name}")

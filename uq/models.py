@@ -68,6 +68,7 @@ class IESModel:
     n_modes: int = 9
     name: str = "ies"
     modal_file: str | None = None
+    variant: Mapping[str, float] = field(default_factory=dict)
     rig: Any = field(default=None, compare=False, repr=False)
 
 
@@ -109,15 +110,27 @@ class IESModel:
         self._rig()
 
     def _rig(self):
-        if self.modal_file is None:
-            return _rig_model(self.n_modes)
         from sim.errors import SimulationInputError
         from sim.modal_file import load_modal_model
+        from sim.variants import with_higher_mode_damping
 
         try:
-            return load_modal_model(self.modal_file)
+            rig = _rig_model(self.n_modes) if self.modal_file is None else load_modal_model(self.modal_file)
         except SimulationInputError as exc:
             raise StudyError(f"[study] modal_model: {exc}") from None
+        if "higher_mode_damping" in self.variant:
+            try:
+                rig = with_higher_mode_damping(rig, self.variant["higher_mode_damping"])
+            except SimulationInputError as exc:
+                raise StudyError(f"[variant] {exc}") from None
+        return rig
+
+    def _impactor(self, params: Mapping[str, float]):
+        """The sphere of Eqs. 3-6 with this run's g and k_H, its mass scaled by [variant] sphere_mass_factor."""
+        from sim.system import SPHERE_MASS, Impactor
+
+        mass = SPHERE_MASS * self.variant.get("sphere_mass_factor", 1.0)
+        return Impactor(mass=mass, clearance=params["g"], k_H=params["k_H"])
 
     def warm_up(self) -> None:
         """Compile the integrator's kernels in this process (`sim.integrators.warm_up`; minutes on a first run)."""
@@ -133,6 +146,8 @@ class IESModel:
         """Settings that define a task's computation (part of its cache key; the built-in rig is covered by
         version, a modal file by its content)."""
         out = {"class": type(self).__name__, "protocol": dict(self.protocol), "n_modes": self.n_modes}
+        if self.variant:
+            out["variant"] = dict(self.variant)
         if self.modal_file is not None:
             out["modal_model_sha256"] = hashlib.sha256(Path(self.modal_file).read_bytes()).hexdigest()
         return out
@@ -140,12 +155,10 @@ class IESModel:
     def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, Any]:
         """One run: its own resonant levels (outputs) and the per-point measures (trace) for aggregation."""
         from sim.protocol import aggregate_runs, run_sweep
-        from sim.system import Impactor
 
         rig = self.rig if self.rig is not None else self._rig()
         model = rig.with_damping(params["D"])
-        impactor = Impactor(clearance=params["g"], k_H=params["k_H"])
-        run = run_sweep(model, impactor, level, self._stepped_sine(), seed=seed, rep=rep)
+        run = run_sweep(model, self._impactor(params), level, self._stepped_sine(), seed=seed, rep=rep)
         own = aggregate_runs([run])
         trace = {key: getattr(run, key).tolist() for key in _TRACE}
         trace.update(level=run.level, a_base=run.a_base, a_noabs=run.a_noabs, seed=run.seed, rep=run.rep)
@@ -283,11 +296,12 @@ class FunctionModel:
 
 
 def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, parameters: tuple[str, ...] = (),
-               modal_model: str | Path | None = None) -> Any:
+               modal_model: str | Path | None = None, variant: Mapping[str, float] | None = None) -> Any:
     """The model named by a study's ``model`` key ("ies", "ishigami" or "module:function"); modal_model: a
-    modal-model file replacing the built-in rig of "ies"."""
+    modal-model file replacing the built-in rig of "ies"; variant: the [variant] table of "ies"."""
     if spec == "ies":
-        return IESModel(dict(protocol or {}), modal_file=None if modal_model is None else str(modal_model))
+        return IESModel(dict(protocol or {}), modal_file=None if modal_model is None else str(modal_model),
+                        variant=dict(variant or {}))
     if spec == "ishigami":
         return IshigamiModel()
     if ":" in spec:

@@ -12,6 +12,10 @@ Layout (every table and key is optional except where noted; SI units)::
     repetitions = 5
     output = "results/fig7"      # default output folder (`--out` overrides), relative to the cwd
 
+    [variant]                    # optional, model "ies": modelling choices the paper leaves open (README,
+    sphere_mass_factor = 1.537   # "Fidelity"): the sphere's effective mass in x over m_a (rolling: 1.4 on a
+    higher_mode_damping = 0.001  # flat floor, 1.537 on the groove's edges); the damping ratio of modes 5..N
+
     [parameters.D]               # listed parameters are varied; unlisted ones stay nominal.
     nominal = 0.00085            # missing keys default to Table 2 (model "ies")
     min = 0.00075
@@ -68,6 +72,7 @@ RESPONSE_FIGURES = ("fig5", "fig6")
 DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
     "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output"},
+    "variant": {"sphere_mass_factor", "higher_mode_damping"},
     "parameters": None,  # one sub-table per parameter
     "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "perturb", "repetition",
                    "start", "dt_scale"},
@@ -101,10 +106,11 @@ class Study:
     source: str = ""
     modal_model: Path | None = None
     figures: tuple[str, ...] = RESPONSE_FIGURES
+    variant: Mapping[str, float] = field(default_factory=dict)
 
     def make_model(self) -> Any:
         return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
-                          modal_model=self.modal_model)
+                          modal_model=self.modal_model, variant=self.variant)
 
     def to_dict(self) -> dict:
         """The resolved study as plain data (written to the results' metadata)."""
@@ -115,7 +121,7 @@ class Study:
             "levels": list(self.levels), "protocol": dict(self.protocol), "parameters": self.space.to_dict(),
             "interval": {"designs": list(self.designs), "interior": self.interior, "z": self.z, "fix": dict(self.fix)},
             "sobol": {"n": self.sobol_n, "bootstrap": self.bootstrap, "confidence": self.confidence},
-            "response": {"figures": list(self.figures)},
+            "response": {"figures": list(self.figures)}, "variant": dict(self.variant),
         }
 
 
@@ -181,6 +187,12 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
             raise StudyError(f"[study] modal_model must be the path of a modal-model file (`ies modes --save`), got {modal_model!r}")
         modal_model = base_dir / modal_model
 
+    variant = {key: float(_number("variant", key, value)) for key, value in data.get("variant", {}).items()}
+    if variant and model_spec != "ies":
+        raise StudyError("[variant] only applies to model = \"ies\" (the simulator)")
+    if not 0 < variant.get("higher_mode_damping", 0.5) < 1:
+        raise StudyError(f"[variant] higher_mode_damping must lie in (0, 1), got {variant['higher_mode_damping']}")
+
     space = _parse_parameters(data.get("parameters"), model_spec, base_dir, source)
 
     exc = dict(data.get("excitation", {}))
@@ -224,9 +236,9 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError("a response study runs the simulator: model = \"ies\"")
 
     study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
-                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures))
+                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures), variant)
     model = study.make_model()  # unknown model -> one line now
-    if modal_model is not None:
+    if modal_model is not None or variant:
         model.check()  # an unreadable modal file -> one line now
     return study
 

@@ -139,13 +139,26 @@ def test_solid_model_of_a_small_beam_through_the_cli(tmp_path, capsys):
     assert (tmp_path / "short-rig.toml").is_file()
 
 
+def test_solid_variant_through_the_cli(tmp_path, capsys):
+    """A named solid variant (sim.variants.SOLID_VARIANTS) saves its name, justification and contact offset."""
+    pytest.importorskip("skfem")
+    path = tmp_path / "rig3d.toml"
+    assert main(["modes", "--solid", "--variant", "updated-contact+2mm", "--json", "--save", str(path)]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["provenance"]["variant"] == "updated-contact+2mm"
+    assert data["provenance"]["contact_offset_m"] == 0.002 and "2 mm above" in data["provenance"]["justification"]
+    assert "variant updated-contact+2mm" in data["source"] and path.is_file()
+
+
 @pytest.mark.parametrize("args, message", [
     (["--from-calculix", "missing.frd", *JOB[2:]], "missing.frd"),
     ([*JOB[:5], "NOPE", *JOB[6:]], "node set 'NOPE' is not defined"),
     (JOB[:2], "--from-calculix also needs --mesh JOB.inp, --wall-left, --wall-right, --tip"),
     (["--solid", "--mesh", "huge"], "with --solid give a mesh level"),
     (["--mesh", "coarse"], "belong to --solid or --from-calculix"),
-    (["--solid", "--variant", "joint-spring"], "cannot be used with --solid"),
+    (["--solid", "--variant", "joint-spring"], "'joint-spring' is not a solid-model variant; choose one of beam-neck"),
+    (["--solid", "--variant", "updated", "--patch-radius", "0.001"], "--variant fixes the solid model's geometry"),
+    ([*JOB, "--variant", "updated"], "the job defines the model; drop --variant"),
     (["--n-modes", "0"], "--n-modes must lie in 1..30"),
 ])
 def test_bad_solid_and_calculix_input_one_line_exit_2_nothing_written(tmp_path, capsys, args, message):

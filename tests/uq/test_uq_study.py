@@ -74,6 +74,10 @@ def test_resolved_study_lists_every_setting(tmp_path):
     (MINIMAL.replace("kind", "modal_model = 'none.toml'\nkind"), "modal file"),
     (MINIMAL.replace("kind", "modal_model = 3\nkind"), "modal_model must be the path"),
     ("[study]\nkind = 'interval'\nmodel = 'ishigami'\nmodal_model = 'm.toml'\n", "only applies to model"),
+    (MINIMAL + "[variant]\nhigher_mode_damping = 1.5\n", "higher_mode_damping must lie in (0, 1)"),
+    (MINIMAL + "[variant]\nsphere_mass_factor = -1\n", "sphere_mass_factor must be positive"),
+    (MINIMAL + "[variant]\nspin = 1\n", "unknown key 'spin' in [variant]"),
+    ("[study]\nkind = 'interval'\nmodel = 'ishigami'\n[variant]\nsphere_mass_factor = 1.4\n", "only applies to model"),
 ])
 def test_bad_study_is_one_line_exit_2(tmp_path, capsys, extra, message):
     path = write(tmp_path, extra)
@@ -141,6 +145,26 @@ def test_a_modal_model_file_replaces_the_built_in_rig(tmp_path):
     key = b.describe()["modal_model_sha256"]
     (tmp_path / "rig.toml").write_text((tmp_path / "rig.toml").read_text().replace("0.00085", "0.0009", 1))
     assert own.make_model().describe()["modal_model_sha256"] != key
+
+
+def test_variant_table_changes_the_sphere_mass_and_the_higher_modes_damping(tmp_path):
+    """[variant] sphere_mass_factor scales m_a, higher_mode_damping sets D of modes 5..N; both enter the task key,
+    and a study without [variant] keeps its key (cached results stay valid)."""
+    from sim.rig import seed_rig_model
+    from sim.system import SPHERE_MASS
+
+    tiny = ("[study]\nkind = 'response'\n{}[excitation]\nlevels = [7.4]\n"
+            "eta = {{ start = 0.975, stop = 0.98, n = 2 }}\nwait = 0.05\nhold = 0.1\n")
+    plain = load_study(write(tmp_path, tiny.format(""), "plain.toml")).make_model()
+    varied = load_study(write(tmp_path, tiny.format("[variant]\nsphere_mass_factor = 1.4\nhigher_mode_damping = 0.004\n"),
+                              "varied.toml")).make_model()
+    assert "variant" not in plain.describe() and varied.describe()["variant"] == {
+        "sphere_mass_factor": 1.4, "higher_mode_damping": 0.004}
+    params = {"D": 0.00085, "g": 0.58e-3, "k_H": K_H_STAR}
+    assert varied._impactor(params).mass == pytest.approx(1.4 * SPHERE_MASS)
+    builtin = seed_rig_model(n_modes=9).damping_ratios
+    damping = varied.with_rig().rig.damping_ratios
+    assert np.all(damping[4:] == 0.004) and np.array_equal(damping[:4], builtin[:4])
 
 
 def test_reproduce_with_a_bad_modal_model_writes_nothing(tmp_path, capsys):
