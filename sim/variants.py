@@ -10,6 +10,7 @@ Landmarks of the paper (Sect. 5.3, Fig. 6, Appendix B):
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -102,6 +103,21 @@ def landmarks(results: Sequence) -> Landmarks:
         regime=regime, apr_samples=np.array(apr_samples), impacts_at_apr_eta=np.array(impacts),
         first_apr=first_apr, last_smr=last_smr, optimum_level=float(levels[best]),
         reduction_mean=1.0 / float(mean[best]), reduction_max=1.0 / float(mx[best]))
+
+
+def switch_line(summary: dict) -> str:
+    """One line on the switch to the almost periodic response of `Landmarks.summary()` next to the paper's."""
+    last, first = summary["last_smr"], summary["first_apr"]
+    if first is None:
+        where = "no switch to APR: most repetition samples are not APR at the highest level"
+    elif last is None:
+        where = f"APR from the lowest level ({first:g}) on"
+    else:
+        where = f"switch from SMR to APR between a_base/a_base* = {last:g} and {first:g}"
+    at_7_4 = summary.get("resonant_mean_7.4")  # NaN (None in JSON) when 7.4 is not among the levels
+    level = "" if at_7_4 is None or math.isnan(at_7_4) else f"; resonant mean level at 7.4: {at_7_4:.3f}"
+    return (f"{where} (by the majority of repetition samples){level}; the paper: switch and optimum at "
+            f"{PAPER_OPTIMUM_LEVEL:g}, APR level at 7.4 {PAPER_APR_LEVEL[0]:g}-{PAPER_APR_LEVEL[1]:g} (Appendix B)")
 
 
 def rolling_mass_factor(sphere_radius: float, support_half_width: float = 0.0) -> float:

@@ -175,10 +175,15 @@ def print_response_result(folder: Path, name: str) -> None:
 
     from sim.tables import optimum_line, overview_text
 
-    overview = json.loads((folder / "study.json").read_text())["overview"]
+    from sim.variants import switch_line
+
+    data = json.loads((folder / "study.json").read_text())
+    overview = data["overview"]
     print(f"{name}: resonant levels (a / a_noabs*) of the nominal point:")
     print(overview_text(overview))
     print(f"{name}: {optimum_line(overview)}")
+    if "landmarks" in data:
+        print(f"{name}: {switch_line(data['landmarks'])}")
 
 
 # ---- ies reproduce ------------------------------------------------------------------------------------------

@@ -313,6 +313,7 @@ def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     amplitude per eta with the spread of the runs, Sect. 5.2) and its resonant levels (Sect. 5.3), every
     stepped-sine run a task of the store (resumable, parallel, on a cluster)."""
     from sim.tables import OVERVIEW_COLUMNS, SWEEP_COLUMNS, overview_data, overview_rows, sweep_rows
+    from sim.variants import landmarks
 
     model = _checked_model(study)
     point = study.space.nominal()
@@ -342,5 +343,6 @@ def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     result.files.append(write_csv(folder / "overview.csv", OVERVIEW_COLUMNS, overview_rows(overview)))
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
                       "wall_time_s": elapsed, "points": 1}
-    result.files.append(_metadata(study, model, result, {"summary": result.summary, "overview": overview}))
+    result.files.append(_metadata(study, model, result, {"summary": result.summary, "overview": overview,
+                                                         "landmarks": landmarks(sweeps).summary()}))
     return result

@@ -97,3 +97,12 @@ def test_solid_variants_name_their_contact_points():
     assert all(v.justification for v in SOLID_VARIANTS.values())
     with pytest.raises(SimulationInputError, match="unknown solid variant 'best'; choose one of beam-neck"):
         solid_variant_model("best")
+
+
+def test_switch_line_names_the_switch_and_the_papers_landmarks():
+    from sim.variants import switch_line
+
+    line = switch_line({"last_smr": 5.3, "first_apr": 5.5, "resonant_mean_7.4": 0.3641})
+    assert "between a_base/a_base* = 5.3 and 5.5" in line and "0.364" in line and "6.7" in line
+    assert "no switch" in switch_line({"last_smr": 9.0, "first_apr": None, "resonant_mean_7.4": None})
+    assert "from the lowest level (4.5)" in switch_line({"last_smr": None, "first_apr": 4.5})
