@@ -17,8 +17,7 @@ from typing import Any, Mapping, Sequence
 from sim.files import plot_to, save_figure
 from sim.redraw import PlotOptions, register, selected
 
-#: the paper's optimum (Sect. 5.3): a_base/a_base* ~ 6.7, resonant max reduced 10x, mean 20x
-PAPER_OPTIMUM = 6.7
+from sim.variants import PAPER_APR_LEVEL, PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, PAPER_REDUCTION_MEAN
 
 
 def draw_sweep(ax: Any, data: Mapping[str, Any], title: str) -> None:
@@ -68,7 +67,8 @@ def draw_overview(ax: Any, data: Mapping[str, Any], title: str, *, paper_optimum
     """Fig. 6 on `ax`: the resonant mean (solid) and max (dashed) level vs the excitation level, each with the
     range of its repetition samples at the resonant eta as error bars, the regime of each level (APR, SMR,
     linear: `sim.measures.classify_regime` through the aggregation) above the axes, this model's optimum (the
-    lowest resonant mean) and, with `paper_optimum`, the paper's (a_base/a_base* ~ 6.7, Sect. 5.3)."""
+    lowest resonant mean) and, with `paper_optimum`, the paper's landmarks: the optimum (a_base/a_base* ~ 6.7 with its
+    mean and max levels, Sect. 5.3) and the almost periodic level at 7.4 (Appendix B)."""
     import numpy as np
 
     levels = np.asarray(data["levels"], dtype=float)
@@ -86,8 +86,16 @@ def draw_overview(ax: Any, data: Mapping[str, Any], title: str, *, paper_optimum
                label=f"optimum of this model ({levels[best]:g}: mean /{1 / data['resonant_mean'][best]:.0f}, "
                      f"max /{1 / data['resonant_max'][best]:.0f})")
     if paper_optimum:
-        ax.axvline(PAPER_OPTIMUM, color="k", lw=1, ls="-.", alpha=0.6,
-                   label=f"paper's optimum ({PAPER_OPTIMUM:g}: mean /20, max /10)")
+        from matplotlib.patches import Rectangle
+
+        ax.axvline(PAPER_OPTIMUM_LEVEL, color="k", lw=1, ls="-.", alpha=0.6,
+                   label=f"paper's optimum ({PAPER_OPTIMUM_LEVEL:g}: mean /{PAPER_REDUCTION_MEAN:g}, "
+                         f"max /{PAPER_REDUCTION_MAX:g}, stars)")
+        ax.plot([PAPER_OPTIMUM_LEVEL] * 2, [1 / PAPER_REDUCTION_MEAN, 1 / PAPER_REDUCTION_MAX], "k*", ms=8)
+        ax.add_patch(Rectangle((7.2, PAPER_APR_LEVEL[0]), 0.4, PAPER_APR_LEVEL[1] - PAPER_APR_LEVEL[0],
+                                facecolor="0.6", alpha=0.5,
+                                label=f"paper's almost periodic level at 7.4 ({PAPER_APR_LEVEL[0]:g}-"
+                                      f"{PAPER_APR_LEVEL[1]:g}, App. B)"))
     ax.set_xlabel(r"$a_{base} / a^*_{base}$")
     ax.set_ylabel(r"resonant level $a / a^{noabs*}$")
     ax.set_ylim(bottom=0)
@@ -99,7 +107,7 @@ def plot_overview(data: Mapping[str, Any], path: str | os.PathLike, title: str, 
     """Fig. 6, written to `path`."""
     with plot_to(path, figsize=(6.5, 4.4)) as (fig, ax):
         draw_overview(ax, data, title, paper_optimum=paper_optimum)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="upper left")  # the low SMR levels leave that corner free
 
 
 def sweep_title(data: Mapping[str, Any]) -> str:
