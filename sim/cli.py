@@ -5,6 +5,7 @@
 * `ies sweep`: a stepped-sine frequency response like Fig. 5 (Sects. 5.1, 5.2).
 * `ies overview`: the resonant response level against the excitation level, like Fig. 6 (Sect. 5.3).
 * `ies trace`: time histories of one stepped-sine point, like Figs. 4 and 9a (Sects. 5.1, 5.5; `sim.trace`).
+* `ies impacts`, `ies modal-fit`: the analyses of measured or simulated signals (`sim.signal_cli`).
 
 `add_commands(subparsers)` (at the end) registers them with the front door (`uq.cli`), which only dispatches. Heavy
 imports (numpy, numba) stay inside the functions, so that `ies --help` stays fast. Every bad value ends in
@@ -19,6 +20,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
+from sim import signal_cli
 from sim.errors import SimulationInputError
 from sim.options import clearance, figure_file, hertz_constant, positive_int
 
@@ -561,11 +563,13 @@ def trace_command(args: argparse.Namespace) -> int:
 COMMANDS = (("modes", MODES_HELP, add_modes_arguments, modes_command),
             ("sweep", SWEEP_HELP, add_sweep_arguments, sweep_command),
             ("overview", OVERVIEW_HELP, add_overview_arguments, overview_command),
-            ("trace", TRACE_HELP, add_trace_arguments, trace_command))
+            ("trace", TRACE_HELP, add_trace_arguments, trace_command),
+            ("impacts", signal_cli.IMPACTS_HELP, signal_cli.add_impacts_arguments, signal_cli.impacts_command),
+            ("modal-fit", signal_cli.MODAL_FIT_HELP, signal_cli.add_modal_fit_arguments, signal_cli.modal_fit_command))
 
 
 def add_commands(subparsers: Any) -> None:
-    """Register `modes`, `sweep`, `overview` and `trace` (COMMANDS) on the front door's subparsers (argparse)."""
+    """Register `modes`, `sweep`, `overview`, `trace`, `impacts` and `modal-fit` (COMMANDS) on the front door's subparsers (argparse)."""
     for name, help_text, add_arguments, run in COMMANDS:
         parser = subparsers.add_parser(name, help=help_text, description=help_text)
         add_arguments(parser)
