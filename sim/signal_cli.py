@@ -73,7 +73,7 @@ def simulator_check(path: str, times: Any) -> dict[str, Any] | None:
         check["warning"] = (f"{100 * false:.0f} % of the impacts are not within {1e3 * MATCH_TOLERANCE:g} ms of a "
                             "contact of the simulator (f_left, f_right columns): the high-pass passes a lightly damped "
                             "mode close to its cut-off (the built-in rig's mode 9 at 19.83 kHz rings through 20 kHz); "
-                            "raise --highpass above the model's highest mode (e.g. 21000)")
+                            "raise --highpass clear of the model's highest mode (22000 for the rig)")
     return check
 
 
