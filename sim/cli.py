@@ -337,6 +337,14 @@ def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     return model, (None if args.no_impactor else impactor)
 
 
+def system_data(model: Any, impactor: Any) -> dict:
+    """The JSON keys of the simulated system: `model` (its source), `impactor` (`mass_kg`, `g_m`,
+    `k_H_N_per_m1p5`; None without impactor) and `D1` (damping ratio of mode 1)."""
+    return {"model": model.source, "D1": float(model.damping_ratios[0]),
+            "impactor": None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
+                                                       "k_H_N_per_m1p5": impactor.k_H}}
+
+
 def build_protocol(args: argparse.Namespace) -> Any:
     """The `sim.protocol.SteppedSine` of the protocol options (Sect. 5.1; 15 s wait without impactor)."""
     from sim.protocol import SteppedSine
@@ -428,10 +436,7 @@ def sweep_command(args: argparse.Namespace) -> int:
     level = check_level(args.level)
     with simulation(args, [level], label=f"sweep {level:g}") as (folder, protocol, model, impactor, (result,)):
         data = result.to_dict()
-        data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps, model=model.source,
-                    impactor=None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
-                                                            "k_H_N_per_m1p5": impactor.k_H},
-                    D1=float(model.damping_ratios[0]))
+        data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps, **system_data(model, impactor))
         written = write_results(folder, "sweep", SWEEP_COLUMNS, sweep_rows(result), data)
     if args.plot:
         plot_sweep(data, args.plot, sweep_title(data))
@@ -527,11 +532,8 @@ def trace_command(args: argparse.Namespace) -> int:
     with output_folder(args.out) as folder:
         warm_up(protocol.integrator)
         trace = record_trace(model, impactor, level, protocol, periods=args.periods, fs=args.fs, seed=args.seed)
-        settings = {"model": model.source, "integrator": protocol.integrator, "seed": args.seed,
-                    "protocol": dataclasses.asdict(protocol), "fs_requested": args.fs,
-                    "impactor": None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
-                                                               "k_H_N_per_m1p5": impactor.k_H},
-                    "D1": float(model.damping_ratios[0])}
+        settings = {"integrator": protocol.integrator, "seed": args.seed, "protocol": dataclasses.asdict(protocol),
+                    "fs_requested": args.fs, **system_data(model, impactor)}
         data = trace_data(trace, settings)
         written: list[Path | str] = []
         try:
