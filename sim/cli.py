@@ -1,9 +1,11 @@
-"""The simulation stage's words of the `ies` command line: `modes`, `sweep`, `overview`.
+"""The simulation stage's words of the `ies` command line: `modes`, `sweep`, `overview`, `trace`.
 
 * `ies modes`: the modal model of the host structure (seed paper Sect. 3.1, Eq. 7, Appendix A), the built-in
   model of the seed rig (`sim.rig`) or a modal-model file (`sim.modal_file`); --save writes it as a file.
 * `ies sweep`: a stepped-sine frequency response like Fig. 5 (Sects. 5.1, 5.2).
 * `ies overview`: the resonant response level against the excitation level, like Fig. 6 (Sect. 5.3).
+* `ies trace`: time histories of one stepped-sine point, like Figs. 4 and 9a (Sects. 5.1, 5.5; `sim.trace`).
+* `ies impacts`, `ies modal-fit`: the analyses of measured or simulated signals (`sim.signal_cli`).
 
 `add_commands(subparsers)` (at the end) registers them with the front door (`uq.cli`), which only dispatches. Heavy
 imports (numpy, numba) stay inside the functions, so that `ies --help` stays fast. Every bad value ends in
@@ -12,17 +14,21 @@ one `SimulationInputError` line.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import time
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
+from sim import signal_cli
 from sim.errors import SimulationInputError
 from sim.options import clearance, figure_file, hertz_constant, positive_int
 
 MODES_HELP = "modal model of the host structure: frequencies, damping, mode values, participation (built-in rig or file)"
 SWEEP_HELP = "stepped-sine frequency response (mean and max amplitude per eta, spread over repetitions; Fig. 5)"
 OVERVIEW_HELP = "resonant response level (largest mean and max over eta) vs excitation level a_base/a_base* (Fig. 6)"
+TRACE_HELP = ("time histories of one stepped-sine point sampled at --fs: tip, walls, sphere, accelerations, contact "
+              "forces (CSV + JSON; Figs. 4, 9a)")
 
 SEQUENCE_CHOICES = ("up", "down", "up-down-up", "up-down-up-down-up")
 
@@ -236,12 +242,20 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int) -> None:
-    """Stepped-sine options (Sect. 5.1)."""
+    """Stepped-sine options (Sect. 5.1) of a sweep: the grid, the run's options and the repetitions."""
     parser.add_argument("--eta", default="0.96:1.02:31", metavar="START:STOP:N",
                         help="grid of eta = Omega/omega_1 (default 0.96:1.02:31)")
-    parser.add_argument("--sequence", default="up", choices=SEQUENCE_CHOICES, help="sweep legs per run (default up)")
+    add_run_arguments(parser)
     parser.add_argument("--repetition", default="leg", choices=("leg", "run"),
                         help="what counts as one repetition: each leg (the experiment's counting, default) or each run from rest")
+    parser.add_argument("--reps", type=positive_int, default=default_reps, metavar="N",
+                        help=f"stepped-sine runs, each from the initial conditions of --start with its own random "
+                             f"perturbation (--perturb) (default {default_reps})")
+
+
+def add_run_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of one stepped-sine run (Sect. 5.1): sequence, start, wait, hold, randomness, integrator."""
+    parser.add_argument("--sequence", default="up", choices=SEQUENCE_CHOICES, help="sweep legs per run (default up)")
     parser.add_argument("--start", default="base-velocity", choices=("base-velocity", "rest"),
                         help="initial conditions of each run: homogeneous relative ICs under the sine excitation, "
                              "the sphere starting with the base's peak velocity so it rattles from the first point "
@@ -250,9 +264,6 @@ def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int
     parser.add_argument("--wait", type=float, default=None, metavar="S",
                         help="wait time per frequency in s (default 3, or 15 with --no-impactor, Sect. 5.1)")
     parser.add_argument("--hold", type=float, default=5.0, metavar="S", help="hold time per frequency in s (default 5)")
-    parser.add_argument("--reps", type=positive_int, default=default_reps, metavar="N",
-                        help=f"stepped-sine runs, each from the initial conditions of --start with its own random "
-                             f"perturbation (--perturb) (default {default_reps})")
     parser.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
     parser.add_argument("--perturbation", type=float, default=5e-4, metavar="REL",
                         help="half-width of the uniform random relative frequency offset (default 5e-4)")
@@ -337,6 +348,14 @@ def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     return model, (None if args.no_impactor else impactor)
 
 
+def system_data(model: Any, impactor: Any) -> dict:
+    """The JSON keys of the simulated system: `model` (its source), `impactor` (`mass_kg`, `g_m`,
+    `k_H_N_per_m1p5`; None without impactor) and `D1` (damping ratio of mode 1)."""
+    return {"model": model.source, "D1": float(model.damping_ratios[0]),
+            "impactor": None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
+                                                       "k_H_N_per_m1p5": impactor.k_H}}
+
+
 def build_protocol(args: argparse.Namespace) -> Any:
     """The `sim.protocol.SteppedSine` of the protocol options (Sect. 5.1; 15 s wait without impactor)."""
     from sim.protocol import SteppedSine
@@ -344,7 +363,8 @@ def build_protocol(args: argparse.Namespace) -> Any:
     start, stop, n = parse_grid(args.eta, "--eta")
     wait = args.wait if args.wait is not None else (15.0 if args.no_impactor else 3.0)
     return SteppedSine(eta_start=start, eta_stop=stop, n_eta=n, sequence=args.sequence, wait=wait,
-                       hold=args.hold, perturbation=args.perturbation, perturb=args.perturb, repetition=args.repetition,
+                       hold=args.hold, perturbation=args.perturbation, perturb=args.perturb,
+                       repetition=getattr(args, "repetition", "leg"),
                        integrator=args.integrator, dt_scale=args.dt_scale, start=args.start)
 
 
@@ -439,10 +459,7 @@ def sweep_command(args: argparse.Namespace) -> int:
     level = check_level(args.level)
     with simulation(args, [level], label=f"sweep {level:g}") as (folder, protocol, model, impactor, (result,)):
         data = result.to_dict()
-        data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps, model=model.source,
-                    impactor=None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
-                                                            "k_H_N_per_m1p5": impactor.k_H},
-                    D1=float(model.damping_ratios[0]))
+        data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps, **system_data(model, impactor))
         written = write_results(folder, "sweep", SWEEP_COLUMNS, sweep_rows(result), data)
     lines = [f"# a_base/a_base* = {level:g}: {result.n_runs} runs, {result.n_samples} samples, "
              f"{protocol.integrator}, {data['wall_time_s']:.1f} s",
@@ -479,15 +496,88 @@ def overview_command(args: argparse.Namespace) -> int:
                   overview_text(data))
 
 
+# ---- ies trace ----------------------------------------------------------------------------------------------
+
+def add_trace_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies trace`."""
+    from sim.trace import DEFAULT_FS, DEFAULT_PERIODS
+
+    parser.add_argument("--level", type=float, required=True, metavar="L", help="excitation level a_base/a_base* (-)")
+    parser.add_argument("--eta", required=True, metavar="ETA|START:STOP:N",
+                        help="eta = Omega/omega_1 of the traced point, or a grid: the run visits it as ies sweep does "
+                             "(--sequence) and traces its last point")
+    parser.add_argument("--periods", type=positive_int, default=DEFAULT_PERIODS, metavar="N",
+                        help=f"excitation periods recorded from the start of the traced point's hold (default "
+                             f"{DEFAULT_PERIODS})")
+    parser.add_argument("--fs", type=float, default=DEFAULT_FS, metavar="HZ",
+                        help=f"sampling rate in Hz (default {DEFAULT_FS:g}, the paper's); rounded to a whole number "
+                             "of samples per excitation period (the JSON's fs is the rate used)")
+    add_run_arguments(parser)
+    add_system_arguments(parser)
+    parser.add_argument("--out", required=True, metavar="DIR", help="write trace.csv (the signals) and trace.json")
+    parser.add_argument("--json", action="store_true", help="print trace.json's object")
+    parser.add_argument("--plot", type=figure_file, metavar="FILE",
+                        help="write Figs. 4 (tip response, amplitudes, mean and max) and 9a (tip velocity, impacts) "
+                             "as two panels of one figure")
+
+
+def trace_command(args: argparse.Namespace) -> int:
+    """`ies trace`: time histories of one stepped-sine point (Sects. 5.1, 5.5; Figs. 4, 9a)."""
+    from sim.figures import plot_trace
+    from sim.files import dumps, report_written, write_csv, write_text
+    from sim.integrators import warm_up
+    from sim.protocol import check_level
+    from sim.trace import COLUMNS, record_trace, trace_data, trace_rows
+
+    started = time.perf_counter()
+    level = check_level(args.level)
+    protocol = build_protocol(args)
+    model, impactor = build_system(args)
+    if args.plot and not Path(args.plot).resolve().parent.is_dir():
+        raise SimulationInputError(f"--plot {args.plot}: folder {Path(args.plot).parent} does not exist")
+    with output_folder(args.out) as folder:
+        warm_up(protocol.integrator)
+        trace = record_trace(model, impactor, level, protocol, periods=args.periods, fs=args.fs, seed=args.seed)
+        settings = {"integrator": protocol.integrator, "seed": args.seed, "protocol": dataclasses.asdict(protocol),
+                    "fs_requested": args.fs, **system_data(model, impactor)}
+        data = trace_data(trace, settings)
+        written: list[Path | str] = []
+        try:
+            written.append(write_csv(folder / "trace.csv", COLUMNS, trace_rows(trace)))
+            data["wall_time_s"] = time.perf_counter() - started
+            written.append(write_text(folder / "trace.json", dumps(data) + "\n"))
+            if args.plot:
+                plot_trace(data, trace.signal.t, trace.signal["q_tip"], trace.signal["v_tip"], args.plot)
+                written.append(args.plot)
+        except BaseException:
+            for path in written:  # all or nothing
+                Path(path).unlink(missing_ok=True)
+            raise
+    if args.json:
+        print(dumps(data))
+        report_written(written, json_mode=True)
+        return 0
+    print(f"# a_base/a_base* = {level:g}, eta = {trace.eta_actual:.5f} ({protocol.integrator}): {trace.amplitudes.size} "
+          f"periods at fs = {trace.fs:.1f} Hz ({trace.samples_per_period} samples per period; requested {args.fs:g} Hz), "
+          f"{data['wall_time_s']:.1f} s")
+    print(f"a/a_noabs*: mean {data['mean']:.4f}, max {data['max']:.4f}, cv {data['cv']:.3f}; "
+          f"{data['impacts_per_period']:.2f} contact onsets per period, {len(data['impacts'])} impacts between samples")
+    report_written(written)
+    return 0
+
+
 # ---- registration with the front door -------------------------------------------------------------------------
 
 COMMANDS = (("modes", MODES_HELP, add_modes_arguments, modes_command),
             ("sweep", SWEEP_HELP, add_sweep_arguments, sweep_command),
-            ("overview", OVERVIEW_HELP, add_overview_arguments, overview_command))
+            ("overview", OVERVIEW_HELP, add_overview_arguments, overview_command),
+            ("trace", TRACE_HELP, add_trace_arguments, trace_command),
+            ("impacts", signal_cli.IMPACTS_HELP, signal_cli.add_impacts_arguments, signal_cli.impacts_command),
+            ("modal-fit", signal_cli.MODAL_FIT_HELP, signal_cli.add_modal_fit_arguments, signal_cli.modal_fit_command))
 
 
 def add_commands(subparsers: Any) -> None:
-    """Register `modes`, `sweep` and `overview` (COMMANDS) on the front door's subparsers (argparse)."""
+    """Register `modes`, `sweep`, `overview`, `trace`, `impacts` and `modal-fit` (COMMANDS) on the front door's subparsers (argparse)."""
     for name, help_text, add_arguments, run in COMMANDS:
         parser = subparsers.add_parser(name, help=help_text, description=help_text)
         add_arguments(parser)

@@ -32,11 +32,15 @@ quadratically onto the first onset (or certifies the step). Grazes with indentat
 Contact: from the located onset, exponential Gauss collocation (`sim.collocation`: the modes and the
 sphere exact, the Hertz force at 10 nodes per step, two to four steps per impact, the last one ending
 exactly at the release; rebound errors ~1e-10). Where that cannot go on (a contact crossing the end of a
-period or a record instant, a force it does not resolve, about 2 % of the contacts in the rig's sweeps)
+period, a force it does not resolve, about 2 % of the contacts in the rig's sweeps)
 an embedded Dormand-Prince 5(4) step with error control on all modal states (`sim.dopri5`, scaled to m
 of wall/tip displacement, tolerance rtol) takes over; its release is located by Newton iteration on the
 length of the last step (|c| < GAP_TOLERANCE * g). Chattering is handled because every release is followed by the same
 certified free-flight search.
+
+Recorded states (the `record` of the integrator contract) are observers: in free flight the closed-form
+state at the record instant, inside a contact a copy of the contact's starting state advanced by
+Dormand-Prince steps to each record instant; the trajectory is the same, bit for bit, with or without them.
 
 Measure (Sect. 5): c_1 = (2/T) int_T q_tip e^{-i Omega t} dt is exact. The particular part contributes
 phi_tip^T S per whole period; for the deviation x_j, multiplying its equation by e^{-i Omega t} and
@@ -80,13 +84,15 @@ _MAX_ONSETS_PER_PERIOD = 100_000
 
 class Grid(NamedTuple):
     """The free-flight grid of one run: N steps of h = T / N per excitation period T (s), the state recorded
-    at every `stride`-th grid point, and cos, sin(Omega k h) of the grid points k = 0..N (`rot`, 2 x (N + 1)).
-    The per-mode constants of a grid step are in the MODE records (grid_a ... grid_d, grid_decay, grid_kappa)."""
+    at M instants i T / M per period (every dt = T / M s; independent of the grid), and cos, sin(Omega k h) of
+    the grid points k = 0..N (`rot`, 2 x (N + 1)). The per-mode constants of a grid step are in the MODE
+    records (grid_a ... grid_d, grid_decay, grid_kappa)."""
 
     N: int
     T: float
     h: float
-    stride: int
+    M: int
+    dt: float
     rot: np.ndarray
 
 
@@ -103,10 +109,20 @@ class Work(NamedTuple):
     counters: np.ndarray
 
 
+class Recorder(NamedTuple):
+    """Scratch of the recorded states (`_record_flight`, `_record_contact`): a copy Y of the state at a
+    contact's start that is advanced from record instant to record instant, Ynew for free flights, and a
+    Dormand-Prince scratch of its own (its counters are not the run's)."""
+
+    Y: np.ndarray
+    Ynew: np.ndarray
+    dp: dopri5.Work
+
+
 class Run(NamedTuple):
     """Everything `_advance` works with: the constants, the grid, the output, the scratch of the period loop,
-    of the Dormand-Prince contact (counting into the same counters) and the collocation context, and whether
-    contacts start by collocation (else all by Dormand-Prince)."""
+    of the Dormand-Prince contact (counting into the same counters), the collocation context, whether
+    contacts start by collocation (else all by Dormand-Prince) and the scratch of the recorded states."""
 
     cst: Constants
     grid: Grid
@@ -115,6 +131,7 @@ class Run(NamedTuple):
     dp: dopri5.Work
     colloc: collocation.Context
     use_collocation: bool
+    recorder: Recorder
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -258,12 +275,12 @@ def _to_state(Y, t, y_out, cst):
 # `sim.collocation`, `sim.dopri5`), the period's Fourier coefficient; and the period loop
 # ----------------------------------------------------------------------------------------------------------
 @kernel
-def _fly(p, t, released, onsets, cst, grid, work, record):
+def _fly(p, t, released, onsets, cst, grid, work, record, recorder):
     """Free flight of period p from t (Eq. 9) until a contact onset or the period's end. From a release at t
     the flight to the next grid point is searched; from there the flight goes on one grid step at a time in
     closed form, each step accepted if certified contact-free, else searched. The state is recorded at the
-    record instants passed. More than _MAX_ONSETS_PER_PERIOD onsets so far (onsets) stop the run at the first
-    grid point reached.
+    record instants passed (`_record_flight`). More than _MAX_ONSETS_PER_PERIOD onsets so far (onsets) stop
+    the run at the first grid point reached.
 
     Returns (status, t, wall, tau): an onset at wall 0/1 at t + tau (its state in work.scratch), t the release
     or the grid point the searched step starts from, or wall -1 at the period's end. t is a grid point unless
@@ -273,8 +290,6 @@ def _fly(p, t, released, onsets, cst, grid, work, record):
     lay = state_layout(md.size)
     Y, Ynew, A, scratch, counters = work.Y, work.Ynew, work.A, work.scratch, work.counters
     N, hg, rot = grid.N, grid.h, grid.rot
-    stride = grid.stride
-    rows = N // stride
     recording = record.shape[0] > 0
     k = int(t / hg)
     if released:
@@ -282,6 +297,8 @@ def _fly(p, t, released, onsets, cst, grid, work, record):
         if k >= N:
             k = N - 1
         tau, wall = _search(Y, t, (k + 1) * hg - t, cst, scratch, counters)
+        if recording:
+            _record_flight(p, Y, t, t + tau if wall != -1 else (k + 1) * hg, record, grid, recorder, cst)
         if wall != -1:
             return (STALLED_SEARCH if wall == -2 else OK), t, wall, tau
         flight.free_flight(Y, Ynew, tau, md)
@@ -290,9 +307,9 @@ def _fly(p, t, released, onsets, cst, grid, work, record):
         t = k * hg
         if onsets > _MAX_ONSETS_PER_PERIOD:
             return STALLED, t, -1, 0.0
-        if recording and k % stride == 0:
-            _to_state(Y, t, record[p * rows + k // stride], cst)
         if k >= N:
+            if recording:
+                _to_state(Y, t, record[(p + 1) * grid.M], cst)
             return OK, t, -1, 0.0
     no_contact = par.k_H == 0.0  # host structure alone (k_H = 0): linear, exact everywhere
     for j in range(lay.n):
@@ -314,24 +331,79 @@ def _fly(p, t, released, onsets, cst, grid, work, record):
             counters[COUNT.searches] += 1
             tau, wall = _search(Y, t, hg, cst, scratch, counters)
             if wall != -1:
+                if recording:
+                    _record_flight(p, Y, t, t + tau, record, grid, recorder, cst)
                 return (STALLED_SEARCH if wall == -2 else OK), t, wall, tau
+        if recording:
+            _record_flight(p, Y, t, (k + 1) * hg, record, grid, recorder, cst)
         c_valid = True
         Y[:] = Ynew
         for j in range(lay.n):
             A[j] *= md[j].grid_decay
         k += 1
         t = k * hg
-        if recording and k % stride == 0:
-            _to_state(Y, t, record[p * rows + k // stride], cst)
         if k >= N:
+            if recording:
+                _to_state(Y, t, record[(p + 1) * grid.M], cst)
             return OK, t, -1, 0.0
 
 
 @kernel(inline="always")
-def _stop_time(t, grid):
-    """(t_stop, ks): a contact phase from t stops at the next record instant (grid point ks) or at the period's end."""
-    ks = (int(t / (grid.stride * grid.h)) + 1) * grid.stride
-    return (grid.T if ks >= grid.N else ks * grid.h), ks
+def _first_instant(t, grid):
+    """Index i of the first record instant i dt after t (the instants of a period are i = 1 .. M - 1 past its
+    start; the one at its end is the next period's row 0)."""
+    i = int(t / grid.dt)
+    while i > 0 and i * grid.dt > t:
+        i -= 1
+    while i * grid.dt <= t:
+        i += 1
+    return i
+
+
+@kernel
+def _record_flight(p, Y, ta, tb, record, grid, recorder, cst):
+    """Record the states of period p at the record instants in (ta, tb] of the free flight of Y from ta, in
+    closed form (Eq. 9); Y is left as it is. The segments (ta, tb] of flights and contacts tile the period,
+    so every instant is recorded once."""
+    i = _first_instant(ta, grid)
+    while i < grid.M and i * grid.dt <= tb:
+        flight.free_flight(Y, recorder.Ynew, i * grid.dt - ta, cst.modes)
+        _to_state(recorder.Ynew, i * grid.dt, record[p * grid.M + i], cst)
+        i += 1
+
+
+@kernel
+def _record_contact(p, t0, t1, at_onset, h, record, run):
+    """Record the states of period p at the record instants in (t0, t1] of the contact phase from t0 (an
+    onset if at_onset) to t1 (its release or the period's end).
+
+    An observer: the contact itself runs to its release whether or not states are recorded. The copy
+    run.recorder.Y of the state at t0 is advanced by Dormand-Prince contact steps (first step h) to each
+    record instant in turn, and in closed-form flight past the copy's own release (it may lie a rounding
+    before t1). Returns a status (`sim.flight`): STALLED if a step did not reach its record instant.
+    """
+    cst, grid, rec = run.cst, run.grid, run.recorder
+    Y = rec.Y
+    i = _first_instant(t0, grid)
+    t = t0
+    in_contact = True
+    while i < grid.M and i * grid.dt <= t1:
+        t_rec = i * grid.dt
+        if in_contact:
+            t, h, in_flight, status, _ = dopri5.contact(Y, t, t_rec, h, at_onset, rec.dp, cst)
+            if status != OK:
+                return status
+            if not (in_flight or t == t_rec):
+                return STALLED
+            at_onset = False
+            in_contact = not in_flight
+        if t_rec > t:
+            flight.free_flight(Y, rec.Ynew, t_rec - t, cst.modes)
+            Y[:] = rec.Ynew
+            t = t_rec
+        _to_state(Y, t_rec, record[p * grid.M + i], cst)
+        i += 1
+    return OK
 
 
 @kernel
@@ -376,9 +448,9 @@ def _advance(y, run):
     Y, X0, scratch, counters = work.Y, work.X0, work.scratch, work.counters
     amplitudes, impacts, record = run.out.amplitudes, run.out.impacts, run.out.record
     lay = state_layout(cst.modes.size)
-    N, stride = grid.N, grid.stride
+    recording = record.shape[0] > 0
     _from_state(y, Y, cst)
-    if record.shape[0] > 0:
+    if recording:
         for i in range(lay.acc):
             record[0, i] = y[i]
     cl, _, cr, _ = flight.closing(Y, 0.0, cst)
@@ -394,7 +466,10 @@ def _advance(y, run):
         wall = 0
         while True:
             if in_contact:
-                t_stop, ks = _stop_time(t, grid)
+                t_start, onset_start, h_start = t, at_onset, h_contact
+                if recording:
+                    run.recorder.Y[:] = Y
+                t_stop = grid.T
                 released = False
                 status = OK
                 extra = 0
@@ -413,19 +488,25 @@ def _advance(y, run):
                 onsets += extra
                 if status != OK:
                     return status, p
+                if recording:
+                    status = _record_contact(p, t_start, t, onset_start, h_start, record, run)
+                    if status != OK:
+                        return status, p
                 if not released:
-                    if record.shape[0] > 0:
-                        _to_state(Y, t, record[p * (N // stride) + min(ks, N) // stride], cst)
-                    if t_stop == grid.T:
-                        break
-                    continue
+                    if t != t_stop:  # a contact phase ends at its release or at the period's end
+                        return STALLED, p
+                    if recording:
+                        _to_state(Y, t, record[(p + 1) * grid.M], cst)
+                    break
                 in_contact = False
-            status, t, wall, tau = _fly(p, t, released, onsets, cst, grid, work, record)
+            status, t, wall, tau = _fly(p, t, released, onsets, cst, grid, work, record, run.recorder)
             if status != OK:
                 return status, p
             if wall < 0:
                 break
             # a located onset at t + tau (its state in work.scratch): the contact starts
+            if onsets > _MAX_ONSETS_PER_PERIOD:  # onsets that do not advance in time
+                return STALLED, p
             Y[:lay.acc] = scratch[:lay.acc]
             t = t + tau
             in_contact = True
@@ -446,10 +527,9 @@ def _advance(y, run):
 # Python entry point
 # ----------------------------------------------------------------------------------------------------------
 def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float, h_max: float,
-             h_fixed: float = 0.0, stride: int | None = None) -> tuple[Constants, Grid]:
+             h_fixed: float = 0.0, samples: int = 1) -> tuple[Constants, Grid]:
     """Constants and grid of the kernels for one excitation (see the module docstring for the symbols); the
-    state is recorded every `stride` grid steps (default N: once per period)."""
-    stride = N if stride is None else stride
+    state is recorded at `samples` equally spaced instants per period."""
     omega = np.asarray(sys.omega, dtype=np.float64)
     D = np.asarray(sys.D, dtype=np.float64)
     n = omega.size
@@ -482,7 +562,8 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
     flight.flight_transitions(hg, md, tr_g)
     md["grid_a"], md["grid_b"], md["grid_c"], md["grid_d"] = tr_g
     phase = Omega * hg * np.arange(N + 1)
-    grid = Grid(N=N, T=2.0 * math.pi / Omega, h=hg, stride=stride, rot=np.vstack([np.cos(phase), np.sin(phase)]))
+    T = 2.0 * math.pi / Omega
+    grid = Grid(N=N, T=T, h=hg, M=samples, dt=T / samples, rot=np.vstack([np.cos(phase), np.sin(phase)]))
     return Constants(modes=md, par=par), grid
 
 
@@ -507,7 +588,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     record: optional float64 array (n_periods * M + 1, len(y)) receiving the state at M equally spaced
     instants per period (row 0 = initial state), exactly at those instants.
     rtol: tolerance of the Dormand-Prince contact steps relative to g (per step, in m of wall/tip displacement).
-    grid_per_period: free-flight certification cells per period (rounded up to a multiple of M).
+    grid_per_period: free-flight certification cells per period (no effect on the trajectory beyond rounding
+    and the onset tolerance; recording does not change them).
     fixed_contact_step: > 0 replaces the error control in contacts by this fixed step in s (order studies;
     Dormand-Prince only).
     contacts: "collocation" (default: `sim.collocation`, Dormand-Prince where it falls back) or "dopri5"
@@ -525,15 +607,19 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
         raise SimulationInputError(f"contacts must be 'collocation' or 'dopri5', got {contacts!r}")
     if not (sys.m_a > 0 and sys.k_H >= 0 and sys.g > 0):
         raise SimulationInputError("sphere mass and clearance g must be positive and k_H >= 0 (0: no impactor)")
-    N = max(int(grid_per_period), samples)
-    N = -(-N // samples) * samples
+    N = int(grid_per_period)
+    if N < 1:
+        raise SimulationInputError(f"grid_per_period must be >= 1, got {grid_per_period!r}")
     omega_max = float(np.max(sys.omega))
     h_max = 0.5 / omega_max  # keeps DOPRI5 far inside its stability region on the highest mode
-    cst, grid = _prepare(Omega, a_base, sys, N, rtol, h_max, float(fixed_contact_step), N // samples)
+    cst, grid = _prepare(Omega, a_base, sys, N, rtol, h_max, float(fixed_contact_step), samples)
     work = _work(cst)
     out = Output(amplitudes=np.empty(n_periods), impacts=np.zeros(n_periods, dtype=np.int64), record=record_arr)
     use_collocation = contacts == "collocation" and fixed_contact_step <= 0.0
-    run = Run(cst, grid, out, work, dopri5.work(work.Y.size, work.counters), collocation.context(cst), use_collocation)
+    recorder = Recorder(Y=np.zeros(work.Y.size), Ynew=np.zeros(work.Y.size),
+                        dp=dopri5.work(work.Y.size, np.zeros_like(work.counters)))
+    run = Run(cst, grid, out, work, dopri5.work(work.Y.size, work.counters), collocation.context(cst), use_collocation,
+              recorder)
     status, period = _advance(y, run)
     if stats is not None:
         for name, value in zip(COUNT._fields, work.counters):

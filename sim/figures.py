@@ -1,10 +1,12 @@
 """Figures of the simulation stage in the style of the seed paper: the stepped-sine frequency response (Fig. 5,
-Sect. 5.2) and the resonant level against the excitation level (Fig. 6, Sect. 5.3).
+Sect. 5.2), the resonant level against the excitation level (Fig. 6, Sect. 5.3) and the time histories of
+one point (Figs. 4 and 9a, Sects. 5.1 and 5.5).
 
 They draw plain data (mappings of arrays), so that a result folder can be redrawn from its files (`ies plot`):
 a frequency response has the keys of `sim.protocol.SweepResult.to_dict` (eta, mean, mean_lo, mean_hi, max,
 max_lo, max_hi); the resonant levels those of `sim.tables.overview_data` (levels, resonant_mean, ...,
-regime). Files are written atomically through `sim.files` (format from the suffix).
+regime); a time history the columns t, q_tip, v_tip of `sim.trace.COLUMNS` and the keys of
+`sim.trace.trace_data`. Files are written atomically through `sim.files` (format from the suffix).
 """
 from __future__ import annotations
 
@@ -143,4 +145,77 @@ def redraw_overview(folder: Path, options: PlotOptions) -> list[Path]:
     paths = options.paths(folder, "fig6")
     for path in paths:
         plot_overview(subset, path, overview_title(data))
+    return paths
+
+
+def draw_tip_response(ax: Any, t: Sequence[float], q_tip: Sequence[float], data: Mapping[str, Any]) -> None:
+    """Fig. 4 on `ax`: q_tip / a_noabs* against t, the per-period amplitudes a / a_noabs* (steps, +-), their
+    mean (solid) and max (dashed) lines."""
+    import numpy as np
+
+    T = 1.0 / data["excitation_hz"]
+    a = np.asarray(data["amplitudes"])
+    edges = np.arange(a.size + 1) * T
+    ax.plot(t, np.asarray(q_tip) / data["a_noabs"], color="0.3", lw=0.6, label=r"$q_{tip}$")
+    for sign in (1, -1):
+        ax.stairs(sign * a, edges, baseline=None, color="tab:orange", lw=0.9,
+                  label="amplitude per period" if sign > 0 else None)
+        ax.axhline(sign * data["mean"], color="tab:blue", ls="-", lw=1.0, label="mean" if sign > 0 else None)
+        ax.axhline(sign * data["max"], color="tab:red", ls="--", lw=1.0, label="max" if sign > 0 else None)
+    ax.set_ylabel(r"$q_{tip} / a^{noabs*}$")
+    ax.grid(alpha=0.3)
+
+
+def draw_tip_velocity(ax: Any, t: Sequence[float], v_tip: Sequence[float], data: Mapping[str, Any]) -> None:
+    """Fig. 9a on `ax`: q_tip' / (Omega a_noabs*) against t with the impacts marked at their walls."""
+    import numpy as np
+
+    scale = 2.0 * math.pi * data["excitation_hz"] * data["a_noabs"]
+    ax.plot(t, np.asarray(v_tip) / scale, color="0.3", lw=0.6)
+    for wall, color in (("left", "tab:green"), ("right", "tab:purple")):
+        times = [impact["t"] for impact in data["impacts"] if impact["wall"] == wall]
+        if times:
+            ax.vlines(times, 0.0, 1.0, transform=ax.get_xaxis_transform(), color=color, lw=0.6, alpha=0.6,
+                      label=f"impact, {wall} wall")
+    ax.set_ylabel(r"$\dot q_{tip} / (\Omega a^{noabs*})$")
+    ax.set_xlabel("t (s)")
+    ax.grid(alpha=0.3)
+
+
+def plot_trace(data: Mapping[str, Any], t: Sequence[float], q_tip: Sequence[float], v_tip: Sequence[float],
+               path: str | os.PathLike) -> None:
+    """Figs. 4 (top: tip response, amplitudes, mean and max) and 9a (bottom: tip velocity and impacts) of one
+    time history, in one file with a shared time axis."""
+    from sim.files import pyplot
+
+    plt = pyplot()
+    fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(7.0, 6.0))
+    try:
+        draw_tip_response(top, t, q_tip, data)
+        draw_tip_velocity(bottom, t, v_tip, data)
+        top.set_title(trace_title(data), fontsize=9)
+        top.legend(fontsize=7, loc="upper right", ncols=4)
+        bottom.legend(fontsize=7, loc="upper right", ncols=2)
+        save_figure(fig, path)
+    finally:
+        plt.close(fig)
+
+
+def trace_title(data: Mapping[str, Any]) -> str:
+    """The title of a time history's figure from its JSON data (`sim.trace.trace_data`)."""
+    return (f"a_base/a_base* = {data['level']:g}, eta = {data['eta_actual']:.4f}: {data['periods']} periods at "
+            f"{data['fs'] / 1e3:.2f} kHz, {data['impacts_per_period']:.2f} contact onsets per period ({data['integrator']})")
+
+
+@register("ies trace --out", lambda folder: (folder / "trace.json").is_file() and (folder / "trace.csv").is_file())
+def redraw_trace(folder: Path, options: PlotOptions) -> list[Path]:
+    """Figs. 4 and 9a of an `ies trace --out` folder (trace.json, trace.csv), as trace.SUFFIX."""
+    from sim.signals import read_signal
+
+    data = json.loads((folder / "trace.json").read_text())
+    selected([data["level"]], options, folder)
+    signal = read_signal(folder / "trace.csv", ("q_tip", "v_tip"))
+    paths = options.paths(folder, "trace")
+    for path in paths:
+        plot_trace(data, signal.t, signal["q_tip"], signal["v_tip"], path)
     return paths

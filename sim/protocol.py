@@ -52,7 +52,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 
@@ -261,7 +261,7 @@ class SweepResult:
         return out
 
 
-def _system(model: ModalModel, impactor: Impactor | None) -> SystemArrays:
+def simulated_system(model: ModalModel, impactor: Impactor | None) -> SystemArrays:
     """System arrays; without impactor k_H = 0 (the sphere never touches: the linear host structure)."""
     if impactor is not None:
         return system_arrays(model, impactor)
@@ -282,11 +282,51 @@ def _check_seed(value: int, name: str) -> int:
     return int(value)
 
 
+def visit_points(model: ModalModel, sys: SystemArrays, a_base: float, protocol: SteppedSine, y: np.ndarray, *,
+                 seed: int, rep: int) -> Iterator[tuple[int, float, float, float]]:
+    """Walk ONE stepped-sine run (Sect. 5.1) from the initial conditions of protocol.start, advancing y in place:
+    for each visited point in execution order the lead-in (before the first point) and the wait are run, and
+    (leg index, eta, eta_actual, Omega in rad/s) is yielded with y at the start of the point's hold. The caller
+    runs the hold on y before asking for the next point.
+
+    The random frequency offsets come only from ``np.random.default_rng([seed, rep])`` (module docstring).
+    """
+    from sim.integrators import get_integrator
+
+    run_step = get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
+    omega_1 = float(model.omega[0])
+    grid = protocol.eta
+    protocol.periods(omega_1 * grid[0] * (1.0 - protocol.perturbation))  # refuse a too short hold up front
+    rng = np.random.default_rng([seed, rep])
+    each_point = protocol.perturb == "each-point"
+    start_offset = 0.0 if each_point else float(rng.uniform(-protocol.perturbation, protocol.perturbation))
+    first = True
+    for leg_index, direction in enumerate(protocol.legs):
+        order = grid if direction == "up" else grid[::-1]
+        offsets = (rng.uniform(-protocol.perturbation, protocol.perturbation, size=order.size) if each_point
+                   else np.zeros(order.size))
+        for eta, offset in zip(order, offsets):
+            eta_actual = float(eta) * (1.0 + float(offset))
+            Omega = eta_actual * omega_1
+            if first:
+                first = False
+                Omega_start = Omega * (1.0 + start_offset)
+                if protocol.start == "base-velocity":
+                    y[2 * model.n_modes + 1] = a_base * Omega_start
+                n_lead_in = protocol.periods(Omega_start)[0] if not each_point else 0
+                if n_lead_in:
+                    run_step(y, n_lead_in, Omega_start, a_base, sys, None)
+            n_wait = protocol.periods(Omega)[0]
+            if n_wait:
+                run_step(y, n_wait, Omega, a_base, sys, None)
+            yield leg_index, float(eta), eta_actual, Omega
+
+
 def run_sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *,
               seed: int, rep: int, nominal: Nominal = Nominal(),
               progress: Callable[[], None] | None = None) -> SweepRun:
     """ONE stepped-sine run from homogeneous initial conditions (Sect. 5.1; protocol.start) at
-    a_base = level * a_base* (nominal D*, g*).
+    a_base = level * a_base* (nominal D*, g*): the points of `visit_points`, each with its hold.
 
     impactor None simulates the host structure alone. The random frequency offsets come only from
     ``np.random.default_rng([seed, rep])`` (module docstring). `progress` is called after every point.
@@ -297,41 +337,19 @@ def run_sweep(model: ModalModel, impactor: Impactor | None, level: float, protoc
     seed = _check_seed(seed, "seed")
     rep = _check_seed(rep, "rep")
     run_step = get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
-    sys = _system(model, impactor)
+    sys = simulated_system(model, impactor)
     a_base = level * a_base_star(model, nominal)
     a_noabs = a_noabs_star(model, a_base, nominal)
-    omega_1 = float(model.omega[0])
-    grid = protocol.eta
-    protocol.periods(omega_1 * grid[0] * (1.0 - protocol.perturbation))  # refuse a too short hold up front
-
-    rng = np.random.default_rng([seed, rep])
-    each_point = protocol.perturb == "each-point"
-    start_offset = 0.0 if each_point else float(rng.uniform(-protocol.perturbation, protocol.perturbation))
     started = time.perf_counter()
     y = np.zeros(2 * model.n_modes + 2)
     rows: list[tuple] = []
-    for leg_index, direction in enumerate(protocol.legs):
-        order = grid if direction == "up" else grid[::-1]
-        offsets = (rng.uniform(-protocol.perturbation, protocol.perturbation, size=order.size) if each_point
-                   else np.zeros(order.size))
-        for eta, offset in zip(order, offsets):
-            eta_actual = float(eta) * (1.0 + float(offset))
-            Omega = eta_actual * omega_1
-            if not rows:
-                Omega_start = Omega * (1.0 + start_offset)
-                if protocol.start == "base-velocity":
-                    y[2 * model.n_modes + 1] = a_base * Omega_start
-                n_lead_in = protocol.periods(Omega_start)[0] if not each_point else 0
-                if n_lead_in:
-                    run_step(y, n_lead_in, Omega_start, a_base, sys, None)
-            n_wait, n_hold = protocol.periods(Omega)
-            if n_wait:
-                run_step(y, n_wait, Omega, a_base, sys, None)
-            amplitudes, impacts = run_step(y, n_hold, Omega, a_base, sys, None)
-            m = hold_measures(amplitudes, impacts, a_noabs)
-            rows.append((float(eta), eta_actual, leg_index, m.mean, m.max, m.min, m.std, m.impacts_per_period, n_hold))
-            if progress is not None:
-                progress()
+    for leg_index, eta, eta_actual, Omega in visit_points(model, sys, a_base, protocol, y, seed=seed, rep=rep):
+        n_hold = protocol.periods(Omega)[1]
+        amplitudes, impacts = run_step(y, n_hold, Omega, a_base, sys, None)
+        m = hold_measures(amplitudes, impacts, a_noabs)
+        rows.append((eta, eta_actual, leg_index, m.mean, m.max, m.min, m.std, m.impacts_per_period, n_hold))
+        if progress is not None:
+            progress()
     cols = list(zip(*rows))
     as_f = lambda i: np.array(cols[i], dtype=float)  # noqa: E731
     return SweepRun(
@@ -430,4 +448,4 @@ def sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: 
 
 
 __all__ = ["SEQUENCES", "SteppedSine", "SweepResult", "SweepRun", "aggregate_runs", "check_level", "run_sweep",
-           "sweep", "APR", "LINEAR"]
+           "sweep", "visit_points", "APR", "LINEAR"]

@@ -66,7 +66,7 @@ def register(name: str, detect: Callable[[Path], bool]) -> Callable[[Redraw], Re
 def kind_of(folder: Path) -> ResultKind:
     """The registered kind that recognises `folder`; a one-line SimulationInputError when none does."""
     if not folder.is_dir():
-        raise SimulationInputError(f"{folder} is not a folder; give a result folder (--out of ies sweep, overview, "
+        raise SimulationInputError(f"{folder} is not a folder; give a result folder (--out of ies sweep, overview, trace, "
                                    "interval, sobol or reproduce)")
     for kind in KINDS:
         if kind.detect(folder):

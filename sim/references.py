@@ -22,10 +22,11 @@ from sim.system import Impactor, ModalModel, SystemArrays, system_arrays
 
 
 def reference_run(y0: np.ndarray, t_end: float, Omega: float, a_base: float, sys: SystemArrays, rtol: float = 1e-12,
-                  atol_scale: float = 1e-16, pieces: list | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                  atol_scale: float = 1e-16, pieces: list | None = None,
+                  t0: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Eqs. 3-7 with the Hertz law at both walls under q_base = a_base cos(Omega t) (SI units), by DOP853 from
-    t = 0 (phase 0) to t_end (s), restarted at every contact event; returns (y(t_end), onset times (s),
-    release times (s), rebound speeds (m/s)).
+    y0 at t0 (s; phase Omega t0) to t_end (s), restarted at every contact event; returns (y(t_end), onset
+    times (s), release times (s), rebound speeds (m/s)).
 
     rebound speeds: the relative speed phi_w^T s' - u_a' (sign of opening) at each release.
     pieces: a list that receives (t_start, t_stop, dense solution) of every piece between events.
@@ -60,7 +61,7 @@ def reference_run(y0: np.ndarray, t_end: float, Omega: float, a_base: float, sys
 
     atol = np.concatenate([np.full(n, sys.g * atol_scale), np.full(n, sys.g * atol_scale * sys.omega.max()),
                            [sys.g * atol_scale, sys.g * atol_scale * sys.omega.max()]])
-    t = 0.0
+    t = float(t0)
     y = np.array(y0, dtype=float)
     closed = [ev_l(t, y) > 0, ev_r(t, y) < 0]
     onsets, releases, speeds = [], [], []

@@ -264,3 +264,77 @@ def test_a_lost_scheduler_is_one_line_and_resume_finishes_the_study(tmp_path):
     assert "reused)" in done.stdout and (out / "bands.csv").is_file()
     tasks = int(done.stdout.split(" runs (")[0].splitlines()[-1])
     assert f"({tasks - kept} run now, {kept} reused)" in done.stdout
+
+
+# ---- ies impacts, ies modal-fit, ies trace ---------------------------------------------------------------------
+
+def _signal_file(folder: Path, text: str) -> Path:
+    path = folder / "signal.csv"
+    path.write_text(text)
+    return path
+
+
+def _uniform_rows(n: int = 200, fs: float = 51.2e3) -> str:
+    t = np.arange(n) / fs
+    return "".join(f"{float(ti)!r},{np.sin(ti * 3e4)},{np.cos(ti * 3e4)},{np.sin(ti * 700)},{np.cos(ti * 700)}\n"
+                   for ti in t)
+
+
+def _with_nan(rows: str) -> str:
+    """The rows with a_left of the eighth one replaced by nan."""
+    lines = rows.splitlines(keepends=True)
+    cells = lines[7].split(",")
+    lines[7] = ",".join([cells[0], "nan", *cells[2:]])
+    return "".join(lines)
+
+
+HEADER = "t,a_left,a_right,a_tip,v_tip\n"
+
+
+@pytest.mark.parametrize("content, phrase", [
+    ("", "is empty"),
+    ("t,a_left,a_tip,v_tip\n0,1,2,3\n1e-5,1,2,3\n", "missing column(s) a_right"),
+    (HEADER + _with_nan(_uniform_rows()), "every value must be a finite number"),
+    (HEADER + _uniform_rows(20).replace(_uniform_rows(20).splitlines()[5], "oops,1,2,3,4"), "'oops' in column 't'"),
+    (HEADER + "".join(reversed(_uniform_rows(20).splitlines(keepends=True))), "t must increase"),
+    (HEADER + _uniform_rows(200, 30e3), "sampling rate 30000 Hz is too low for the 20000 Hz high-pass"),
+])
+@pytest.mark.parametrize("command", [["impacts"], ["modal-fit", "--model", "builtin"]])
+def test_bad_signal_files_are_one_line(tmp_path, capsys, content, phrase, command):
+    path = _signal_file(tmp_path, content)
+    before = files_in(tmp_path)
+    refused(capsys, main([command[0], str(path), *command[1:], "--plot", str(tmp_path / "fit.png")] if command[0] ==
+                         "modal-fit" else [*command, str(path)]), phrase)
+    assert files_in(tmp_path) == before
+
+
+def test_non_uniform_sampling_is_refused(tmp_path, capsys):
+    t = np.arange(300) / 51.2e3
+    t[100:] += 0.3 / 51.2e3
+    rows = "".join(f"{float(ti)!r},1,2,3\n" for ti in t)
+    path = _signal_file(tmp_path, "t,a_left,a_right,a_tip\n" + rows)
+    refused(capsys, main(["impacts", str(path)]), "not uniformly sampled")
+
+
+@pytest.mark.parametrize("args, phrase", [
+    (["--model", "nowhere.toml"], "unknown model 'nowhere.toml'"),
+    (["--model", "builtin", "--impacts", "none.json"], "--impacts none.json: file not found"),
+    (["--model", "builtin", "--threshold", "0.8:1.0"], "needs one threshold factor"),
+])
+def test_bad_modal_fit_options_are_one_line(tmp_path, capsys, monkeypatch, args, phrase):
+    monkeypatch.chdir(tmp_path)
+    path = _signal_file(tmp_path, HEADER + _uniform_rows())
+    refused(capsys, main(["modal-fit", str(path), *args, "--plot", "fit.png"]), phrase)
+    assert [p.name for p in files_in(tmp_path)] == ["signal.csv"]
+
+
+@pytest.mark.parametrize("args, phrase", [
+    (["--fs", "100"], "is below twice the excitation frequency"),
+    (["--periods", "0"], "argument --periods"),
+    (["--model", "nowhere.toml"], "nowhere.toml"),
+])
+def test_bad_trace_options_create_nothing(tmp_path, model_file, capsys, monkeypatch, args, phrase):
+    monkeypatch.chdir(tmp_path)
+    base = ["trace", "--level", "6", "--eta", "0.99", "--wait", "0.02", "--model", model_file, "--out", "res"]
+    refused(capsys, main([*base, *args, "--plot", "trace.png"]), phrase)
+    assert [p.name for p in files_in(tmp_path)] == ["three.toml"]

@@ -319,7 +319,7 @@ def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list
 def add_plot_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies plot`."""
     parser.add_argument("folder", type=Path, metavar="DIR",
-                        help="a result folder: --out of ies sweep, overview, interval, sobol, response or reproduce")
+                        help="a result folder: --out of ies sweep, overview, trace, interval, sobol, response or reproduce")
     parser.add_argument("--format", dest="formats", type=figure_formats, default=(".png", ".pdf"), metavar="F1,F2",
                         help="figure formats, e.g. png,pdf,svg (default png,pdf)")
     parser.add_argument("--style", metavar="NAME|FILE",
@@ -331,7 +331,7 @@ def add_plot_arguments(parser: argparse.ArgumentParser) -> None:
 
 def plot_command(args: argparse.Namespace) -> int:
     """`ies plot`: redraw the figures of a result folder from its data files (`sim.redraw`)."""
-    import sim.figures  # noqa: F401 - registers ies sweep's and ies overview's folders
+    import sim.figures  # noqa: F401 - registers ies sweep's, overview's and trace's folders
     import uq.figures  # noqa: F401 - registers the study folders
     from sim.errors import SimulationInputError
     from sim.files import report_written

@@ -51,9 +51,7 @@ def rig_trace(eta: float = 0.976, periods: int = 50, down_from: float | None = 0
         exact.run_step(y, int(round(3.0 * Omega / (2 * np.pi))), Omega, a_base, system)
     M = SAMPLES_PER_PERIOD
     states = np.empty((periods * M + 1, y.size))
-    # the grid only places certification cells; at the default grid (M cells) this trace stalls in a contact
-    # that crosses record instants (sim.exact), at 3 M it does not
-    _, onsets = exact.run_step(y, periods, Omega, a_base, system, states, grid_per_period=3 * M)
+    _, onsets = exact.run_step(y, periods, Omega, a_base, system, states)
     return Trace(simulated_signal(states, M, Omega, a_base, system), states,
                  simulated_contacts(states, M, Omega, a_base, system), model, system, Omega, a_base,
                  int(onsets.sum()))

@@ -1,0 +1,137 @@
+"""Time histories of one stepped-sine point (seed paper Sect. 5.1, Fig. 4; Sect. 5.5, Fig. 9a): `ies trace`.
+
+The stepped-sine run of a protocol (`sim.protocol.visit_points`: lead-in, wait, and the holds of the points
+before) is walked to its last point; after that point's wait, `periods` excitation periods of its hold are
+simulated with the state recorded at M = round(fs / f_exc) instants per period, exactly at those instants
+(the integrator's states, not interpolated: `sim.system` record contract). The sampling rate is therefore
+M f_exc, the nearest to the requested one that puts a whole number of samples in every period. The recorded
+states become the signal columns of `sim.signals.simulated_signal` (SI units), the simulator's contacts
+between samples the impact list of `sim.signals.simulated_contacts`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from sim.errors import SimulationInputError
+from sim.measures import hold_measures
+from sim.protocol import SteppedSine, check_level, simulated_system, visit_points
+from sim.signals import Signal, SimulatedContacts, simulated_contacts, simulated_signal
+from sim.system import Impactor, ModalModel, Nominal, a_base_star, a_noabs_star
+
+#: The paper's sampling rate (Sect. 5.5: 51.2 kHz).
+DEFAULT_FS = 51.2e3
+DEFAULT_PERIODS = 50
+#: The columns of the trace's CSV, in order (`sim.signals.simulated_signal`; t first).
+COLUMNS = ("t", "q_tip", "v_tip", "a_tip", "q_wall_left", "q_wall_right", "a_left", "a_right", "q_sphere",
+           "f_left", "f_right")
+#: Units of the columns (SI).
+UNITS = {"t": "s", "q_tip": "m", "v_tip": "m/s", "a_tip": "m/s^2", "q_wall_left": "m", "q_wall_right": "m",
+         "a_left": "m/s^2", "a_right": "m/s^2", "q_sphere": "m", "f_left": "N", "f_right": "N"}
+
+
+@dataclass(frozen=True)
+class Trace:
+    """The recorded stretch of one stepped-sine point.
+
+    signal: the columns (`COLUMNS`, SI) from t = 0 at the start of the recorded stretch (phase 0 of the
+    excitation q_base = a_base cos(Omega t)); states: the recorded rows y = [s, s', u_a, u_a'] (`sim.system`);
+    contacts: the simulator's contacts between samples; samples_per_period M; fs = M Omega / (2 pi) (Hz);
+    amplitudes: |c_1| of q_tip per recorded period (m, Sect. 5); impacts: contact onsets per period;
+    level a_base/a_base*, a_base, a_noabs (m); eta, eta_actual: the point's nominal and simulated
+    Omega / omega_1; Omega (rad/s).
+    """
+
+    signal: Signal
+    states: np.ndarray
+    contacts: SimulatedContacts
+    samples_per_period: int
+    fs: float
+    amplitudes: np.ndarray
+    impacts: np.ndarray
+    level: float
+    a_base: float
+    a_noabs: float
+    eta: float
+    eta_actual: float
+    Omega: float
+
+    @property
+    def normalised_amplitudes(self) -> np.ndarray:
+        """a / a_noabs* per recorded period (-), the paper's Fig. 4 ordinate."""
+        return self.amplitudes / self.a_noabs
+
+
+def samples_per_period(fs: float, Omega: float) -> int:
+    """M = round(fs / f_exc) for a requested sampling rate fs (Hz) at the excitation Omega (rad/s); at least two
+    samples per period (one-line SimulationInputError otherwise)."""
+    f_exc = Omega / (2.0 * math.pi)
+    if not (math.isfinite(fs) and fs >= 2.0 * f_exc):
+        raise SimulationInputError(f"--fs {fs:g} Hz is below twice the excitation frequency ({2.0 * f_exc:.4g} Hz); "
+                                   f"give --fs of at least that (default {DEFAULT_FS:g})")
+    return int(round(fs / f_exc))
+
+
+def record_trace(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *,
+                 periods: int = DEFAULT_PERIODS, fs: float = DEFAULT_FS, seed: int = 0, rep: int = 0,
+                 nominal: Nominal = Nominal()) -> Trace:
+    """Simulate the stepped-sine run of `protocol` at a_base = level a_base* (Sect. 5.1) to its last point and
+    record `periods` excitation periods of that point's hold at fs (Hz, rounded to M f_exc; module docstring).
+
+    impactor None: the host structure alone. Raises SimulationInputError for bad settings.
+    """
+    from sim.integrators import get_integrator
+
+    level = check_level(level)
+    if int(periods) != periods or periods < 1:
+        raise SimulationInputError(f"--periods must be a whole number >= 1, got {periods!r}")
+    fs = float(fs)
+    omega_1 = float(model.omega[0])
+    lowest = protocol.eta[0] * omega_1 * (1.0 - protocol.perturbation)
+    samples_per_period(fs, lowest)  # refuse a too low rate before simulating
+    run_step = get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
+    sys = simulated_system(model, impactor)
+    a_base = level * a_base_star(model, nominal)
+    a_noabs = a_noabs_star(model, a_base, nominal)
+    y = np.zeros(2 * model.n_modes + 2)
+    points = len(protocol.legs) * int(protocol.n_eta)
+    for visited, (_, eta, eta_actual, Omega) in enumerate(visit_points(model, sys, a_base, protocol, y, seed=seed,
+                                                                        rep=rep), start=1):
+        if visited == points:
+            break
+        run_step(y, protocol.periods(Omega)[1], Omega, a_base, sys, None)
+    M = samples_per_period(fs, Omega)
+    states = np.empty((int(periods) * M + 1, y.size))
+    amplitudes, impacts = run_step(y, int(periods), Omega, a_base, sys, states)
+    return Trace(simulated_signal(states, M, Omega, a_base, sys), states,
+                 simulated_contacts(states, M, Omega, a_base, sys), M, M * Omega / (2.0 * math.pi), amplitudes,
+                 impacts, level, a_base, a_noabs, eta, eta_actual, Omega)
+
+
+def trace_rows(trace: Trace) -> np.ndarray:
+    """The CSV table of a trace: one row per sample, the columns of `COLUMNS`."""
+    return np.column_stack([trace.signal[name] for name in COLUMNS])
+
+
+def trace_data(trace: Trace, settings: dict[str, Any]) -> dict[str, Any]:
+    """The JSON object of a trace (SI units): `settings` (the command's parameters), the actual sampling rate,
+    the per-period amplitudes a / a_noabs* with their mean and max (Fig. 4), the contact onsets per period, and
+    the simulator's impacts (`sim.signals.simulated_contacts`: onset time known to one sample interval)."""
+    a = trace.normalised_amplitudes
+    m = hold_measures(trace.amplitudes, trace.impacts, trace.a_noabs)
+    contacts = trace.contacts
+    return {
+        **settings,
+        "level": trace.level, "a_base": trace.a_base, "a_noabs": trace.a_noabs, "eta": trace.eta,
+        "eta_actual": trace.eta_actual, "excitation_hz": trace.Omega / (2.0 * math.pi),
+        "fs": trace.fs, "samples_per_period": trace.samples_per_period,
+        "periods": int(a.size), "n_samples": int(trace.signal.t.size),
+        "amplitudes": a, "mean": m.mean, "max": m.max, "cv": m.cv,
+        "impacts_per_period": m.impacts_per_period, "onsets_per_period": trace.impacts,
+        "impacts": [{"t": t, "wall": wall, "impulse": impulse}
+                    for t, wall, impulse in zip(contacts.times, contacts.walls, contacts.impulses)],
+        "columns": list(COLUMNS), "units": UNITS,
+    }
