@@ -152,3 +152,60 @@ def rebound_error(v0: float, runner, a_base: float = 0.0) -> float:
     y = y0.copy()
     runner(y, sys, Omega, a_base)
     return abs(y[2 * n + 1] - y_ref[2 * n + 1]) / v0
+
+
+def two_body_impact(r_cont: float, v0: float, m_a: float, m_beam: float, k_H: float,
+                    rtol: float = 1e-12) -> dict[str, float]:
+    """One impact of the sphere (m_a, kg) on a free rigid wall of mass m_beam (kg) under Eq. 10 (the paper's
+    xi(r_cont) and d_H, written out here from the paper, not taken from `sim.contact_law`), by scipy DOP853 in
+    the bodies' own coordinates x_a, x_w with events at delta = 0 (onset, release) and delta' = 0 (turning
+    point: approach -> restitution). The sphere closes at v0 (m/s), the wall at rest; delta = x_a - x_w.
+
+    Returns the coefficient of restitution r = -(relative velocity after) / (relative velocity before), the
+    kinetic energies before and after (J), the dissipated energy (J, the integral of d_H delta'^2 as a state),
+    the largest indentation (m) and the times of the turning point and the release (s).
+    """
+    from scipy.integrate import solve_ivp
+
+    xi = 4.5 * math.sqrt(5.0) * (1.0 - r_cont**2) / (r_cont * (r_cont * (9.0 * math.pi - 16.0) + 16.0))
+    m_red = m_beam * m_a / (m_beam + m_a)
+
+    def force(delta: float, rate: float, approach: bool) -> float:
+        if delta <= 0:
+            return 0.0
+        f = k_H * delta**1.5
+        return f + 2.0 * xi * math.sqrt(k_H * math.sqrt(delta) * m_red) * rate if approach else f
+
+    def rhs_of(approach: bool):
+        def rhs(_t, y):
+            delta, rate = y[0] - y[2], y[1] - y[3]
+            f = force(delta, rate, approach)
+            dissipation = f * rate - (k_H * max(delta, 0.0) ** 1.5 * rate)  # the damper's power
+            return [y[1], -f / m_a, y[3], f / m_beam, dissipation]
+        return rhs
+
+    def turning(_t, y):
+        return y[1] - y[3]
+
+    def release(_t, y):
+        return y[0] - y[2]
+
+    turning.terminal, turning.direction = True, -1.0
+    release.terminal, release.direction = True, -1.0
+    # contact duration scale: (m_red^2 / (k_H^2 v0))^(1/5)
+    tau = (m_red**2 / (k_H**2 * v0)) ** 0.2
+    atol = np.array([1e-18, 1e-16 * v0, 1e-18, 1e-16 * v0, 1e-30])
+    y0 = [0.0, v0, 0.0, 0.0, 0.0]  # onset: delta = 0 at t = 0
+    approach = solve_ivp(rhs_of(True), (0.0, 20 * tau), y0, method="DOP853", rtol=rtol, atol=atol, events=turning)
+    if approach.status != 1:
+        raise RuntimeError("the reference impact found no turning point")
+    y1, t1 = approach.y[:, -1], approach.t[-1]
+    restitution = solve_ivp(rhs_of(False), (t1, t1 + 20 * tau), y1, method="DOP853", rtol=rtol, atol=atol,
+                            events=release)
+    if restitution.status != 1:
+        raise RuntimeError("the reference impact found no release")
+    y2 = restitution.y[:, -1]
+    kinetic = lambda y: 0.5 * m_a * y[1] ** 2 + 0.5 * m_beam * y[3] ** 2  # noqa: E731
+    return {"r": -(y2[1] - y2[3]) / v0, "kinetic_before": 0.5 * m_a * v0**2, "kinetic_after": kinetic(y2),
+            "dissipated": float(y2[4]), "max_indentation": float(y1[0] - y1[2]), "t_turning": float(t1),
+            "t_release": float(restitution.t[-1])}
