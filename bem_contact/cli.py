@@ -6,6 +6,9 @@ levels it on the flat wall, places the sphere above the crater and calibrates k_
 sphere - wall; it also reports the crater metrics and the clearance interval of Sect. 4.1. With no
 SCAN it uses the shipped paper-like crater (`scans/data/paper_crater.ply`).
 `ies calibrate --flat` presses the ideal sphere (R = 7.92 mm, brass) on the flat steel wall (Table 1).
+`ies calibrate --tangential [--normal-force N]` gives instead the tangential stiffness k_t of the stuck sphere on
+the flat (Appendix C, Cattaneo-Mindlin; default N = the sphere's weight m_a g) by BEM and Mindlin's 8 G* a,
+beside the paper's 22 kN/mm and the normal force Mindlin's formula would need for it.
 Both compute the force at 20 indentations from 2 to 40 um, fit f = k_H delta^1.5 and compare with k_H*
 of Eq. 8; the error bar comes from repeating the curve on a grid half as fine. The indentation is
 measured from the first touch; on a scan, from the first touch on the wall denoised by a second-order
@@ -30,6 +33,10 @@ from sim.options import figure_file
 HELP = "calibrate the Hertzian spring constant k_H by BEM contact on a scanned crater or the flat wall (Sect. 4.1, Eq. 8, Fig. 3)"
 
 SPHERE_RADIUS = 7.92e-3  # m, Sect. 2
+SPHERE_WEIGHT = 0.0177 * 9.81  # N, m_a g: the normal load of Appendix C
+K_T_PAPER = 22e6  # N/m, Appendix C: "stiffness 22 kN/mm"
+DEFAULT_GRID = 256
+DEFAULT_TANGENTIAL_GRID = 96  # BEM k_t within 0.1 % of Mindlin's at the weight
 DEFAULT_SIDE_MM = 2.5  # contact radius at 40 um is 0.56 mm: the domain holds it with room to spare
 PAPER_FLATTENING_MM = 0.02  # Sect. 4.1: sphere diameter 15.80 mm in the flattened regions, 15.84 nominal
 PAPER_CLEARANCE_MM = 0.58  # Sect. 4.1: (17 - 15.84) / 2
@@ -54,6 +61,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="scanned wall or imprint: STL, PLY, OBJ, OFF mesh, XYZ/CSV points, NPY/NPZ height map "
                              "(default: the shipped paper-like crater)")
     source.add_argument("--flat", action="store_true", help="the ideal sphere on the flat wall instead of a scan")
+    source.add_argument("--tangential", action="store_true",
+                        help="the tangential stiffness k_t of the sphere stuck on the flat wall (Appendix C, "
+                             "Cattaneo-Mindlin) instead of k_H: BEM and 8 G* a, beside the paper's 22 kN/mm")
+    source.add_argument("--normal-force", dest="normal_force", type=float, default=None, metavar="N",
+                        help=f"--tangential: normal load in N (default the sphere's weight m_a g = {SPHERE_WEIGHT:.4g} N)")
     source.add_argument("--shape", choices=SHAPES, default="paraboloid",
                         help="sphere geometry on the flat wall: Hertz's paraboloid (default; Eq. 8 is exact for it) "
                              "or the exact spherical cap (k_H about 0.04 %% lower)")
@@ -83,8 +95,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     scan.add_argument("--clearance", type=float, default=PAPER_CLEARANCE_MM, metavar="MM",
                       help=f"nominal clearance in mm (default {PAPER_CLEARANCE_MM} = (17 - 15.84) / 2)")
     numerics = parser.add_argument_group("numerics")
-    numerics.add_argument("--grid", type=int, default=256, metavar="N",
-                          help="elements across the domain (default 256); the error bar uses N/2")
+    numerics.add_argument("--grid", type=int, default=None, metavar="N",
+                          help=f"elements across the domain (default {DEFAULT_GRID}; the error bar uses N/2; "
+                               f"--tangential: {DEFAULT_TANGENTIAL_GRID} across 4 contact radii)")
     numerics.add_argument("--solver", choices=solver_names(), default="auto",
                           help="contact solver (default auto = pk, Polonsky-Keer CG on the FFT operator; "
                                "al-jacobi, osqp, cvxpy are dense, for small grids)")
@@ -248,7 +261,8 @@ def calibrate(args: argparse.Namespace):
 
     # progress on stderr for long runs (fine grids); silent when stderr is not a terminal
     with tqdm(total=2 * len(deltas), desc="contact solves", unit="solve", leave=False, disable=not sys.stderr.isatty()) as bar:
-        result = calibrate_k_H(source.gap_at, args.grid, E_star, deltas, solver=args.solver, R=SPHERE_RADIUS, on_solve=bar.update)
+        grid = DEFAULT_GRID if args.grid is None else args.grid
+        result = calibrate_k_H(source.gap_at, grid, E_star, deltas, solver=args.solver, R=SPHERE_RADIUS, on_solve=bar.update)
     return result, source, E_star
 
 
@@ -338,10 +352,61 @@ def scan_plot(data: dict[str, Any], source: GapSource, path: str) -> None:
     save_figure(fig, path)
 
 
+def tangential(args: argparse.Namespace) -> dict[str, Any]:
+    """`ies calibrate --tangential`: k_t of the sphere stuck on the flat wall (Appendix C) by BEM and by Mindlin's
+    8 G* a, the paper's value and the normal force (N) for which 8 G* a would equal it (k_t grows as N^(1/3)).
+    Plain data in SI units (the JSON object)."""
+    import math
+
+    from bem_contact.errors import ContactInputError
+    from bem_contact.materials import BRASS, STEEL
+    from bem_contact.tangential import sphere_tangential_stiffness
+
+    if args.scan is not None or args.plot:
+        raise ContactInputError("--tangential is the ideal sphere on the flat wall: drop the SCAN file and --plot")
+    force = SPHERE_WEIGHT if args.normal_force is None else args.normal_force
+    if not (math.isfinite(force) and force > 0):
+        raise ContactInputError(f"--normal-force {force} must be a finite number of newtons > 0 (the weight: {SPHERE_WEIGHT:.4g})")
+    grid = DEFAULT_TANGENTIAL_GRID if args.grid is None else args.grid
+    if grid < 8:
+        raise ContactInputError(f"--grid {grid}: need at least 8 elements across the domain")
+    check = sphere_tangential_stiffness(force, SPHERE_RADIUS, BRASS, STEEL, grid=grid)
+    return {"k_t": check.k_t, "k_t_mindlin": check.k_t_mindlin, "contact_radius": check.contact_radius,
+            "normal_force": check.normal_force, "grid": check.grid, "k_t_paper": K_T_PAPER,
+            "paper_over_mindlin": K_T_PAPER / check.k_t_mindlin,
+            "normal_force_for_paper": force * (K_T_PAPER / check.k_t_mindlin) ** 3,
+            "weight": SPHERE_WEIGHT, "R": SPHERE_RADIUS,
+            "materials": {"wall": "steel, E = 207 GPa, nu = 0.3", "sphere": "brass, E = 102 GPa, nu = 0.3"},
+            "units": {"k_t": "N/m", "k_t_mindlin": "N/m (8 G* a)", "k_t_paper": "N/m", "contact_radius": "m",
+                      "normal_force": "N", "normal_force_for_paper": "N", "weight": "N (m_a g)", "R": "m"}}
+
+
+def _tangential_text(data: dict[str, Any]) -> str:
+    kn_mm = 1e-6  # N/m -> kN/mm
+    return "\n".join([
+        f"sphere R = {SPHERE_RADIUS * 1e3:g} mm (brass) stuck on the flat steel wall, normal force "
+        f"{data['normal_force']:.4g} N ({data['normal_force'] / data['weight']:.3g} x the weight m_a g)",
+        f"contact radius a = {data['contact_radius'] * 1e6:.2f} um (Hertz)",
+        f"k_t = {data['k_t'] * kn_mm:.4g} kN/mm (BEM, grid {data['grid']})   "
+        f"8 G* a = {data['k_t_mindlin'] * kn_mm:.4g} kN/mm (Mindlin)",
+        f"paper (Appendix C): {data['k_t_paper'] * kn_mm:g} kN/mm = {data['paper_over_mindlin']:.3g} x Mindlin's; "
+        f"8 G* a reaches it at a normal force of {data['normal_force_for_paper']:.4g} N "
+        f"({data['normal_force_for_paper'] / data['weight']:.0f} x the weight)",
+    ])
+
+
 def run(args: argparse.Namespace) -> int:
     """`ies calibrate`: calibrate, plot on request, print the summary (text or JSON)."""
     from sim.files import dumps, report_written
 
+    if args.normal_force is not None and not args.tangential:
+        from bem_contact.errors import ContactInputError
+
+        raise ContactInputError("--normal-force belongs to --tangential")
+    if args.tangential:
+        data = tangential(args)
+        print(dumps(data) if args.json else _tangential_text(data))
+        return 0
     result, source, E_star = calibrate(args)
     data = summary(result, source, E_star)
     if args.plot and data.get("geometry") == "scan":

@@ -13,6 +13,8 @@ front door) stays light (importing all of them takes 0.6-0.8 s more):
   system:     ModalModel, Impactor, Nominal, a_base_star, a_noabs_star (Eqs. 3-7, Sect. 5)
   rig:        seed_rig_model (the built-in Timoshenko beam model of the rig, Appendix A)
   modal_file: load_modal_model, save_modal_model (modes from any FE tool)
+  contact_law: ContactLaw (Eq. 4 or the damped Hertz law of Eq. 10)
+  friction:   JenkinsElement (the elastic dry-friction element of Appendix C)
   protocol:   SteppedSine, SweepResult, run_sweep, sweep (Sects. 5.1-5.3)
   signals:    Signal, read_signal, simulated_signal (measured or simulated time signals)
   impacts:    detect_impacts, ImpactDetection (impact detection, Appendix D.1)
@@ -31,6 +33,7 @@ _MODULE_OF = {
     "a_noabs_star": "system",
     "seed_rig_model": "rig",
     "load_modal_model": "modal_file", "save_modal_model": "modal_file",
+    "ContactLaw": "contact_law", "JenkinsElement": "friction",
     "SteppedSine": "protocol", "SweepResult": "protocol", "run_sweep": "protocol", "sweep": "protocol",
     "Signal": "signals", "read_signal": "signals", "simulated_signal": "signals",
     "detect_impacts": "impacts", "ImpactDetection": "impacts",

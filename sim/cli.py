@@ -88,10 +88,12 @@ def describe_modes(model: Any, rig: Any = None) -> dict:
         "participation": model.participation,
         "modal_mass_ratio": SPHERE_MASS * phi_c**2,
         "phi_tip_over_phi_c": float(model.phi_tip[0] / phi_c),
+        "phi_floor": model.phi_floor,
+        "beam_mass_kg": model.beam_mass,
         "a_base_star": a_base_star(model),
         "dt": 2.0 * np.pi / (15.0 * float(model.omega[-1])),
         "units": {"frequencies_hz": "Hz", "damping_ratios": "1", "phi": "1/sqrt(kg)", "participation": "sqrt(kg)",
-                  "a_base_star": "m", "dt": "s", "modal_mass_ratio": "1 (sphere mass m_a = %g kg)" % SPHERE_MASS},
+                  "beam_mass_kg": "kg (free length without block; null if unknown)", "a_base_star": "m", "dt": "s", "modal_mass_ratio": "1 (sphere mass m_a = %g kg)" % SPHERE_MASS},
     }
     if rig is not None:
         data["rig"] = rig.summary()
@@ -107,6 +109,11 @@ def modes_table(data: dict) -> str:
                      f"{data['phi_wall_left'][j]:>9.4f} {data['phi_wall_right'][j]:>9.4f} {data['phi_tip'][j]:>9.4f} "
                      f"{data['participation'][j]:>10.4f}")
     lines.append("mode values in 1/sqrt(kg), participation in sqrt(kg)")
+    if data["phi_floor"] is not None:
+        lines.append("phi at the cavity floor (friction, App. C): " + " ".join(f"{v:.4f}" for v in data["phi_floor"]))
+    if data["beam_mass_kg"] is not None:
+        paper = f" (paper: ca. {data['rig']['beam_mass_paper_kg']:g} kg)" if data.get("rig") else ""
+        lines.append(f"beam mass (free length without block, Eq. 10): {data['beam_mass_kg']:.4f} kg{paper}")
     lines.append(f"modal mass ratio m_a phi_c^2 = {100 * data['modal_mass_ratio']:.2f} %   "
                  f"phi_tip/phi_c = {data['phi_tip_over_phi_c']:.4f}")
     lines.append(f"a_base* = {data['a_base_star']:.4e} m   ode3 step dt = 2 pi/(15 omega_{data['n_modes']}) = {data['dt']:.4e} s")

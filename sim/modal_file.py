@@ -11,6 +11,8 @@ Format (TOML, UTF-8). Arrays have one value per retained mode, in ascending freq
     phi_wall_right = [1.376, 1.390]  # same at the right cavity wall, 1/sqrt(kg)
     phi_tip        = [1.324, 1.194]  # same at the measurement point (response output), 1/sqrt(kg)
     participation  = [1.106, -0.553] # phi_j^T M b, b = unit x-translation of the base, sqrt(kg)
+    beam_mass_kg   = 1.573           # optional: mass of the beam's free length without the block, kg (Eq. 10)
+    phi_floor      = [1.380, 1.267]  # optional: same at the cavity floor on the beam axis, 1/sqrt(kg) (App. C)
 
     [units]                          # optional; if present each entry must name the unit above
     frequencies_hz = "Hz"
@@ -22,9 +24,12 @@ Format (TOML, UTF-8). Arrays have one value per retained mode, in ascending freq
     model = "3D solid ..."           # sim.calculix: geometry, material, mesh, DOF count, solve time, and a
     [provenance.convergence]         # mesh-convergence table); readers ignore it
 
+The optional keys are needed only by the damped contact law (beam_mass_kg) and by friction (phi_floor);
+files without them load as before, and those laws then refuse the model with one line naming the key.
+
 Signs follow sim/system.py: the wall directions w_l, w_r are both +x, so phi_wall_* are the x-components of
-the mass-normalised modes (phi_j^T M phi_j = 1 kg^0). A mode's overall sign is free, but phi_wall_*, phi_tip
-and participation of that mode must use the same sign.
+the mass-normalised modes (phi_j^T M phi_j = 1 kg^0). A mode's overall sign is free, but phi_wall_*, phi_tip,
+phi_floor and participation of that mode must use the same sign.
 """
 from __future__ import annotations
 
@@ -42,12 +47,15 @@ from sim.system import ModalModel
 FORMAT_NAME = "ies-modal-model"
 FORMAT_VERSION = 1
 ARRAY_KEYS = ("frequencies_hz", "damping_ratios", "phi_wall_left", "phi_wall_right", "phi_tip", "participation")
+OPTIONAL_ARRAY_KEYS = ("phi_floor",)
+BEAM_MASS_KEY = "beam_mass_kg"
 UNITS = {"frequencies_hz": "Hz", "damping_ratios": "1", "phi": "1/sqrt(kg)", "participation": "sqrt(kg)"}
 
 _HEADER = """\
 # ies modal model of the host structure without the sphere (seed paper Eq. 7); format described in
 # sim/modal_file.py. One value per mode, ascending frequency. Mode values are mass-normalised x-values
-# (1/sqrt(kg)) at the left/right cavity walls and the measurement point; participation = phi^T M b (sqrt(kg)).
+# (1/sqrt(kg)) at the left/right cavity walls, the measurement point and (optional) the cavity floor;
+# participation = phi^T M b (sqrt(kg)); beam_mass_kg (optional): the beam's free length without the block (kg).
 """
 
 
@@ -66,8 +74,9 @@ def load_modal_model(path: str | os.PathLike) -> ModalModel:
     """Read a modal-model file (format in this module's docstring) into a ModalModel.
 
     Raises SimulationInputError with one line naming the file and the problem for a missing or unreadable
-    file, invalid TOML, a missing key, a non-numeric entry, arrays of different lengths, frequencies that are
-    not positive and strictly ascending, or damping ratios outside (0, 1).
+    file, invalid TOML, a missing key, a non-numeric entry (also in the optional phi_floor, beam_mass_kg),
+    arrays of different lengths, frequencies that are not positive and strictly ascending, damping ratios
+    outside (0, 1) or a beam mass that is not positive.
     """
     path = Path(path)
     text = read_text(path, "modal file", "TOML", "; give the path of a .toml modal-model file")
@@ -88,15 +97,18 @@ def load_modal_model(path: str | os.PathLike) -> ModalModel:
     for key, unit in units.items():
         if key in UNITS and unit != UNITS[key]:
             raise SimulationInputError(f"{path}: units.{key} is {unit!r} but must be {UNITS[key]!r}; convert the values")
-    arrays = {key: _numbers(path, key, data[key]) for key in ARRAY_KEYS}
+    arrays = {key: _numbers(path, key, data[key]) for key in ARRAY_KEYS + OPTIONAL_ARRAY_KEYS if key in data}
     lengths = {key: a.size for key, a in arrays.items()}
     n = lengths["frequencies_hz"]
     wrong = [f"{key} has {size}" for key, size in lengths.items() if size != n]
     if wrong:
         raise SimulationInputError(f"{path}: arrays must all have {n} values (one per mode) but {'; '.join(wrong)}")
     source = data.get("source", str(path))
+    beam_mass = data.get(BEAM_MASS_KEY)
+    if beam_mass is not None and (isinstance(beam_mass, bool) or not isinstance(beam_mass, (int, float))):
+        raise SimulationInputError(f"{path}: '{BEAM_MASS_KEY}' must be a number (kg), e.g. {BEAM_MASS_KEY} = 1.573")
     try:
-        return ModalModel(**arrays, source=str(source))
+        return ModalModel(**arrays, source=str(source), beam_mass=beam_mass)
     except SimulationInputError as exc:
         raise SimulationInputError(f"{path}: {exc}") from None
 
@@ -107,6 +119,10 @@ def modal_model_document(model: ModalModel, provenance: dict | None = None) -> d
     doc: dict = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "source": model.source}
     for key in ARRAY_KEYS:
         doc[key] = [float(v) for v in getattr(model, key)]
+    if model.phi_floor is not None:
+        doc["phi_floor"] = [float(v) for v in model.phi_floor]
+    if model.beam_mass is not None:
+        doc[BEAM_MASS_KEY] = model.beam_mass
     doc["units"] = dict(UNITS)
     if provenance:
         doc["provenance"] = provenance

@@ -152,3 +152,129 @@ def rebound_error(v0: float, runner, a_base: float = 0.0) -> float:
     y = y0.copy()
     runner(y, sys, Omega, a_base)
     return abs(y[2 * n + 1] - y_ref[2 * n + 1]) / v0
+
+
+def two_body_impact(r_cont: float, v0: float, m_a: float, m_beam: float, k_H: float,
+                    rtol: float = 1e-12) -> dict[str, float]:
+    """One impact of the sphere (m_a, kg) on a free rigid wall of mass m_beam (kg) under Eq. 10 (the paper's
+    xi(r_cont) and d_H, written out here from the paper, not taken from `sim.contact_law`), by scipy DOP853 in
+    the bodies' own coordinates x_a, x_w with events at delta = 0 (onset, release) and delta' = 0 (turning
+    point: approach -> restitution). The sphere closes at v0 (m/s), the wall at rest; delta = x_a - x_w.
+
+    Returns the coefficient of restitution r = -(relative velocity after) / (relative velocity before), the
+    kinetic energies before and after (J), the dissipated energy (J, the integral of d_H delta'^2 as a state),
+    the largest indentation (m) and the times of the turning point and the release (s).
+    """
+    from scipy.integrate import solve_ivp
+
+    xi = 4.5 * math.sqrt(5.0) * (1.0 - r_cont**2) / (r_cont * (r_cont * (9.0 * math.pi - 16.0) + 16.0))
+    m_red = m_beam * m_a / (m_beam + m_a)
+
+    def force(delta: float, rate: float, approach: bool) -> float:
+        if delta <= 0:
+            return 0.0
+        f = k_H * delta**1.5
+        return f + 2.0 * xi * math.sqrt(k_H * math.sqrt(delta) * m_red) * rate if approach else f
+
+    def rhs_of(approach: bool):
+        def rhs(_t, y):
+            delta, rate = y[0] - y[2], y[1] - y[3]
+            f = force(delta, rate, approach)
+            dissipation = f * rate - (k_H * max(delta, 0.0) ** 1.5 * rate)  # the damper's power
+            return [y[1], -f / m_a, y[3], f / m_beam, dissipation]
+        return rhs
+
+    def turning(_t, y):
+        return y[1] - y[3]
+
+    def release(_t, y):
+        return y[0] - y[2]
+
+    turning.terminal, turning.direction = True, -1.0
+    release.terminal, release.direction = True, -1.0
+    # contact duration scale: (m_red^2 / (k_H^2 v0))^(1/5)
+    tau = (m_red**2 / (k_H**2 * v0)) ** 0.2
+    atol = np.array([1e-18, 1e-16 * v0, 1e-18, 1e-16 * v0, 1e-30])
+    y0 = [0.0, v0, 0.0, 0.0, 0.0]  # onset: delta = 0 at t = 0
+    approach = solve_ivp(rhs_of(True), (0.0, 20 * tau), y0, method="DOP853", rtol=rtol, atol=atol, events=turning)
+    if approach.status != 1:
+        raise RuntimeError("the reference impact found no turning point")
+    y1, t1 = approach.y[:, -1], approach.t[-1]
+    restitution = solve_ivp(rhs_of(False), (t1, t1 + 20 * tau), y1, method="DOP853", rtol=rtol, atol=atol,
+                            events=release)
+    if restitution.status != 1:
+        raise RuntimeError("the reference impact found no release")
+    y2 = restitution.y[:, -1]
+    kinetic = lambda y: 0.5 * m_a * y[1] ** 2 + 0.5 * m_beam * y[3] ** 2  # noqa: E731
+    return {"r": -(y2[1] - y2[3]) / v0, "kinetic_before": 0.5 * m_a * v0**2, "kinetic_after": kinetic(y2),
+            "dissipated": float(y2[4]), "max_indentation": float(y1[0] - y1[2]), "t_turning": float(t1),
+            "t_release": float(restitution.t[-1])}
+
+
+def jenkins_reference(k_t: float, mu_N: float, mass: float, X: float, Omega: float, t_end: float,
+                      rtol: float = 1e-12, pieces: list | None = None) -> dict[str, Any]:
+    """Appendix C's elastic Coulomb element on a single DOF, by scipy DOP853 with events: a mass (kg) on a floor
+    moved as X cos(Omega t) (m, rad/s), from rest (spring unloaded) at t = 0 to t_end (s). Absolute
+    coordinates: the mass at x, the slider at p on the floor, spring elongation w = x - p, m x'' = -k_t w.
+    Stick: p' = x_f' (|k_t w| < mu_N); slip: p' = x' (w fixed). Events: |k_t w| = mu_N (stick -> slip) and
+    x' - x_f' = 0 (slip -> stick). The dissipated energy mu_N |x' - x_f'| is integrated as a state.
+
+    Returns x, x' (m, m/s), the relative displacement u = x - x_f and slider position z = p - x_f (m) at t_end,
+    the transitions [(t, "slip" | "stick", sign)], the spring force k_t w just before and after each transition
+    (N), and the dissipated energy (J). pieces: receives (t0, t1, dense solution, kind, sign) per phase.
+    """
+    from scipy.integrate import solve_ivp
+
+    floor = lambda t: X * math.cos(Omega * t)  # noqa: E731
+    floor_v = lambda t: -X * Omega * math.sin(Omega * t)  # noqa: E731
+
+    def rhs_of(slipping: bool):
+        def rhs(t, y):
+            x, xd, p = y[0], y[1], y[2]
+            rel = xd - floor_v(t)
+            return [xd, -k_t * (x - p) / mass, xd if slipping else floor_v(t), mu_N * abs(rel) if slipping else 0.0]
+        return rhs
+
+    def limit_plus(_t, y):
+        return k_t * (y[0] - y[2]) - mu_N
+
+    def limit_minus(_t, y):
+        return k_t * (y[0] - y[2]) + mu_N
+
+    def slip_velocity(t, y):
+        return y[1] - floor_v(t)
+
+    limit_plus.terminal = limit_minus.terminal = slip_velocity.terminal = True
+    limit_plus.direction, limit_minus.direction = 1.0, -1.0
+    scale = max(X, mu_N / k_t)
+    atol = np.array([1e-14 * scale, 1e-14 * scale * max(Omega, math.sqrt(k_t / mass)), 1e-14 * scale, 1e-14 * mu_N * scale])
+    t, y = 0.0, np.array([floor(0.0), floor_v(0.0), floor(0.0), 0.0])
+    slipping, sign = False, 0.0
+    transitions, forces = [], []
+    while t < t_end:
+        if slipping:
+            slip_velocity.direction = -sign
+            events = [slip_velocity]
+        else:
+            events = [limit_plus, limit_minus]
+        sol = solve_ivp(rhs_of(slipping), (t, t_end), y, method="DOP853", rtol=rtol, atol=atol, events=events,
+                        dense_output=pieces is not None, first_step=1e-9)
+        if pieces is not None:
+            pieces.append((t, sol.t[-1], sol.sol, "slip" if slipping else "stick", sign))
+        y, t_new = sol.y[:, -1].copy(), sol.t[-1]
+        if sol.status == 1:
+            before = k_t * (y[0] - y[2])
+            if slipping:
+                slipping = False
+                transitions.append((t_new, "stick", sign))
+            else:
+                sign = 1.0 if sol.t_events[0].size else -1.0
+                y[2] = y[0] - sign * mu_N / k_t  # on the limit exactly
+                slipping = True
+                transitions.append((t_new, "slip", sign))
+            forces.append((before, k_t * (y[0] - y[2])))
+        if t_new <= t and sol.status != 0:
+            raise RuntimeError("the friction reference did not progress")
+        t = t_new
+    return {"x": y[0], "xd": y[1], "u": y[0] - floor(t), "z": y[2] - floor(t), "transitions": transitions,
+            "forces": forces, "dissipated": float(y[3])}

@@ -213,9 +213,14 @@ class RigGeometry(ContactHeights):
         half = 0.5 * self.groove_width
         return self.cavity_z - math.sqrt(max(self.sphere_radius**2 - half**2, 0.0))
 
+    @property
+    def floor_height(self) -> float:
+        """z of the cavity floor (the groove's edges, on which the sphere rests; Sect. 2, Appendix C), in m."""
+        return self.free_length - self.cavity_z
+
     def segments(self, params: RigParameters) -> list[Segment]:
         """Prismatic segments from the clamped section upward, split at the contact and measurement heights."""
-        floor = self.free_length - self.cavity_z
+        floor = self.floor_height
         if not 0 < params.neck_length < floor - self.groove_depth:
             raise SimulationInputError(f"neck length {params.neck_length!r} m must be positive and end below the cavity")
         pieces = [
@@ -440,7 +445,8 @@ class RigModes:
     """Modal description of the rig model (lowest n modes, ascending).
 
     frequencies_hz (Hz); phi_contact, phi_tip (1/sqrt(kg)) at the contact height and the measurement point;
-    participation phi^T M b (sqrt(kg)); beam_mass (kg, free length); moving_mass = r^T M^-1 r with r = M b the
+    participation phi^T M b (sqrt(kg)); phi_floor (1/sqrt(kg)) at the cavity floor on the axis (Appendix C);
+    beam_mass (kg, free length); moving_mass = r^T M^-1 r with r = M b the
     base inertia load (kg; equals the sum of participation^2 over all FE modes and converges to beam_mass);
     params, geometry: what was built.
     """
@@ -449,6 +455,7 @@ class RigModes:
     phi_contact: np.ndarray
     phi_tip: np.ndarray
     participation: np.ndarray
+    phi_floor: np.ndarray
     beam_mass: float
     moving_mass: float
     params: RigParameters
@@ -477,6 +484,8 @@ class RigModes:
             "contact_height_m": self.geometry.contact_height,
             "measurement_height_m": self.geometry.measurement_height,
             "beam_mass_kg": self.beam_mass,
+            "beam_mass_paper_kg": BEAM_MASS_PAPER,
+            "floor_height_m": self.geometry.floor_height,
             "f_measured_hz": list(F_MEASURED_HZ),
             "f_model_error": self.frequency_errors.tolist(),
             "f_paper_model_error": list(F_PAPER_MODEL_ERROR),
@@ -511,6 +520,7 @@ def rig_modes(params: RigParameters = UPDATED_PARAMETERS, geometry: RigGeometry 
         phi_contact=phi[mesh.w_dof(geometry.contact_height)],
         phi_tip=phi[mesh.w_dof(geometry.measurement_height)],
         participation=phi.T @ mesh.base_load,
+        phi_floor=phi[mesh.w_dof(geometry.floor_height)],
         beam_mass=RHO_STEEL * sum(s.section.area * s.length for s in segments),
         moving_mass=mesh.moving_mass,
         params=params,
@@ -587,7 +597,7 @@ def _seed_rig_model(n_modes: int, variant: str) -> ModalModel:
     return ModalModel(
         frequencies_hz=modes.frequencies_hz, damping_ratios=damping_ratios(n_modes),
         phi_wall_left=modes.phi_contact, phi_wall_right=modes.phi_contact, phi_tip=modes.phi_tip,
-        participation=modes.participation,
+        participation=modes.participation, beam_mass=modes.beam_mass, phi_floor=modes.phi_floor,
         source=f"built-in seed rig (sim.rig, Timoshenko beam, updated, variant {variant})",
     )
 

@@ -30,6 +30,7 @@ Conventions shared by every integrator in `sim`
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from typing import NamedTuple
 
@@ -55,6 +56,9 @@ class ModalModel:
         phi_tip: mass-normalised x-value at the measurement point (1/sqrt(kg)).
         participation: phi_j^T M b (sqrt(kg)), b = rigid unit x-translation of the base.
         source: where the model came from (built-in rig model or a file path).
+        beam_mass: mass of the beam's free length without the block (kg), for d_H of Eq. 10; None if unknown.
+        phi_floor: mass-normalised x-values at the cavity floor on the beam axis (1/sqrt(kg)), the host point
+            under the sphere's friction contact (Appendix C); None if unknown.
     """
 
     frequencies_hz: np.ndarray
@@ -64,9 +68,13 @@ class ModalModel:
     phi_tip: np.ndarray
     participation: np.ndarray
     source: str = "unspecified"
+    beam_mass: float | None = None
+    phi_floor: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         names = ("frequencies_hz", "damping_ratios", "phi_wall_left", "phi_wall_right", "phi_tip", "participation")
+        if self.phi_floor is not None:
+            names += ("phi_floor",)
         arrays = {}
         for name in names:
             value = np.atleast_1d(np.asarray(getattr(self, name), dtype=float)).copy()
@@ -86,6 +94,11 @@ class ModalModel:
         d = arrays["damping_ratios"]
         if np.any(d <= 0) or np.any(d >= 1):
             raise SimulationInputError("modal model: damping ratios must lie in (0, 1), e.g. 0.001 for 0.1 %")
+        if self.beam_mass is not None:
+            mass = self.beam_mass
+            if isinstance(mass, bool) or not isinstance(mass, (int, float)) or not math.isfinite(mass) or mass <= 0:
+                raise SimulationInputError(f"modal model: beam mass must be a positive number (kg), got {mass!r}")
+            object.__setattr__(self, "beam_mass", float(mass))
 
     @property
     def n_modes(self) -> int:

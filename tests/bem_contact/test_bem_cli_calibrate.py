@@ -72,3 +72,42 @@ def test_numerical_failure_exits_3(monkeypatch, capsys):
 def test_subprocess_has_no_traceback():
     proc = subprocess.run([sys.executable, "-m", "uq", "calibrate", "--grid", "-3"], capture_output=True, text=True)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_tangential_stiffness_under_the_weight(capsys):
+    """Appendix C: BEM and Mindlin's 8 G* a at N = m_a g (2.96 kN/mm, 7.4x below the paper's 22 kN/mm); the
+    closed form a = (3 N R / (4 E*))^(1/3) with E*, G* of Table 1 computed here."""
+    import json
+    import math
+
+    assert main(["calibrate", "--tangential", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    N = 0.0177 * 9.81
+    E_star = 1 / (0.91 / 207e9 + 0.91 / 102e9)
+    G_star = 1 / (1.7 * 2.6 / 207e9 + 1.7 * 2.6 / 102e9)
+    a = (3 * N * 7.92e-3 / (4 * E_star)) ** (1 / 3)
+    assert data["normal_force"] == pytest.approx(N)
+    assert data["contact_radius"] == pytest.approx(a, rel=1e-12)
+    assert data["k_t_mindlin"] == pytest.approx(8 * G_star * a, rel=1e-12) == pytest.approx(2.962e6, rel=1e-3)
+    assert data["k_t"] == pytest.approx(data["k_t_mindlin"], rel=2e-3)
+    assert data["normal_force_for_paper"] / N == pytest.approx((22e6 / data["k_t_mindlin"]) ** 3) == pytest.approx(410, abs=1)
+    assert main(["calibrate", "--tangential", "--json", "--normal-force", str(data["normal_force_for_paper"])]) == 0
+    at_paper = json.loads(capsys.readouterr().out)
+    assert at_paper["k_t_mindlin"] == pytest.approx(22e6, rel=1e-12)
+    assert at_paper["k_t"] == pytest.approx(22e6, rel=2e-3)
+    assert math.isfinite(at_paper["contact_radius"])
+    assert main(["calibrate", "--tangential"]) == 0
+    assert "22 kN/mm = 7.43 x Mindlin's" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--tangential", "--normal-force", "0"], "--normal-force 0.0 must be"),
+    (["--tangential", "--normal-force", "nan"], "--normal-force nan must be"),
+    (["--normal-force", "1"], "--normal-force belongs to --tangential"),
+    (["--tangential", "crater.ply"], "drop the SCAN file"),
+    (["--tangential", "--grid", "2"], "--grid 2"),
+])
+def test_tangential_bad_input_is_one_line_exit_2(capsys, args, message):
+    assert main(["calibrate", *args]) == 2
+    captured = capsys.readouterr()
+    assert message in captured.err and captured.err.count("\n") == 1 and captured.out == ""

@@ -36,9 +36,10 @@ def test_round_trip_is_exact(tmp_path):
     model = seed_rig_model()
     path = save_modal_model(model, tmp_path / "rig.toml")
     again = load_modal_model(path)
-    for key in ARRAY_KEYS:
+    for key in ARRAY_KEYS + ("phi_floor",):
         assert np.array_equal(getattr(again, key), getattr(model, key)), key
     assert again.source == model.source
+    assert again.beam_mass == model.beam_mass is not None
     assert sorted(os.listdir(tmp_path)) == ["rig.toml"]  # no temporary file left behind
     text = path.read_text()
     assert text.startswith("# ies modal model")
@@ -50,6 +51,22 @@ def test_hand_written_file(tmp_path):
     assert isinstance(model, ModalModel) and model.n_modes == 2
     assert model.frequencies_hz.tolist() == [117.4, 886.0]
     assert model.phi_wall_right[1] == 1.40 and model.source == "hand-written"
+
+
+def test_files_without_the_optional_keys_load_unchanged(tmp_path):
+    """A file of the first format (no beam_mass_kg, no phi_floor) gives the same model as before, and saving
+    it again writes neither key."""
+    model = load_modal_model(write(tmp_path, GOOD))
+    assert model.beam_mass is None and model.phi_floor is None
+    again = tomllib.loads(save_modal_model(model, tmp_path / "again.toml").read_text())
+    assert "beam_mass_kg" not in again and "phi_floor" not in again
+    assert {k: again[k] for k in ARRAY_KEYS} == {k: tomllib.loads(GOOD)[k] for k in ARRAY_KEYS} | {
+        "frequencies_hz": [117.4, 886.0]}
+
+
+def test_optional_keys_are_read(tmp_path):
+    model = load_modal_model(write(tmp_path, GOOD.replace("[units]", "beam_mass_kg = 1.8\nphi_floor = [1.3, 1.2]\n\n[units]")))
+    assert model.beam_mass == 1.8 and model.phi_floor.tolist() == [1.3, 1.2]
 
 
 def replace_line(key, new_line):
@@ -77,6 +94,11 @@ MALFORMED = [
     ('format = "something-else"\n' + GOOD, "expected 'ies-modal-model'"),
     ("version = 7\n" + GOOD, "version 7 is not supported"),
     (GOOD.replace('frequencies_hz = "Hz"', 'frequencies_hz = "kHz"'), "units.frequencies_hz is 'kHz'"),
+    (GOOD.replace("[units]", "phi_floor = [1.3]\n[units]"), "phi_floor has 1"),
+    (GOOD.replace("[units]", "phi_floor = [1.3, \"a\"]\n[units]"), "non-numeric value 'a'"),
+    (GOOD.replace("[units]", "beam_mass_kg = -1.0\n[units]"), "beam mass must be a positive number"),
+    (GOOD.replace("[units]", "beam_mass_kg = \"1.8 kg\"\n[units]"), "'beam_mass_kg' must be a number"),
+    (GOOD.replace("[units]", "beam_mass_kg = [1.8]\n[units]"), "'beam_mass_kg' must be a number"),
 ]
 
 

@@ -56,7 +56,8 @@ def test_table_is_readable(capsys):
     assert main(["modes"]) == 0
     out = capsys.readouterr().out
     assert "117.40" in out and "modal mass ratio" in out and "a_base*" in out
-    assert len(out.splitlines()) == 2 + 9 + 6
+    assert "beam mass (free length without block, Eq. 10): 1.5730 kg (paper: ca. 1.8 kg)" in out
+    assert len(out.splitlines()) == 2 + 9 + 8
 
 
 def test_save_then_load_through_the_cli(tmp_path, capsys):
@@ -65,9 +66,11 @@ def test_save_then_load_through_the_cli(tmp_path, capsys):
     capsys.readouterr()
     built_in = run_json(capsys)
     loaded = run_json(capsys, "--model", str(path))
-    for key in KEYS:
+    for key in KEYS | {"beam_mass_kg", "phi_floor"}:
         assert loaded[key] == built_in[key], key
     assert "rig" not in loaded
+    assert built_in["beam_mass_kg"] == pytest.approx(1.573, abs=1e-3)
+    assert len(built_in["phi_floor"]) == 9
 
 
 @pytest.mark.parametrize("content, message", [

@@ -343,3 +343,40 @@ def test_seed_rig_model_rejects_unknown_variants():
 def test_neck_must_fit_in_the_beam():
     with pytest.raises(SimulationInputError, match="neck length"):
         RigGeometry().segments(replace(UPDATED_PARAMETERS, neck_length=0.5))
+
+
+# ---------------------------------------------------------------------------------------------- the floor point
+def euler_bernoulli_shape(j: int, z: float, length: float, mass: float) -> float:
+    """Mass-normalised mode j (0-based) of a uniform Euler-Bernoulli cantilever of this length (m) and mass
+    (kg) at height z (m): (cosh bz - cos bz - s (sinh bz - sin bz)) / sqrt(mass), tip value 2 / sqrt(mass)."""
+    bl = brentq(lambda b: np.cos(b) * np.cosh(b) + 1, (j + 0.5) * np.pi - 0.5, (j + 0.5) * np.pi + 0.5)
+    s = (np.cosh(bl) + np.cos(bl)) / (np.sinh(bl) + np.sin(bl))
+    x = bl * z / length
+    return abs(np.cosh(x) - np.cos(x) - s * (np.sinh(x) - np.sin(x))) / np.sqrt(mass)
+
+
+def test_floor_point_of_a_uniform_beam_matches_euler_bernoulli():
+    """The rig's geometry without cavity, groove and neck (a uniform 28 x 22 mm cantilever, rigid joint): the
+    floor values against the Euler-Bernoulli shapes (shear and rotary inertia, L/h = 14, make the difference
+    0.2 % in mode 1); the floor-to-contact ratios agree better (0.01 % in mode 1)."""
+    geometry = RigGeometry(cavity_x=0.0, cavity_y=0.0)
+    modes = rig_modes(RigParameters(E_STEEL, 0.1, 0.028, 0.022), geometry, n_modes=3)
+    assert modes.beam_mass == pytest.approx(RHO_STEEL * 0.028 * 0.022 * 0.4, rel=1e-12)
+    eb = lambda j, z: euler_bernoulli_shape(j, z, geometry.free_length, modes.beam_mass)  # noqa: E731
+    assert modes.phi_floor[0] == pytest.approx(eb(0, geometry.floor_height), rel=3e-3)
+    for j, tol in enumerate((3e-4, 2e-3, 6e-3)):
+        ratio = eb(j, geometry.floor_height) / eb(j, geometry.contact_height)
+        assert modes.phi_floor[j] / modes.phi_contact[j] == pytest.approx(ratio, rel=tol)
+
+
+def test_floor_point_lies_between_the_measurement_point_and_the_contact(rig):
+    g = rig.geometry
+    assert g.measurement_height < g.floor_height < g.contact_height
+    assert g.floor_height == pytest.approx(0.4 - 0.0169)
+    low, high = np.minimum(rig.phi_tip, rig.phi_contact), np.maximum(rig.phi_tip, rig.phi_contact)
+    assert np.all((low < rig.phi_floor) & (rig.phi_floor < high))
+    # mode 1 is nearly linear over these 12 mm: linear interpolation within 0.1 %
+    t = (g.floor_height - g.measurement_height) / (g.contact_height - g.measurement_height)
+    assert rig.phi_floor[0] == pytest.approx(rig.phi_tip[0] + t * (rig.phi_contact[0] - rig.phi_tip[0]), rel=1e-3)
+    model = seed_rig_model()
+    assert np.array_equal(model.phi_floor, rig.phi_floor) and model.beam_mass == rig.beam_mass
