@@ -117,9 +117,10 @@ NODE_DATA = gauss_nodes()
 
 
 #: The blocks of a table, in their order: P, Q (n x (s+1), mode by mode), W (s x (s+1), column by column), BX,
-#: BV (s x n), BZ, BZD (s), TR (4 x n), TAU (s+1), WQ (s). The layouts put the inner loops of the kernels
-#: along contiguous memory.
-TABLE_BLOCKS = ("P", "Q", "W", "BX", "BV", "BZ", "BZD", "TR", "TAU", "WQ")
+#: BV (s x n), BZ, BZD (s), TR (4 x n), TAU (s+1), WQ (s), and the contact work's VC, VD (s x n) and VS
+#: (s (s + 1) / 2 x n, the node pairs k <= i). The layouts put the inner loops of the kernels along contiguous
+#: memory.
+TABLE_BLOCKS = ("P", "Q", "W", "BX", "BV", "BZ", "BZD", "TR", "TAU", "WQ", "VC", "VD", "VS")
 
 
 class TableLayout(NamedTuple):
@@ -135,6 +136,9 @@ class TableLayout(NamedTuple):
     TR: int
     TAU: int
     WQ: int
+    VC: int
+    VD: int
+    VS: int
     size: int
     s: int
     n: int
@@ -144,7 +148,7 @@ def table_layout(s: int, n: int) -> TableLayout:
     """The `TableLayout` of s nodes and n modes."""
     r = s + 1
     sizes = {"P": r * n, "Q": r * n, "W": r * s, "BX": s * n, "BV": s * n, "BZ": s, "BZD": s, "TR": 4 * n,
-             "TAU": r, "WQ": s}
+             "TAU": r, "WQ": s, "VC": s * n, "VD": s * n, "VS": s * (s + 1) // 2 * n}
     ends = np.cumsum([sizes[name] for name in TABLE_BLOCKS])
     starts = [0, *ends[:-1].tolist()]
     return TableLayout(**dict(zip(TABLE_BLOCKS, starts)), size=int(ends[-1]), s=s, n=n)
@@ -186,6 +190,8 @@ def _build(tab, nodes, off, kind, h, wall, cst):
     P, Q: c_hom at node i (row s: the step's end) = sum_j P_ij x_j + Q_ij v_j + (harmonic and sphere terms).
     W: c_w at node i drops by sum_k W_ik F_k. BX, BV, BZ, BZD: end-state response to the nodal force F_k.
     TR: mode transitions over h. TAU: node times. WQ: quadrature weights of int F dt over the step.
+    VC, VD, VS: the contact work of mode j over the step, G_j = int sgn phi_w,j F x_j' dt (Gauss quadrature at
+    the nodes), = sum_i F_i (VC_ij x_j + VD_ij v_j) + sum_{k <= i} VS_ikj F_i F_k (`_contact_work`).
     The impulse responses are the transitions' entries: x(t) = b(t), x'(t) = d(t) per unit velocity.
     """
     md = cst.modes
@@ -195,6 +201,7 @@ def _build(tab, nodes, off, kind, h, wall, cst):
     sgn = 1.0 if wall == 0 else -1.0
     inv_ma = cst.par.inv_m_a
     lag_k = np.empty(s)
+    vel = np.zeros((s, s, n))  # vel[i, k, j]: x_j' at node i per unit nodal force F_k
     tab[:] = 0.0
     for i in range(s + 1):
         ui = u[i] if i < s else 1.0
@@ -217,6 +224,11 @@ def _build(tab, nodes, off, kind, h, wall, cst):
             _lagrange(u, wb, v, lag_k)
             for k in range(s):
                 tab[off.W + k * (s + 1) + i] += weight * lag_k[k]
+            if i < s:
+                for j in range(n):
+                    dj = -sgn * _phi(md, j, wall) * transition(lag, md, j)[3] * ui * bq[q] * h * dv
+                    for k in range(s):
+                        vel[i, k, j] += dj * lag_k[k]
     for q in range(xq.size):
         v = xq[q]
         wv, dv = time_map(kind, v)
@@ -241,6 +253,20 @@ def _build(tab, nodes, off, kind, h, wall, cst):
     for k in range(s):
         _, dk = time_map(kind, u[k])
         tab[off.WQ + k] = b[k] * h * dk
+    # the contact work: quadrature weight, sign and wall value folded in; the pairs (i, k) and (k, i) summed
+    for i in range(s):
+        for j in range(n):
+            wphi = tab[off.WQ + i] * sgn * _phi(md, j, wall)
+            _, _, c, d = transition(tab[off.TAU + i], md, j)
+            tab[off.VC + i * n + j] = wphi * c
+            tab[off.VD + i * n + j] = wphi * d
+    for i in range(s):
+        for k in range(i + 1):
+            for j in range(n):
+                pair = tab[off.WQ + i] * sgn * _phi(md, j, wall) * vel[i, k, j]
+                if k < i:
+                    pair += tab[off.WQ + k] * sgn * _phi(md, j, wall) * vel[k, i, j]
+                tab[off.VS + ((i * (i + 1)) // 2 + k) * n + j] = pair
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -440,10 +466,29 @@ def _newton(step, ws, kH):
     return -1
 
 
+@kernel(inline="always")
+def _contact_work(step, Y, Yout, F, lay):
+    """Yout[G + j] += the contact work of mode j's deviation over the step, int sgn phi_w,j F x_j' dt (Gauss
+    quadrature at the nodes of the exact modal velocities there: blocks VC, VD, VS of the table)."""
+    tab, off = step.tab, step.off
+    n = lay.n
+    s = off.s
+    for i in range(s):
+        fi = F[i]
+        for j in range(n):
+            Yout[lay.G + j] += fi * (tab[off.VC + i * n + j] * Y[lay.x + j] + tab[off.VD + i * n + j] * Y[lay.v + j])
+        row = off.VS + (i * (i + 1)) // 2 * n
+        for k in range(i + 1):
+            fik = fi * F[k]
+            for j in range(n):
+                Yout[lay.G + j] += tab[row + k * n + j] * fik
+
+
 @kernel
 def _end_state(step, Y, Yout, F, ct, st, wall):
-    """Yout = the state at the step's end (Eqs. 3-7): transitions, responses to the nodal forces F, and the
-    Fourier integral of the contact force over the step (Gauss quadrature at the node phases)."""
+    """Yout = the state at the step's end (Eqs. 3-7): transitions, responses to the nodal forces F, the
+    Fourier integral of the contact force over the step (Gauss quadrature at the node phases) and the modes'
+    contact work (`_contact_work`)."""
     tab, ph, off = step.tab, step.ph, step.off
     lay = state_layout(off.n)
     n = lay.n
@@ -479,6 +524,7 @@ def _end_state(step, Y, Yout, F, ct, st, wall):
     row = lay.F_l if wall == 0 else lay.F_r
     Yout[row] += sgn * re
     Yout[row + 1] += sgn * im
+    _contact_work(step, Y, Yout, F, lay)
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -553,6 +599,26 @@ def _overlap_fourier(Fs, sigma, ct_e, st_e, Om):
             term *= Om * sigma * _INV[m]
         power *= sigma
     return ct_e * jr + st_e * ji, ct_e * ji - st_e * jr
+
+
+@kernel
+def _overlap_work(S, Fs, sigma, wall, cst, Y):
+    """Y[G + j] -= int over [t_e - sigma, t_e] of sgn phi_w,j F x_j' dt: the contact work of the overlap, from
+    the series of the force (Fs) and of the state (S), both in the backward time (`_series`)."""
+    md = cst.modes
+    lay = state_layout(md.size)
+    p = S.shape[0]
+    sgn = 1.0 if wall == 0 else -1.0
+    for j in range(lay.n):
+        acc = 0.0
+        power = sigma
+        for m in range(p):  # the product series' coefficient of sigma^m, integrated: sigma^(m + 1) / (m + 1)
+            coeff = 0.0
+            for a in range(m + 1):
+                coeff += Fs[a] * S[m - a, lay.v + j]
+            acc += coeff * power * _INV[m]
+            power *= sigma
+        Y[lay.G + j] -= sgn * _phi(md, j, wall) * acc
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -878,6 +944,7 @@ def contact(Y, t, t_stop, wall, ctx, cst):
                 frow = lay.F_l if wall == 0 else lay.F_r
                 Ynew[frow] -= sgn * ore
                 Ynew[frow + 1] -= sgn * oim
+                _overlap_work(S, Fs, d, wall, cst, Ynew)
                 _end_state(step, Ynew, Y, F, cs, ss, wall)
                 return RELEASED, t - d + h_k, steps + 1
             # the contact lasts longer than predicted, or its end is not resolved: a regular step first

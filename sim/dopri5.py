@@ -1,7 +1,7 @@
 """Contacts by the embedded Dormand-Prince 5(4) pair with error control, for the exact integrator (`sim.exact`).
 
 Eqs. 3-7 in the deviation coordinates of `sim.exact` plus the integrands of the Fourier integrals F_l, F_r of
-the contact forces. A step runs on the time map of `sim.flight.time_map` (u^2 from an onset, so the local
+the contact forces and of the modes' contact work (the energy bookkeeping, `sim.energy`). A step runs on the time map of `sim.flight.time_map` (u^2 from an onset, so the local
 error stays of 5th order although the force starts like (t - t_on)^1.5); the step length is controlled by
 the embedded error estimate on all mechanical states (scaled to m of wall/tip displacement, tolerance
 rtol); the release is predicted from c, c', c'' of the active wall and reached by a step with the release
@@ -71,7 +71,8 @@ _FAST = False
 
 @kernel(inline="always", fastmath=_FAST)
 def rhs(ct, st, Y, out, cst):
-    """Eqs. 3-7 in the deviation coordinates at cos, sin(Omega t) = ct, st, plus the integrands of F_l, F_r."""
+    """Eqs. 3-7 in the deviation coordinates at cos, sin(Omega t) = ct, st, plus the integrands of F_l, F_r and
+    of each mode's contact work G_j (`sim.flight.StateLayout`)."""
     md, par = cst.modes, cst.par
     lay = flight.state_layout(md.size)
     g = par.g
@@ -89,6 +90,7 @@ def rhs(ct, st, Y, out, cst):
         v = Y[lay.v + j]
         out[lay.x + j] = v
         out[lay.v + j] = -2.0 * md[j].sig * v - md[j].w2 * Y[lay.x + j] - md[j].phi_l * fl - md[j].phi_r * fr
+        out[lay.G + j] = (md[j].phi_l * fl + md[j].phi_r * fr) * v
     out[lay.z] = Y[lay.zd]
     out[lay.zd] = (fl + fr) * par.inv_m_a
     out[lay.F_l] = fl * ct
