@@ -117,8 +117,8 @@ NODE_DATA = gauss_nodes()
 
 
 #: The blocks of a table, in their order: P, Q (n x (s+1), mode by mode), W (s x (s+1), column by column), BX,
-#: BV (s x n), BZ, BZD (s), TR (4 x n), TAU (s+1), WQ (s), and the contact work's VC, VD (s x n) and VS
-#: (s (s + 1) / 2 x n, the node pairs k <= i). The layouts put the inner loops of the kernels along contiguous
+#: BV (s x n), BZ, BZD (s), TR (4 x n), TAU (s+1), WQ (s), and the contact work's VC, VD (n x s, mode by mode)
+#: and VS (n x s (s + 1) / 2, mode by mode, the node pairs k <= i). The layouts put the inner loops of the kernels along contiguous
 #: memory.
 TABLE_BLOCKS = ("P", "Q", "W", "BX", "BV", "BZ", "BZD", "TR", "TAU", "WQ", "VC", "VD", "VS")
 
@@ -258,15 +258,15 @@ def _build(tab, nodes, off, kind, h, wall, cst):
         for j in range(n):
             wphi = tab[off.WQ + i] * sgn * _phi(md, j, wall)
             _, _, c, d = transition(tab[off.TAU + i], md, j)
-            tab[off.VC + i * n + j] = wphi * c
-            tab[off.VD + i * n + j] = wphi * d
+            tab[off.VC + j * s + i] = wphi * c
+            tab[off.VD + j * s + i] = wphi * d
     for i in range(s):
         for k in range(i + 1):
             for j in range(n):
                 pair = tab[off.WQ + i] * sgn * _phi(md, j, wall) * vel[i, k, j]
                 if k < i:
                     pair += tab[off.WQ + k] * sgn * _phi(md, j, wall) * vel[k, i, j]
-                tab[off.VS + ((i * (i + 1)) // 2 + k) * n + j] = pair
+                tab[off.VS + j * (s * (s + 1) // 2) + (i * (i + 1)) // 2 + k] = pair
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -466,29 +466,38 @@ def _newton(step, ws, kH):
     return -1
 
 
-@kernel(inline="always")
-def _contact_work(step, Y, Yout, F, lay):
-    """Yout[G + j] += the contact work of mode j's deviation over the step, int sgn phi_w,j F x_j' dt (Gauss
-    quadrature at the nodes of the exact modal velocities there: blocks VC, VD, VS of the table)."""
-    tab, off = step.tab, step.off
-    n = lay.n
+@kernel(fastmath=True)
+def _contact_work(tab, off, Y, Yout, F):
+    """Yout[G + j] += the contact work of mode j's deviation over the step of the table `tab` (layout `off`),
+    int sgn phi_w,j F x_j' dt (Gauss quadrature at the nodes of the exact modal velocities there: blocks VC, VD,
+    VS). Bookkeeping only, so the sums may be reordered (fastmath: vectorised dot products)."""
+    lay = state_layout(off.n)
     s = off.s
-    for i in range(s):
-        fi = F[i]
-        for j in range(n):
-            Yout[lay.G + j] += fi * (tab[off.VC + i * n + j] * Y[lay.x + j] + tab[off.VD + i * n + j] * Y[lay.v + j])
-        row = off.VS + (i * (i + 1)) // 2 * n
-        for k in range(i + 1):
-            fik = fi * F[k]
-            for j in range(n):
-                Yout[lay.G + j] += tab[row + k * n + j] * fik
+    pairs = s * (s + 1) // 2
+    for j in range(lay.n):
+        vc = off.VC + j * s
+        vd = off.VD + j * s
+        hc = 0.0
+        hd = 0.0
+        for i in range(s):
+            hc += tab[vc + i] * F[i]
+            hd += tab[vd + i] * F[i]
+        acc = hc * Y[lay.x + j] + hd * Y[lay.v + j]
+        row = off.VS + j * pairs
+        for i in range(s):
+            inner = 0.0
+            for k in range(i + 1):
+                inner += tab[row + k] * F[k]
+            acc += F[i] * inner
+            row += i + 1
+        Yout[lay.G + j] += acc
 
 
 @kernel
 def _end_state(step, Y, Yout, F, ct, st, wall):
-    """Yout = the state at the step's end (Eqs. 3-7): transitions, responses to the nodal forces F, the
-    Fourier integral of the contact force over the step (Gauss quadrature at the node phases) and the modes'
-    contact work (`_contact_work`)."""
+    """Yout = the state at the step's end (Eqs. 3-7): transitions, responses to the nodal forces F, and the
+    Fourier integral of the contact force over the step (Gauss quadrature at the node phases). The modes'
+    contact work is `_contact_work`'s."""
     tab, ph, off = step.tab, step.ph, step.off
     lay = state_layout(off.n)
     n = lay.n
@@ -524,7 +533,6 @@ def _end_state(step, Y, Yout, F, ct, st, wall):
     row = lay.F_l if wall == 0 else lay.F_r
     Yout[row] += sgn * re
     Yout[row + 1] += sgn * im
-    _contact_work(step, Y, Yout, F, lay)
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -875,6 +883,7 @@ def contact(Y, t, t_stop, wall, ctx, cst):
     Om = par.Omega
     kH = par.k_H
     sgn = 1.0 if wall == 0 else -1.0
+    book = par.book > 0.0  # the energy bookkeeping's contact work (`sim.exact`)
     ct = math.cos(Om * t)
     st = math.sin(Om * t)
     _, v = _active(Y, ct, st, wall, cst)
@@ -899,6 +908,8 @@ def contact(Y, t, t_stop, wall, ctx, cst):
               and _resolution(nodes.tail, F, s) <= _RESOLUTION_TOL)
         if ok:
             _end_state(step, Y, Ynew, F, ct, st, wall)
+            if book:
+                _contact_work(step.tab, step.off, Y, Ynew, F)
             c1, s1 = _node_phase(step.ph, s, ct, st)
             c_e, cd_e = _active(Ynew, c1, s1, wall, cst)
             if c_e > 0.0:
@@ -944,8 +955,11 @@ def contact(Y, t, t_stop, wall, ctx, cst):
                 frow = lay.F_l if wall == 0 else lay.F_r
                 Ynew[frow] -= sgn * ore
                 Ynew[frow + 1] -= sgn * oim
-                _overlap_work(S, Fs, d, wall, cst, Ynew)
+                if book:
+                    _overlap_work(S, Fs, d, wall, cst, Ynew)
                 _end_state(step, Ynew, Y, F, cs, ss, wall)
+                if book:
+                    _contact_work(step.tab, step.off, Ynew, Y, F)
                 return RELEASED, t - d + h_k, steps + 1
             # the contact lasts longer than predicted, or its end is not resolved: a regular step first
         k = _ladder(min(R / 1.6, _MAX_STEP_PERIODS * h_ref), h_ref, False)

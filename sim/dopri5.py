@@ -108,9 +108,9 @@ def _warp(kind, u, s):
 
 
 @kernel(inline="always", fastmath=_FAST)
-def _combine(Y, K, d, row, out):
-    """out = Y + sum_j row[j] d[j] K[j], summed left to right (a stage or the solution; zero weights skipped)."""
-    for i in range(Y.size):
+def _combine(Y, K, d, row, out, m):
+    """out[:m] = Y + sum_j row[j] d[j] K[j], summed left to right (a stage or the solution; zero weights skipped)."""
+    for i in range(m):
         acc = Y[i]
         for j in range(len(row)):
             if row[j] != 0.0:
@@ -120,8 +120,9 @@ def _combine(Y, K, d, row, out):
 
 @kernel(inline="always", fastmath=_FAST)
 def _stage(Y, K, tmp, d, row, k, phase, cst):
-    """Stage k: its state Y + sum_j row[j] d[j] K[j] in tmp, and K[k] = F there, at cos, sin(Omega t) = phase."""
-    _combine(Y, K, d, row, tmp)
+    """Stage k: its state Y + sum_j row[j] d[j] K[j] in tmp, and K[k] = F there, at cos, sin(Omega t) = phase.
+    Only the mechanical state: the right-hand side does not depend on the carried integrals."""
+    _combine(Y, K, d, row, tmp, flight.state_layout(cst.modes.size).acc)
     rhs(phase[0], phase[1], tmp, K[k], cst)
 
 
@@ -163,7 +164,7 @@ def step(Y, ct0, st0, s, kind, work, cst):
     _stage(Y, K, tmp, d, a[4], 4, flight.rotate(ct0, st0, Om * p5), cst)
     ct, st = flight.rotate(ct0, st0, Om * s)
     _stage(Y, K, tmp, d, a[5], 5, (ct, st), cst)
-    _combine(Y, K, d, DOPRI5.b, Ynew)
+    _combine(Y, K, d, DOPRI5.b, Ynew, Y.size)
     rhs(ct, st, Ynew, K[6], cst)
     err = 0.0
     for j in range(lay.n):

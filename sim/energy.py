@@ -42,8 +42,9 @@ def stored_energy(y: np.ndarray, sys: SystemArrays) -> float:
 #: One impact (onset to release) of a run_step call (Appendix D, Sect. 5.5): the fields of
 #: `sim.flight.ImpactColumns` with their units there (wall 0 = left, 1 = right; period counted from 0 in the call).
 IMPACT_DTYPE = np.dtype([(name, np.float64) for name in IMPACT._fields])
-#: Impact log rows per excitation period reserved by `Ledger` unless given (the rig: 2-6 impacts per period).
-IMPACTS_PER_PERIOD_RESERVED = 32
+#: Impact log rows per excitation period reserved by `Ledger` unless given (the rig: 1-4 impacts per period in
+#: sweeps); more impacts are counted in `Ledger.dropped`, not recorded.
+IMPACTS_PER_PERIOD_RESERVED = 8
 
 
 @dataclass
@@ -121,5 +122,5 @@ def integrator_output(n_periods: int, n_modes: int, record: np.ndarray, ledger: 
     """The `sim.flight.Output` of a run_step call of n_periods: the impact log sized by the ledger (none without)."""
     rows = ledger.log_rows(n_periods) if ledger is not None else 0
     return Output(amplitudes=np.empty(n_periods), impacts=np.zeros(n_periods, dtype=np.int64), record=record,
-                  ledger=np.zeros((n_periods, LEDGER.modes + n_modes)), log=np.full((rows, len(IMPACT)), np.nan),
+                  ledger=np.zeros((n_periods, LEDGER.modes + n_modes)), log=np.empty((rows, len(IMPACT))),
                   log_count=np.zeros(1, dtype=np.int64))

@@ -56,9 +56,9 @@ Sigma_j = int_T s_j e^{-i Omega t} dt = X_j + S_j T / 2 (X_j the integral above)
     contact work of j  C_j = int (phi_l,j f_l + phi_r,j f_r) s_j' dt = G_j + Omega Re(i S_j conj(phi_l,j F_l + phi_r,j F_r))
     dissipation of j   D_j = int 2 D_j omega_j s_j'^2 dt = W_j - C_j - [E_j]      (mode j's energy equation, Eq. 7)
 
-G_j = int (phi_l,j f_l + phi_r,j f_r) x_j' dt is accumulated during contacts only (Gauss quadrature of the exact
-modal velocities at the collocation nodes, `sim.collocation`; a component of the Dormand-Prince state); the
-harmonic part of s_j' enters through F_l, F_r. The contact forces are internal: the balance
+G_j = int (phi_l,j f_l + phi_r,j f_r) x_j' dt is accumulated during contacts only, and only when a ledger is
+asked for (Gauss quadrature of the exact modal velocities at the collocation nodes, `sim.collocation`; a
+component of the Dormand-Prince state); the harmonic part of s_j' enters through F_l, F_r. The contact forces are internal: the balance
 sum_j W_j + W_a - sum_j D_j - [E] (E the stored energy, `sim.energy.stored_energy`) vanishes up to the
 contact integration's error.
 """
@@ -300,7 +300,8 @@ def _fly(p, t, released, onsets, cst, grid, work, record):
         if wall != -1:
             return (STALLED_SEARCH if wall == -2 else OK), t, wall, tau
         flight.free_flight(Y, Ynew, tau, md)
-        Y[:] = Ynew
+        for i in range(lay.acc):
+            Y[i] = Ynew[i]
         k += 1
         t = k * hg
         if onsets > _MAX_ONSETS_PER_PERIOD:
@@ -331,7 +332,8 @@ def _fly(p, t, released, onsets, cst, grid, work, record):
             if wall != -1:
                 return (STALLED_SEARCH if wall == -2 else OK), t, wall, tau
         c_valid = True
-        Y[:] = Ynew
+        for i in range(lay.acc):
+            Y[i] = Ynew[i]
         for j in range(lay.n):
             A[j] *= md[j].grid_decay
         k += 1
@@ -582,9 +584,10 @@ def _advance(y, run):
 # Python entry point
 # ----------------------------------------------------------------------------------------------------------
 def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float, h_max: float,
-             h_fixed: float = 0.0, stride: int | None = None) -> tuple[Constants, Grid]:
+             h_fixed: float = 0.0, stride: int | None = None, book: bool = True) -> tuple[Constants, Grid]:
     """Constants and grid of the kernels for one excitation (see the module docstring for the symbols); the
-    state is recorded every `stride` grid steps (default N: once per period)."""
+    state is recorded every `stride` grid steps (default N: once per period); `book`: keep the contact work of
+    the energy bookkeeping and the impact log (else the ledger's dissipation is not valid)."""
     stride = N if stride is None else stride
     omega = np.asarray(sys.omega, dtype=np.float64)
     D = np.asarray(sys.D, dtype=np.float64)
@@ -615,7 +618,7 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
                      W_l_re=Wl.real, W_l_im=Wl.imag, W_r_re=Wr.real, W_r_im=Wr.imag, P_re=P.real, P_im=P.imag,
                      gap_tol=GAP_TOLERANCE * sys.g, v_min=MIN_APPROACH_SPEED, M_l0=abs(Wl) * Omega**2,
                      M_r0=abs(Wr) * Omega**2, err_z=1.0 / atol, err_zd=1.0 / (atol * omega[0]),
-                     h_max=h_max, h_fixed=h_fixed)
+                     h_max=h_max, h_fixed=h_fixed, book=float(book))
     tr_g = np.empty((4, n))
     flight.flight_transitions(hg, md, tr_g)
     md["grid_a"], md["grid_b"], md["grid_c"], md["grid_d"] = tr_g
@@ -669,7 +672,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     N = -(-N // samples) * samples
     omega_max = float(np.max(sys.omega))
     h_max = 0.5 / omega_max  # keeps DOPRI5 far inside its stability region on the highest mode
-    cst, grid = _prepare(Omega, a_base, sys, N, rtol, h_max, float(fixed_contact_step), N // samples)
+    cst, grid = _prepare(Omega, a_base, sys, N, rtol, h_max, float(fixed_contact_step), N // samples,
+                         book=ledger is not None)
     work = _work(cst)
     out = integrator_output(n_periods, sys.omega.size, record_arr, ledger)
     stored_start = stored_energy(y, sys) if ledger is not None else math.nan

@@ -115,6 +115,7 @@ RUN = np.dtype([
     ("err_zd", np.float64),
     ("h_max", np.float64),  # longest Dormand-Prince contact step (s)
     ("h_fixed", np.float64),  # > 0: fixed Dormand-Prince contact step instead of error control (s)
+    ("book", np.float64),  # 1: keep the energy bookkeeping's contact work and the impact log, 0: not (`sim.energy`)
 ], align=True)
 
 
@@ -265,15 +266,15 @@ def _fly_mode(Y, Ynew, j, tr, lay):
 
 @kernel(inline="always")
 def _fly_sphere(Y, Ynew, tau, lay):
-    """The sphere of a free flight over tau s (constant velocity); the carried integrals do not change."""
+    """The sphere of a free flight over tau s (constant velocity). The carried integrals do not change in free
+    flight: they are not written (the callers copy the mechanical state, `lay.acc` components, back)."""
     Ynew[lay.z] = Y[lay.z] + tau * Y[lay.zd]
-    for i in range(lay.zd, Y.size):
-        Ynew[i] = Y[i]
+    Ynew[lay.zd] = Y[lay.zd]
 
 
 @kernel
 def grid_flight(Y, Ynew, h, md):
-    """Ynew = free flight of Y over one grid step h (s) with the transitions of the records (grid_a ... grid_d)."""
+    """Ynew[:acc] = free flight of Y over one grid step h (s) with the transitions of the records (grid_a ... grid_d)."""
     lay = state_layout(md.size)
     for j in range(lay.n):
         _fly_mode(Y, Ynew, j, (md[j].grid_a, md[j].grid_b, md[j].grid_c, md[j].grid_d), lay)
@@ -282,7 +283,7 @@ def grid_flight(Y, Ynew, h, md):
 
 @kernel
 def free_flight(Y, Ynew, tau, md):
-    """Ynew = free flight of Y over tau s (Eq. 9)."""
+    """Ynew[:acc] = free flight of Y over tau s (Eq. 9)."""
     lay = state_layout(md.size)
     for j in range(lay.n):
         _fly_mode(Y, Ynew, j, transition(tau, md, j), lay)
