@@ -60,7 +60,7 @@ class Ledger:
     `sim.flight.LEDGER` (input work, contact dissipation, c_1 of tip and walls, dissipation per mode, J and m);
     `impacts`: structured array (IMPACT_DTYPE) of the impacts in onset order; `dropped`: impacts beyond the
     capacity (counted, not recorded; 0 unless the capacity was too small); `stored_start`, `stored_end`: the
-    stored energy (J) at the call's start and end; Omega (rad/s).
+    stored energy (J) at the call's start and end; Omega (rad/s); `damping`: 2 D_j omega_j of each mode (1/s).
     """
 
     capacity: int | None = None
@@ -70,6 +70,7 @@ class Ledger:
     stored_start: float = math.nan
     stored_end: float = math.nan
     Omega: float = math.nan
+    damping: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def log_rows(self, n_periods: int) -> int:
         """Rows of the impact log for a call of n_periods."""
@@ -78,8 +79,9 @@ class Ledger:
         return max(0, int(self.capacity))
 
     def fill(self, periods: np.ndarray, log: np.ndarray, count: int, stored_start: float, stored_end: float,
-             Omega: float) -> None:
+             Omega: float, sys: SystemArrays) -> None:
         """Store what the integrator wrote (its `Output.ledger`, `Output.log` and the impact count)."""
+        self.damping = 2.0 * np.asarray(sys.D) * np.asarray(sys.omega)
         self.periods = periods
         kept = min(count, log.shape[0])
         self.impacts = np.ascontiguousarray(log[:kept]).view(IMPACT_DTYPE).reshape(-1)
@@ -108,6 +110,18 @@ class Ledger:
             raise ValueError(f"where must be 'tip', 'left' or 'right', got {where!r}")
         re = getattr(LEDGER, f"{where}_re")
         return self.periods[:, re] + 1j * self.periods[:, re + 1]
+
+    @property
+    def period(self) -> float:
+        """The excitation period T = 2 pi / Omega (s)."""
+        return 2.0 * math.pi / self.Omega
+
+    @property
+    def mean_kinetic(self) -> np.ndarray:
+        """Time average of each mode's kinetic energy s_j'^2 / 2 over the call (J): its dissipation over
+        2 D_j omega_j (exact with the bookkeeping, no sampling)."""
+        seconds = self.periods.shape[0] * self.period
+        return self.dissipation.sum(axis=0) / self.damping / (2.0 * seconds)
 
     @property
     def balance_error(self) -> float:

@@ -690,5 +690,5 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
         raise SimulationDiverged(
             f"exact integrator failed in period {period + 1} of this step ({why}); check k_H, g and the level")
     if ledger is not None:
-        ledger.fill(out.ledger, out.log, int(out.log_count[0]), stored_start, stored_energy(y, sys), Omega)
+        ledger.fill(out.ledger, out.log, int(out.log_count[0]), stored_start, stored_energy(y, sys), Omega, sys)
     return out.amplitudes, out.impacts

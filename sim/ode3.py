@@ -308,5 +308,5 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
         raise SimulationDiverged(
             f"ode3 diverged after {t:.4g} s of this step ({why}); reduce dt_scale or check k_H, g and the level")
     if ledger is not None:
-        ledger.fill(out.ledger, out.log, 0, stored_start, stored_energy(y, sys), Omega)
+        ledger.fill(out.ledger, out.log, 0, stored_start, stored_energy(y, sys), Omega, sys)
     return out.amplitudes, out.impacts
