@@ -36,11 +36,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from sim.energy import Ledger
 from sim.system import ModalModel, Nominal
+
+if TYPE_CHECKING:  # sim.energy imports the kernels (numba); the measures need only the ledger's arrays
+    from sim.energy import Ledger
 
 #: cv = std/mean of the per-period amplitudes above which the response counts as strongly modulated.
 #: Chosen from simulations of the rig model at a_base/a_base* = 7.4 (Fig. 4; down-sweep, 3 runs): inside the

@@ -11,6 +11,9 @@ Layout (every table and key is optional except where noted; SI units)::
     seed = 1                     # random stream of the repetitions (Sect. 5.1: perturbed frequencies)
     repetitions = 5
     output = "results/fig7"      # default output folder (`--out` overrides), relative to the cwd
+    outputs = ["mean", "max"]    # model "ies": the outputs the bands / indices are computed for (default
+                                 # mean, max; also "restitution", "significant_impacts_per_period", ... of
+                                 # sim.measures.SCATTERING_MEASURES, at the resonant mean's eta)
 
     [parameters.D]               # listed parameters are varied; unlisted ones stay nominal.
     nominal = 0.00085            # missing keys default to Table 2 (model "ies")
@@ -67,7 +70,7 @@ KINDS = ("interval", "sobol", "response")
 RESPONSE_FIGURES = ("fig5", "fig6")
 DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
-    "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output"},
+    "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output", "outputs"},
     "parameters": None,  # one sub-table per parameter
     "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "perturb", "repetition",
                    "start", "dt_scale"},
@@ -101,10 +104,11 @@ class Study:
     source: str = ""
     modal_model: Path | None = None
     figures: tuple[str, ...] = RESPONSE_FIGURES
+    outputs: tuple[str, ...] = ()
 
     def make_model(self) -> Any:
         return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
-                          modal_model=self.modal_model)
+                          modal_model=self.modal_model, outputs=self.outputs)
 
     def to_dict(self) -> dict:
         """The resolved study as plain data (written to the results' metadata)."""
@@ -115,7 +119,7 @@ class Study:
             "levels": list(self.levels), "protocol": dict(self.protocol), "parameters": self.space.to_dict(),
             "interval": {"designs": list(self.designs), "interior": self.interior, "z": self.z, "fix": dict(self.fix)},
             "sobol": {"n": self.sobol_n, "bootstrap": self.bootstrap, "confidence": self.confidence},
-            "response": {"figures": list(self.figures)},
+            "response": {"figures": list(self.figures)}, "outputs": list(self.outputs),
         }
 
 
@@ -223,8 +227,11 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
     if kind == "response" and model_spec != "ies":
         raise StudyError("a response study runs the simulator: model = \"ies\"")
 
+    outputs = head.get("outputs", [])
+    if not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs) or len(set(outputs)) != len(outputs):
+        raise StudyError(f"[study] outputs must be a list of distinct output names, e.g. [\"mean\", \"restitution\"], got {outputs!r}")
     study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
-                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures))
+                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures), tuple(outputs))
     model = study.make_model()  # unknown model -> one line now
     if modal_model is not None:
         model.check()  # an unreadable modal file -> one line now

@@ -132,3 +132,26 @@ def test_records_r_and_energy_share_match_a_dop853_solution(rig_apr):
         v_mod = lambda t: np.real(1j * Omega * c1[p] * np.exp(1j * Omega * (t - p * T)))  # noqa: E731
         r_ref = -(v_mod(t_on[i] + rec["duration"][i]) - after[2 * n + 1]) / (v_mod(t_on[i]) - before[2 * n + 1])
         assert modal_restitution(rec[i:i + 1], ledger.fundamental("tip"), Omega)[0] == pytest.approx(r_ref, rel=1e-6)
+
+
+def test_uq_model_outputs_the_scattering_measures():
+    """`uq.models.IESModel` outputs every scattering measure at the resonant mean's eta; a study names the ones
+    it bands (`[study] outputs`); an unknown name is one StudyError line."""
+    from uq.errors import StudyError
+    from uq.models import make_model
+
+    model = make_model("ies", protocol=dict(eta_start=0.97, eta_stop=0.99, n_eta=3, wait=0.3, hold=0.3),
+                       outputs=("mean", "restitution_wall"))
+    assert model.banded_outputs == ("mean", "restitution_wall")
+    records = []
+    for rep in range(2):
+        out = model({"D": 0.00085, "g": 0.58e-3, "k_H": 282e3 * 1e3**1.5}, 7.4, rep, 1)
+        records.append({"outputs": {k: v for k, v in out.items() if k != "trace"}, "trace": out["trace"], "error": ""})
+    summary = model.aggregate(records)
+    res = model.sweep_result(records)
+    at = res.eta == res.eta_resonant_mean
+    for name in ("restitution_wall", "significant_impacts_per_period", "higher_mode_energy_share", "balance_error"):
+        assert summary[name][0] == pytest.approx(float(res.scattering[name][at][0]))
+    assert abs(summary["balance_error"][0]) < 1e-6
+    with pytest.raises(StudyError, match="unknown output"):
+        make_model("ies", outputs=("bogus",))
