@@ -276,7 +276,7 @@ class WorkRows(NamedTuple):
     """Rows of the workspace (`Workspace.rows`) of `contact`: at the nodes and the end (s + 1 entries) the free
     closing function `chom`, its rate `dchom` and the right-hand side `rhs`; at the nodes the indentations
     `delta`, forces `F` and dF/d delta `D`; the states `Ynew` (a step's end) and `Ys` (a release step's
-    start); the backward series `Fs` of the force."""
+    start); the backward series `Fs` of the force; the products F_i F_k (k <= i) of the nodal forces `pairs`."""
 
     chom: int
     dchom: int
@@ -287,6 +287,7 @@ class WorkRows(NamedTuple):
     Ynew: int
     Ys: int
     Fs: int
+    pairs: int
 
 
 ROW = WorkRows(*range(len(WorkRows._fields)))
@@ -307,7 +308,7 @@ def workspace(nodes: Nodes, n: int) -> Workspace:
     s = nodes.u.size
     order = nodes.onset.shape[0]
     lay = state_layout(n)
-    return Workspace(rows=np.zeros((len(ROW), max(s + 1, lay.size, order))), A=np.zeros((s + 1, s + 1)),
+    return Workspace(rows=np.zeros((len(ROW), max(s + 1, lay.size, order, s * (s + 1) // 2))), A=np.zeros((s + 1, s + 1)),
                      S=np.zeros((order, lay.acc)))
 
 
@@ -467,13 +468,19 @@ def _newton(step, ws, kH):
 
 
 @kernel(fastmath=True)
-def _contact_work(tab, off, Y, Yout, F):
+def _contact_work(tab, off, Y, Yout, F, FF):
     """Yout[G + j] += the contact work of mode j's deviation over the step of the table `tab` (layout `off`),
     int sgn phi_w,j F x_j' dt (Gauss quadrature at the nodes of the exact modal velocities there: blocks VC, VD,
-    VS). Bookkeeping only, so the sums may be reordered (fastmath: vectorised dot products)."""
+    VS), with FF the scratch for the s (s + 1) / 2 products F_i F_k. Bookkeeping only, so the sums may be
+    reordered (fastmath: vectorised dot products)."""
     lay = state_layout(off.n)
     s = off.s
     pairs = s * (s + 1) // 2
+    m = 0
+    for i in range(s):
+        for k in range(i + 1):
+            FF[m] = F[i] * F[k]
+            m += 1
     for j in range(lay.n):
         vc = off.VC + j * s
         vd = off.VD + j * s
@@ -482,15 +489,19 @@ def _contact_work(tab, off, Y, Yout, F):
         for i in range(s):
             hc += tab[vc + i] * F[i]
             hd += tab[vd + i] * F[i]
-        acc = hc * Y[lay.x + j] + hd * Y[lay.v + j]
         row = off.VS + j * pairs
-        for i in range(s):
-            inner = 0.0
-            for k in range(i + 1):
-                inner += tab[row + k] * F[k]
-            acc += F[i] * inner
-            row += i + 1
-        Yout[lay.G + j] += acc
+        q0 = q1 = q2 = q3 = 0.0  # four independent sums: the additions need not wait for each other
+        m = 0
+        while m + 4 <= pairs:
+            q0 += tab[row + m] * FF[m]
+            q1 += tab[row + m + 1] * FF[m + 1]
+            q2 += tab[row + m + 2] * FF[m + 2]
+            q3 += tab[row + m + 3] * FF[m + 3]
+            m += 4
+        while m < pairs:
+            q0 += tab[row + m] * FF[m]
+            m += 1
+        Yout[lay.G + j] += hc * Y[lay.x + j] + hd * Y[lay.v + j] + (q0 + q1) + (q2 + q3)
 
 
 @kernel
@@ -909,7 +920,7 @@ def contact(Y, t, t_stop, wall, ctx, cst):
         if ok:
             _end_state(step, Y, Ynew, F, ct, st, wall)
             if book:
-                _contact_work(step.tab, step.off, Y, Ynew, F)
+                _contact_work(step.tab, step.off, Y, Ynew, F, rows[ROW.pairs])
             c1, s1 = _node_phase(step.ph, s, ct, st)
             c_e, cd_e = _active(Ynew, c1, s1, wall, cst)
             if c_e > 0.0:
@@ -959,7 +970,7 @@ def contact(Y, t, t_stop, wall, ctx, cst):
                     _overlap_work(S, Fs, d, wall, cst, Ynew)
                 _end_state(step, Ynew, Y, F, cs, ss, wall)
                 if book:
-                    _contact_work(step.tab, step.off, Ynew, Y, F)
+                    _contact_work(step.tab, step.off, Ynew, Y, F, rows[ROW.pairs])
                 return RELEASED, t - d + h_k, steps + 1
             # the contact lasts longer than predicted, or its end is not resolved: a regular step first
         k = _ladder(min(R / 1.6, _MAX_STEP_PERIODS * h_ref), h_ref, False)

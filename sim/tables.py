@@ -85,6 +85,18 @@ def overview_text(data: dict[str, list]) -> str:
     return "\n".join(lines)
 
 
+def scattering_text(data: dict[str, list]) -> str:
+    """Per level, at the resonant eta: all and significant impacts per period, r from the tip and from the wall,
+    the energy share of modes 2..N after impacts and the dissipation shares (Sect. 5.5, Appendix D)."""
+    lines = [f"{'level':>7} {'imp/T':>6} {'sig/T':>6} {'r_tip':>6} {'r_wall':>6} {'E2..N':>6} {'D_1':>6} {'D_2..N':>6}  regime"]
+    for i, level in enumerate(data["levels"]):
+        lines.append(f"{level:7.3f} {data['impacts_per_period'][i]:6.2f} {data['significant_impacts_per_period'][i]:6.2f} "
+                     f"{data['restitution'][i]:6.3f} {data['restitution_wall'][i]:6.3f} "
+                     f"{data['higher_mode_energy_share'][i]:6.3f} {data['dissipation_fundamental'][i]:6.3f} "
+                     f"{data['dissipation_higher_modes'][i]:6.3f}  {data['regime'][i]}")
+    return "\n".join(lines)
+
+
 def optimum_line(data: dict[str, list]) -> str:
     """Where the resonant mean level is lowest (the optimum, Sect. 5.3) and the reductions there, 1 / level (the
     levels are normalised by the linear resonant amplitude a_noabs* at the same excitation)."""

@@ -47,7 +47,8 @@ Layout (every table and key is optional except where noted; SI units)::
     confidence = 0.95
 
     [response]                   # kind "response": the frequency responses and resonant levels of the nominal
-    figures = ["fig5", "fig6"]   # point (the parameters' nominal values) at every level, as Figs. 5 and 6
+    figures = ["fig5", "fig6"]   # point (the parameters' nominal values) at every level, as Figs. 5 and 6, and
+                                 # "figD2", "figD3": impacts per period and r at the resonant eta (Appendix D)
 
 Unknown tables or keys, unknown parameters, min > max, non-positive bounds and the like are refused with
 a `StudyError` whose one line names the file, the key and the fix.
@@ -67,7 +68,7 @@ from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_
 
 KINDS = ("interval", "sobol", "response")
 #: the figures a response study draws (Figs. 5 and 6 of the seed paper)
-RESPONSE_FIGURES = ("fig5", "fig6")
+RESPONSE_FIGURES = ("fig5", "fig6", "figD2", "figD3")
 DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
     "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output", "outputs"},
