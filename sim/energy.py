@@ -42,9 +42,9 @@ def stored_energy(y: np.ndarray, sys: SystemArrays) -> float:
 #: One impact (onset to release) of a run_step call (Appendix D, Sect. 5.5): the fields of
 #: `sim.flight.ImpactColumns` with their units there (wall 0 = left, 1 = right; period counted from 0 in the call).
 IMPACT_DTYPE = np.dtype([(name, np.float64) for name in IMPACT._fields])
-#: Impact log rows per excitation period reserved by `Ledger` unless given (the rig: 1-4 impacts per period in
+#: Impact log rows per excitation period reserved by `Ledger` unless given (the rig: 1-5 impacts per period in
 #: sweeps); more impacts are counted in `Ledger.dropped`, not recorded.
-IMPACTS_PER_PERIOD_RESERVED = 8
+IMPACTS_PER_PERIOD_RESERVED = 16
 
 
 @dataclass
