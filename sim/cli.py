@@ -491,13 +491,14 @@ def add_overview_arguments(parser: argparse.ArgumentParser) -> None:
 def overview_command(args: argparse.Namespace) -> int:
     """`ies overview`: the resonant level at each excitation level (Sect. 5.3; Fig. 6)."""
     from sim.figures import overview_title, plot_overview
-    from sim.tables import OVERVIEW_COLUMNS, overview_data, overview_rows, overview_text
+    from sim.tables import OVERVIEW_COLUMNS, dissipation_key, overview_data, overview_rows, overview_text
 
     started = time.perf_counter()
     levels = parse_levels(args.levels)
     with simulation(args, levels, label="overview") as (folder, protocol, model, _, results):
         data = {**overview_data(levels, results), "sweeps": [r.to_dict() for r in results], "reps": args.reps,
                 "seed": args.seed, "model": model.source, "wall_time_s": time.perf_counter() - started}
+        data["dissipation"] = dissipation_key(data)
         written = write_results(folder, "overview", OVERVIEW_COLUMNS, overview_rows(data), data)
     return report(args, data, written, lambda path: plot_overview(data, path, overview_title(data)),
                   overview_text(data))

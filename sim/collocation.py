@@ -117,9 +117,10 @@ NODE_DATA = gauss_nodes()
 
 
 #: The blocks of a table, in their order: P, Q (n x (s+1), mode by mode), W (s x (s+1), column by column), BX,
-#: BV (s x n), BZ, BZD (s), TR (4 x n), TAU (s+1), WQ (s). The layouts put the inner loops of the kernels
-#: along contiguous memory.
-TABLE_BLOCKS = ("P", "Q", "W", "BX", "BV", "BZ", "BZD", "TR", "TAU", "WQ")
+#: BV (s x n), BZ, BZD (s), TR (4 x n), TAU (s+1), WQ (s), and the contact work's VC, VD (n x s, mode by mode)
+#: and VS (n x s (s + 1) / 2, mode by mode, the node pairs k <= i). The layouts put the inner loops of the kernels along contiguous
+#: memory.
+TABLE_BLOCKS = ("P", "Q", "W", "BX", "BV", "BZ", "BZD", "TR", "TAU", "WQ", "VC", "VD", "VS")
 
 
 class TableLayout(NamedTuple):
@@ -135,6 +136,9 @@ class TableLayout(NamedTuple):
     TR: int
     TAU: int
     WQ: int
+    VC: int
+    VD: int
+    VS: int
     size: int
     s: int
     n: int
@@ -144,7 +148,7 @@ def table_layout(s: int, n: int) -> TableLayout:
     """The `TableLayout` of s nodes and n modes."""
     r = s + 1
     sizes = {"P": r * n, "Q": r * n, "W": r * s, "BX": s * n, "BV": s * n, "BZ": s, "BZD": s, "TR": 4 * n,
-             "TAU": r, "WQ": s}
+             "TAU": r, "WQ": s, "VC": s * n, "VD": s * n, "VS": s * (s + 1) // 2 * n}
     ends = np.cumsum([sizes[name] for name in TABLE_BLOCKS])
     starts = [0, *ends[:-1].tolist()]
     return TableLayout(**dict(zip(TABLE_BLOCKS, starts)), size=int(ends[-1]), s=s, n=n)
@@ -186,6 +190,8 @@ def _build(tab, nodes, off, kind, h, wall, cst):
     P, Q: c_hom at node i (row s: the step's end) = sum_j P_ij x_j + Q_ij v_j + (harmonic and sphere terms).
     W: c_w at node i drops by sum_k W_ik F_k. BX, BV, BZ, BZD: end-state response to the nodal force F_k.
     TR: mode transitions over h. TAU: node times. WQ: quadrature weights of int F dt over the step.
+    VC, VD, VS: the contact work of mode j over the step, G_j = int sgn phi_w,j F x_j' dt (Gauss quadrature at
+    the nodes), = sum_i F_i (VC_ij x_j + VD_ij v_j) + sum_{k <= i} VS_ikj F_i F_k (`_contact_work`).
     The impulse responses are the transitions' entries: x(t) = b(t), x'(t) = d(t) per unit velocity.
     """
     md = cst.modes
@@ -195,6 +201,7 @@ def _build(tab, nodes, off, kind, h, wall, cst):
     sgn = 1.0 if wall == 0 else -1.0
     inv_ma = cst.par.inv_m_a
     lag_k = np.empty(s)
+    vel = np.zeros((s, s, n))  # vel[i, k, j]: x_j' at node i per unit nodal force F_k
     tab[:] = 0.0
     for i in range(s + 1):
         ui = u[i] if i < s else 1.0
@@ -217,6 +224,11 @@ def _build(tab, nodes, off, kind, h, wall, cst):
             _lagrange(u, wb, v, lag_k)
             for k in range(s):
                 tab[off.W + k * (s + 1) + i] += weight * lag_k[k]
+            if i < s:
+                for j in range(n):
+                    dj = -sgn * _phi(md, j, wall) * transition(lag, md, j)[3] * ui * bq[q] * h * dv
+                    for k in range(s):
+                        vel[i, k, j] += dj * lag_k[k]
     for q in range(xq.size):
         v = xq[q]
         wv, dv = time_map(kind, v)
@@ -241,6 +253,20 @@ def _build(tab, nodes, off, kind, h, wall, cst):
     for k in range(s):
         _, dk = time_map(kind, u[k])
         tab[off.WQ + k] = b[k] * h * dk
+    # the contact work: quadrature weight, sign and wall value folded in; the pairs (i, k) and (k, i) summed
+    for i in range(s):
+        for j in range(n):
+            wphi = tab[off.WQ + i] * sgn * _phi(md, j, wall)
+            _, _, c, d = transition(tab[off.TAU + i], md, j)
+            tab[off.VC + j * s + i] = wphi * c
+            tab[off.VD + j * s + i] = wphi * d
+    for i in range(s):
+        for k in range(i + 1):
+            for j in range(n):
+                pair = tab[off.WQ + i] * sgn * _phi(md, j, wall) * vel[i, k, j]
+                if k < i:
+                    pair += tab[off.WQ + k] * sgn * _phi(md, j, wall) * vel[k, i, j]
+                tab[off.VS + j * (s * (s + 1) // 2) + (i * (i + 1)) // 2 + k] = pair
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -250,7 +276,7 @@ class WorkRows(NamedTuple):
     """Rows of the workspace (`Workspace.rows`) of `contact`: at the nodes and the end (s + 1 entries) the free
     closing function `chom`, its rate `dchom` and the right-hand side `rhs`; at the nodes the indentations
     `delta`, forces `F` and dF/d delta `D`; the states `Ynew` (a step's end) and `Ys` (a release step's
-    start); the backward series `Fs` of the force."""
+    start); the backward series `Fs` of the force; the products F_i F_k (k <= i) of the nodal forces `pairs`."""
 
     chom: int
     dchom: int
@@ -261,6 +287,7 @@ class WorkRows(NamedTuple):
     Ynew: int
     Ys: int
     Fs: int
+    pairs: int
 
 
 ROW = WorkRows(*range(len(WorkRows._fields)))
@@ -281,7 +308,7 @@ def workspace(nodes: Nodes, n: int) -> Workspace:
     s = nodes.u.size
     order = nodes.onset.shape[0]
     lay = state_layout(n)
-    return Workspace(rows=np.zeros((len(ROW), max(s + 1, lay.size, order))), A=np.zeros((s + 1, s + 1)),
+    return Workspace(rows=np.zeros((len(ROW), max(s + 1, lay.size, order, s * (s + 1) // 2))), A=np.zeros((s + 1, s + 1)),
                      S=np.zeros((order, lay.acc)))
 
 
@@ -440,10 +467,48 @@ def _newton(step, ws, kH):
     return -1
 
 
+@kernel(fastmath=True)
+def _contact_work(tab, off, Y, Yout, F, FF):
+    """Yout[G + j] += the contact work of mode j's deviation over the step of the table `tab` (layout `off`),
+    int sgn phi_w,j F x_j' dt (Gauss quadrature at the nodes of the exact modal velocities there: blocks VC, VD,
+    VS), with FF the scratch for the s (s + 1) / 2 products F_i F_k. Bookkeeping only, so the sums may be
+    reordered (fastmath: vectorised dot products)."""
+    lay = state_layout(off.n)
+    s = off.s
+    pairs = s * (s + 1) // 2
+    m = 0
+    for i in range(s):
+        for k in range(i + 1):
+            FF[m] = F[i] * F[k]
+            m += 1
+    for j in range(lay.n):
+        vc = off.VC + j * s
+        vd = off.VD + j * s
+        hc = 0.0
+        hd = 0.0
+        for i in range(s):
+            hc += tab[vc + i] * F[i]
+            hd += tab[vd + i] * F[i]
+        row = off.VS + j * pairs
+        q0 = q1 = q2 = q3 = 0.0  # four independent sums: the additions need not wait for each other
+        m = 0
+        while m + 4 <= pairs:
+            q0 += tab[row + m] * FF[m]
+            q1 += tab[row + m + 1] * FF[m + 1]
+            q2 += tab[row + m + 2] * FF[m + 2]
+            q3 += tab[row + m + 3] * FF[m + 3]
+            m += 4
+        while m < pairs:
+            q0 += tab[row + m] * FF[m]
+            m += 1
+        Yout[lay.G + j] += hc * Y[lay.x + j] + hd * Y[lay.v + j] + (q0 + q1) + (q2 + q3)
+
+
 @kernel
 def _end_state(step, Y, Yout, F, ct, st, wall):
     """Yout = the state at the step's end (Eqs. 3-7): transitions, responses to the nodal forces F, and the
-    Fourier integral of the contact force over the step (Gauss quadrature at the node phases)."""
+    Fourier integral of the contact force over the step (Gauss quadrature at the node phases). The modes'
+    contact work is `_contact_work`'s."""
     tab, ph, off = step.tab, step.ph, step.off
     lay = state_layout(off.n)
     n = lay.n
@@ -553,6 +618,30 @@ def _overlap_fourier(Fs, sigma, ct_e, st_e, Om):
             term *= Om * sigma * _INV[m]
         power *= sigma
     return ct_e * jr + st_e * ji, ct_e * ji - st_e * jr
+
+
+#: Gauss-Legendre points and weights on [0, 1] of `_overlap_work` (exact for the product of the force's and a
+#: velocity's series up to degree 15; the overlap is at most a quarter of a step, omega_max sigma < 1.6)
+_OVERLAP_X, _OVERLAP_W = (0.5 * (np.polynomial.legendre.leggauss(8)[0] + 1.0), 0.5 * np.polynomial.legendre.leggauss(8)[1])
+
+
+@kernel
+def _overlap_work(S, Fs, sigma, wall, cst, Y, scratch):
+    """Y[G + j] -= int over [t_e - sigma, t_e] of sgn phi_w,j F x_j' dt: the contact work of the overlap, by
+    Gauss-Legendre quadrature of the series of the force (Fs) and of the state (S, evaluated into `scratch`),
+    both in the backward time (`_series`)."""
+    md = cst.modes
+    lay = state_layout(md.size)
+    sgn = 1.0 if wall == 0 else -1.0
+    for q in range(_OVERLAP_X.size):
+        u = sigma * _OVERLAP_X[q]
+        _series_at(S, u, scratch, lay.acc)
+        f = Fs[Fs.size - 1]
+        for k in range(Fs.size - 2, -1, -1):
+            f = f * u + Fs[k]
+        weight = sgn * sigma * _OVERLAP_W[q] * f
+        for j in range(lay.n):
+            Y[lay.G + j] -= weight * _phi(md, j, wall) * scratch[lay.v + j]
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -809,6 +898,7 @@ def contact(Y, t, t_stop, wall, ctx, cst):
     Om = par.Omega
     kH = par.k_H
     sgn = 1.0 if wall == 0 else -1.0
+    book = par.book > 0.0  # the energy bookkeeping's contact work (`sim.exact`)
     ct = math.cos(Om * t)
     st = math.sin(Om * t)
     _, v = _active(Y, ct, st, wall, cst)
@@ -843,6 +933,8 @@ def contact(Y, t, t_stop, wall, ctx, cst):
             if k < 0 or halvings > _MAX_HALVINGS:
                 return FALLBACK, t, steps
             continue
+        if book:  # the accepted step's contact work (F still holds its nodal forces)
+            _contact_work(step.tab, step.off, Y, Ynew, F, rows[ROW.pairs])
         Y[:] = Ynew
         t += h
         norm = 1.5 - 0.5 * (c1 * c1 + s1 * s1)  # keeps cos^2 + sin^2 = 1 to rounding
@@ -878,7 +970,11 @@ def contact(Y, t, t_stop, wall, ctx, cst):
                 frow = lay.F_l if wall == 0 else lay.F_r
                 Ynew[frow] -= sgn * ore
                 Ynew[frow + 1] -= sgn * oim
+                if book:
+                    _overlap_work(S, Fs, d, wall, cst, Ynew, Ys)
                 _end_state(step, Ynew, Y, F, cs, ss, wall)
+                if book:
+                    _contact_work(step.tab, step.off, Ynew, Y, F, rows[ROW.pairs])
                 return RELEASED, t - d + h_k, steps + 1
             # the contact lasts longer than predicted, or its end is not resolved: a regular step first
         k = _ladder(min(R / 1.6, _MAX_STEP_PERIODS * h_ref), h_ref, False)

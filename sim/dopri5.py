@@ -1,7 +1,7 @@
 """Contacts by the embedded Dormand-Prince 5(4) pair with error control, for the exact integrator (`sim.exact`).
 
 Eqs. 3-7 in the deviation coordinates of `sim.exact` plus the integrands of the Fourier integrals F_l, F_r of
-the contact forces. A step runs on the time map of `sim.flight.time_map` (u^2 from an onset, so the local
+the contact forces and of the modes' contact work (the energy bookkeeping, `sim.energy`). A step runs on the time map of `sim.flight.time_map` (u^2 from an onset, so the local
 error stays of 5th order although the force starts like (t - t_on)^1.5); the step length is controlled by
 the embedded error estimate on all mechanical states (scaled to m of wall/tip displacement, tolerance
 rtol); the release is predicted from c, c', c'' of the active wall and reached by a step with the release
@@ -71,7 +71,8 @@ _FAST = False
 
 @kernel(inline="always", fastmath=_FAST)
 def rhs(ct, st, Y, out, cst):
-    """Eqs. 3-7 in the deviation coordinates at cos, sin(Omega t) = ct, st, plus the integrands of F_l, F_r."""
+    """Eqs. 3-7 in the deviation coordinates at cos, sin(Omega t) = ct, st, plus the integrands of F_l, F_r and
+    of each mode's contact work G_j (`sim.flight.StateLayout`)."""
     md, par = cst.modes, cst.par
     lay = flight.state_layout(md.size)
     g = par.g
@@ -89,6 +90,7 @@ def rhs(ct, st, Y, out, cst):
         v = Y[lay.v + j]
         out[lay.x + j] = v
         out[lay.v + j] = -2.0 * md[j].sig * v - md[j].w2 * Y[lay.x + j] - md[j].phi_l * fl - md[j].phi_r * fr
+        out[lay.G + j] = (md[j].phi_l * fl + md[j].phi_r * fr) * v
     out[lay.z] = Y[lay.zd]
     out[lay.zd] = (fl + fr) * par.inv_m_a
     out[lay.F_l] = fl * ct
@@ -106,9 +108,9 @@ def _warp(kind, u, s):
 
 
 @kernel(inline="always", fastmath=_FAST)
-def _combine(Y, K, d, row, out):
-    """out = Y + sum_j row[j] d[j] K[j], summed left to right (a stage or the solution; zero weights skipped)."""
-    for i in range(Y.size):
+def _combine(Y, K, d, row, out, m):
+    """out[:m] = Y + sum_j row[j] d[j] K[j], summed left to right (a stage or the solution; zero weights skipped)."""
+    for i in range(m):
         acc = Y[i]
         for j in range(len(row)):
             if row[j] != 0.0:
@@ -118,8 +120,9 @@ def _combine(Y, K, d, row, out):
 
 @kernel(inline="always", fastmath=_FAST)
 def _stage(Y, K, tmp, d, row, k, phase, cst):
-    """Stage k: its state Y + sum_j row[j] d[j] K[j] in tmp, and K[k] = F there, at cos, sin(Omega t) = phase."""
-    _combine(Y, K, d, row, tmp)
+    """Stage k: its state Y + sum_j row[j] d[j] K[j] in tmp, and K[k] = F there, at cos, sin(Omega t) = phase.
+    Only the mechanical state: the right-hand side does not depend on the carried integrals."""
+    _combine(Y, K, d, row, tmp, flight.state_layout(cst.modes.size).acc)
     rhs(phase[0], phase[1], tmp, K[k], cst)
 
 
@@ -161,7 +164,7 @@ def step(Y, ct0, st0, s, kind, work, cst):
     _stage(Y, K, tmp, d, a[4], 4, flight.rotate(ct0, st0, Om * p5), cst)
     ct, st = flight.rotate(ct0, st0, Om * s)
     _stage(Y, K, tmp, d, a[5], 5, (ct, st), cst)
-    _combine(Y, K, d, DOPRI5.b, Ynew)
+    _combine(Y, K, d, DOPRI5.b, Ynew, Y.size)
     rhs(ct, st, Ynew, K[6], cst)
     err = 0.0
     for j in range(lay.n):

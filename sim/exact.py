@@ -51,6 +51,20 @@ integrating by parts over the period (e^{-i Omega T} = 1) gives, with Delta_j = 
 [.] the change over the period and F_w = int_T f_w e^{-i Omega t} dt the Fourier integral of the contact force,
 two further components of the Dormand-Prince state during contacts (5th order). Free flight needs no
 quadrature at all.
+
+Energy bookkeeping (Sect. 5.5, `sim.energy`), per period and in closed form from the same integrals. With
+Sigma_j = int_T s_j e^{-i Omega t} dt = X_j + S_j T / 2 (X_j the integral above) and E_j = (s_j'^2 + omega_j^2 s_j^2)/2:
+
+    input to mode j    W_j = gamma_j a_base Omega^2 int_T cos(Omega t) s_j' dt = gamma_j a_base Omega^2 ([s_j] - Omega Im Sigma_j)
+    input to the sphere W_a = a_base Omega^2 m_a int_T cos(Omega t) u_a' dt = a_base Omega Im(F_l + F_r)
+    contact work of j  C_j = int (phi_l,j f_l + phi_r,j f_r) s_j' dt = G_j + Omega Re(i S_j conj(phi_l,j F_l + phi_r,j F_r))
+    dissipation of j   D_j = int 2 D_j omega_j s_j'^2 dt = W_j - C_j - [E_j]      (mode j's energy equation, Eq. 7)
+
+G_j = int (phi_l,j f_l + phi_r,j f_r) x_j' dt is accumulated during contacts only, and only when a ledger is
+asked for (Gauss quadrature of the exact modal velocities at the collocation nodes, `sim.collocation`; a
+component of the Dormand-Prince state); the harmonic part of s_j' enters through F_l, F_r. The contact forces are internal: the balance
+sum_j W_j + W_a - sum_j D_j - [E] (E the stored energy, `sim.energy.stored_energy`) vanishes up to the
+contact integration's error.
 """
 from __future__ import annotations
 
@@ -60,9 +74,10 @@ from typing import NamedTuple
 import numpy as np
 
 from sim import collocation, dopri5, flight
+from sim.energy import Ledger, integrator_output, stored_energy
 from sim.errors import SimulationDiverged, SimulationInputError
-from sim.flight import (COUNT, NONFINITE, OK, OVERLAP, STALLED, STALLED_SEARCH, Constants, Output, mode_records,
-                        run_record, state_layout)
+from sim.flight import (COUNT, IMPACT, LEDGER, NONFINITE, OK, OVERLAP, STALLED, STALLED_SEARCH, Constants, Output,
+                        mode_records, run_record, state_layout)
 from sim.jit import kernel
 from sim.system import SystemArrays, check_run_step
 
@@ -302,7 +317,8 @@ def _fly(p, t, released, onsets, cst, grid, work, record, recorder):
         if wall != -1:
             return (STALLED_SEARCH if wall == -2 else OK), t, wall, tau
         flight.free_flight(Y, Ynew, tau, md)
-        Y[:] = Ynew
+        for i in range(lay.acc):
+            Y[i] = Ynew[i]
         k += 1
         t = k * hg
         if onsets > _MAX_ONSETS_PER_PERIOD:
@@ -337,7 +353,8 @@ def _fly(p, t, released, onsets, cst, grid, work, record, recorder):
         if recording:
             _record_flight(p, Y, t, (k + 1) * hg, record, grid, recorder, cst)
         c_valid = True
-        Y[:] = Ynew
+        for i in range(lay.acc):
+            Y[i] = Ynew[i]
         for j in range(lay.n):
             A[j] *= md[j].grid_decay
         k += 1
@@ -436,6 +453,121 @@ def _fundamental(Y, X0, T, cst):
 
 
 @kernel
+def _close_period(Y, X0, T, cst, row):
+    """The period's energy bookkeeping and Fourier coefficients into `row` (columns `sim.flight.LEDGER`), from
+    the period that ends with Y and started with the modal deviations X0 (closed forms of the module docstring)."""
+    md, par = cst.modes, cst.par
+    lay = state_layout(md.size)
+    n = lay.n
+    Om = par.Omega
+    half = 0.5 * T
+    flr, fli = Y[lay.F_l], Y[lay.F_l + 1]
+    frr, fri = Y[lay.F_r], Y[lay.F_r + 1]
+    total_in = par.a_base * Om * (fli + fri)
+    tr = ti = lr = li = rr = ri = 0.0
+    for j in range(n):
+        m = md[j]
+        dx = Y[lay.x + j] - X0[j]
+        dv = Y[lay.v + j] - X0[n + j]
+        nre = -dv - 2.0 * m.sig * dx - m.phi_l * flr - m.phi_r * frr
+        nim = -Om * dx - m.phi_l * fli - m.phi_r * fri
+        sre = nre * m.idelta_re - nim * m.idelta_im + m.S_re * half  # Sigma_j
+        sim = nre * m.idelta_im + nim * m.idelta_re + m.S_im * half
+        tr += m.phi_tip * sre
+        ti += m.phi_tip * sim
+        lr += m.phi_l * sre
+        li += m.phi_l * sim
+        rr += m.phi_r * sre
+        ri += m.phi_r * sim
+        w_in = m.gamma * par.a_base * Om * Om * (dx - Om * sim)
+        cre = m.phi_l * flr + m.phi_r * frr
+        cim = m.phi_l * fli + m.phi_r * fri
+        work = Y[lay.G + j] + Om * (m.S_re * cim - m.S_im * cre)
+        s0 = X0[j] + m.S_re
+        s1 = Y[lay.x + j] + m.S_re
+        v0 = X0[n + j] - Om * m.S_im
+        v1 = Y[lay.v + j] - Om * m.S_im
+        dE = 0.5 * (dv * (v1 + v0) + m.w2 * dx * (s1 + s0))
+        row[LEDGER.modes + j] = w_in - work - dE
+        total_in += w_in
+    row[LEDGER.input] = total_in
+    row[LEDGER.contact] = 0.0  # the elastic contact law (Eq. 4) dissipates nothing
+    scale = 2.0 / T
+    row[LEDGER.tip_re] = scale * tr
+    row[LEDGER.tip_im] = scale * ti
+    row[LEDGER.left_re] = scale * lr
+    row[LEDGER.left_im] = scale * li
+    row[LEDGER.right_re] = scale * rr
+    row[LEDGER.right_im] = scale * ri
+
+
+@kernel(inline="always")
+def _modal_energies(Y, t, cst):
+    """(E_1, sum_{j >= 2} E_j) in J, E_j = (s_j'^2 + omega_j^2 s_j^2)/2, at phase time t from the deviation state Y."""
+    md, par = cst.modes, cst.par
+    lay = state_layout(md.size)
+    Om = par.Omega
+    ct = math.cos(Om * t)
+    st = math.sin(Om * t)
+    first = 0.0
+    higher = 0.0
+    for j in range(lay.n):
+        sj = Y[lay.x + j] + md[j].S_re * ct - md[j].S_im * st
+        vj = Y[lay.v + j] - Om * (md[j].S_re * st + md[j].S_im * ct)
+        e = 0.5 * (vj * vj + md[j].w2 * sj * sj)
+        if j == 0:
+            first = e
+        else:
+            higher += e
+    return first, higher
+
+
+@kernel
+def _log_onset(Y, t, p, wall, cst, log, count):
+    """A new row of the impact log (`sim.flight.IMPACT`) for the onset at wall 0/1, period p, phase time t;
+    returns its index (-1 when the log is full: the impact is counted in count[0] only)."""
+    i = count[0]
+    count[0] += 1
+    if i >= log.shape[0]:
+        return -1
+    cl, cld, cr, crd = flight.closing(Y, t, cst)
+    lay = state_layout(cst.modes.size)
+    par = cst.par
+    e1, eh = _modal_energies(Y, t, cst)
+    row = log[i]
+    row[IMPACT.wall] = wall
+    row[IMPACT.period] = p
+    row[IMPACT.t_onset] = t
+    row[IMPACT.approach_speed] = cld if wall == 0 else crd
+    row[IMPACT.sphere_before] = Y[lay.zd] + par.a_base * par.Omega * math.sin(par.Omega * t)
+    row[IMPACT.fundamental_onset] = e1
+    row[IMPACT.higher_onset] = eh
+    row[IMPACT.duration] = math.nan
+    row[IMPACT.impulse] = math.nan
+    row[IMPACT.sphere_after] = math.nan
+    row[IMPACT.fundamental_release] = math.nan
+    row[IMPACT.higher_release] = math.nan
+    return i
+
+
+@kernel
+def _log_release(Y, t, p, T, cst, log, i):
+    """Complete row i of the impact log with the release at phase time t of period p."""
+    if i < 0:
+        return
+    lay = state_layout(cst.modes.size)
+    par = cst.par
+    row = log[i]
+    e1, eh = _modal_energies(Y, t, cst)
+    after = Y[lay.zd] + par.a_base * par.Omega * math.sin(par.Omega * t)
+    row[IMPACT.duration] = (p - row[IMPACT.period]) * T + t - row[IMPACT.t_onset]
+    row[IMPACT.impulse] = par.m_a * abs(after - row[IMPACT.sphere_before])
+    row[IMPACT.sphere_after] = after
+    row[IMPACT.fundamental_release] = e1
+    row[IMPACT.higher_release] = eh
+
+
+@kernel
 def _advance(y, run):
     """Advance y (phase 0) over the periods of run.out; returns (status, period of failure).
 
@@ -447,6 +579,8 @@ def _advance(y, run):
     work = run.work
     Y, X0, scratch, counters = work.Y, work.X0, work.scratch, work.counters
     amplitudes, impacts, record = run.out.amplitudes, run.out.impacts, run.out.record
+    ledger, log, log_count = run.out.ledger, run.out.log, run.out.log_count
+    open_impact = -1  # the log row of the contact in progress
     lay = state_layout(cst.modes.size)
     recording = record.shape[0] > 0
     _from_state(y, Y, cst)
@@ -499,6 +633,8 @@ def _advance(y, run):
                         _to_state(Y, t, record[(p + 1) * grid.M], cst)
                     break
                 in_contact = False
+                _log_release(Y, t, p, grid.T, cst, log, open_impact)
+                open_impact = -1
             status, t, wall, tau = _fly(p, t, released, onsets, cst, grid, work, record, run.recorder)
             if status != OK:
                 return status, p
@@ -513,8 +649,10 @@ def _advance(y, run):
             at_onset = True
             onsets += 1
             counters[COUNT.contacts] += 1
+            open_impact = _log_onset(Y, t, p, wall, cst, log, log_count)
             h_contact = _initial_contact_step(Y, t, cst)
         amplitudes[p] = _fundamental(Y, X0, grid.T, cst)
+        _close_period(Y, X0, grid.T, cst, ledger[p])
         impacts[p] = onsets
         for i in range(Y.size):
             if not math.isfinite(Y[i]):
@@ -527,9 +665,10 @@ def _advance(y, run):
 # Python entry point
 # ----------------------------------------------------------------------------------------------------------
 def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float, h_max: float,
-             h_fixed: float = 0.0, samples: int = 1) -> tuple[Constants, Grid]:
+             h_fixed: float = 0.0, samples: int = 1, book: bool = True) -> tuple[Constants, Grid]:
     """Constants and grid of the kernels for one excitation (see the module docstring for the symbols); the
-    state is recorded at `samples` equally spaced instants per period."""
+    state is recorded at `samples` equally spaced instants per period; `book`: keep the contact work of the
+    energy bookkeeping and the impact log (else the ledger's dissipation is not valid)."""
     omega = np.asarray(sys.omega, dtype=np.float64)
     D = np.asarray(sys.D, dtype=np.float64)
     n = omega.size
@@ -542,13 +681,15 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
     atol = rtol * sys.g
     wpos = np.maximum(np.maximum(np.abs(sys.phi_l), np.abs(sys.phi_r)), np.abs(sys.phi_tip))
     wpos = np.where(wpos > 0, wpos, 1e-300)
+    idelta = 1.0 / (omega**2 - Omega**2 + 2j * sig * Omega)  # 1 / Delta_j
     rho = sys.phi_tip / (omega**2 - Omega**2 + 2j * sig * Omega)  # phi_tip,j / Delta_j
     hg = 2.0 * math.pi / Omega / N
     unset = np.zeros(n)
     md = mode_records(
         sig=sig, wd=wd, w2=omega**2, phi_l=sys.phi_l, phi_r=sys.phi_r, abs_phi_l=np.abs(sys.phi_l),
         abs_phi_r=np.abs(sys.phi_r), sig_wd=sig / wd, inv_wd=1.0 / wd, w2_wd=omega**2 / wd, S_re=S.real,
-        S_im=S.imag, rho_re=rho.real, rho_im=rho.imag,
+        S_im=S.imag, rho_re=rho.real, rho_im=rho.imag, idelta_re=idelta.real, idelta_im=idelta.imag,
+        gamma=sys.gamma, phi_tip=sys.phi_tip,
         # inverse error scales: x_j error -> displacement phi_j x_j (m); velocity error e_v -> amplitude e_v / omega_j
         err_x=wpos / atol, err_v=wpos / (atol * omega),
         grid_a=unset, grid_b=unset, grid_c=unset, grid_d=unset,  # below, from the records' transition
@@ -557,7 +698,7 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
                      W_l_re=Wl.real, W_l_im=Wl.imag, W_r_re=Wr.real, W_r_im=Wr.imag, P_re=P.real, P_im=P.imag,
                      gap_tol=GAP_TOLERANCE * sys.g, v_min=MIN_APPROACH_SPEED, M_l0=abs(Wl) * Omega**2,
                      M_r0=abs(Wr) * Omega**2, err_z=1.0 / atol, err_zd=1.0 / (atol * omega[0]),
-                     h_max=h_max, h_fixed=h_fixed)
+                     h_max=h_max, h_fixed=h_fixed, book=float(book))
     tr_g = np.empty((4, n))
     flight.flight_transitions(hg, md, tr_g)
     md["grid_a"], md["grid_b"], md["grid_c"], md["grid_d"] = tr_g
@@ -577,7 +718,7 @@ def _work(cst: Constants) -> Work:
 def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: SystemArrays,
              record: np.ndarray | None = None, *, rtol: float = CONTACT_RTOL, grid_per_period: int = GRID_PER_PERIOD,
              fixed_contact_step: float = 0.0, contacts: str = "collocation",
-             stats: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
+             stats: dict | None = None, ledger: Ledger | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Advance y in place over `n_periods` whole excitation periods, exact between contacts (Eqs. 3-9, Sect. 5).
 
     Integrator contract of `sim.system` (same as `sim.ode3.run_step`): y = [s, s', u_a, u_a'] at
@@ -596,6 +737,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     (every contact by the Dormand-Prince 5(4) pair with error control at rtol).
     stats: optional dict that receives the kernel's counters (the fields of `sim.flight.Counters`: grid
     steps, searches, contact steps, ...).
+    ledger: optional `sim.energy.Ledger` that receives the energy bookkeeping per period (exact closed forms,
+    module docstring) and the impact records of the call (Sect. 5.5, Appendix D).
     Raises SimulationInputError for bad arguments, SimulationDiverged for a non-finite state, an
     indentation beyond the clearance or a stalled contact search.
     """
@@ -612,9 +755,11 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
         raise SimulationInputError(f"grid_per_period must be >= 1, got {grid_per_period!r}")
     omega_max = float(np.max(sys.omega))
     h_max = 0.5 / omega_max  # keeps DOPRI5 far inside its stability region on the highest mode
-    cst, grid = _prepare(Omega, a_base, sys, N, rtol, h_max, float(fixed_contact_step), samples)
+    cst, grid = _prepare(Omega, a_base, sys, N, rtol, h_max, float(fixed_contact_step), samples,
+                         book=ledger is not None)
     work = _work(cst)
-    out = Output(amplitudes=np.empty(n_periods), impacts=np.zeros(n_periods, dtype=np.int64), record=record_arr)
+    out = integrator_output(n_periods, sys.omega.size, record_arr, ledger)
+    stored_start = stored_energy(y, sys) if ledger is not None else math.nan
     use_collocation = contacts == "collocation" and fixed_contact_step <= 0.0
     recorder = Recorder(Y=np.zeros(work.Y.size), Ynew=np.zeros(work.Y.size),
                         dp=dopri5.work(work.Y.size, np.zeros_like(work.counters)))
@@ -630,4 +775,6 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
                STALLED_SEARCH: "a contact search that did not progress"}[status]
         raise SimulationDiverged(
             f"exact integrator failed in period {period + 1} of this step ({why}); check k_H, g and the level")
+    if ledger is not None:
+        ledger.fill(out.ledger, out.log, int(out.log_count[0]), stored_start, stored_energy(y, sys), Omega, sys)
     return out.amplitudes, out.impacts

@@ -1,6 +1,7 @@
 """Figures of the simulation stage in the style of the seed paper: the stepped-sine frequency response (Fig. 5,
-Sect. 5.2), the resonant level against the excitation level (Fig. 6, Sect. 5.3) and the time histories of
-one point (Figs. 4 and 9a, Sects. 5.1 and 5.5).
+Sect. 5.2), the resonant level against the excitation level (Fig. 6, Sect. 5.3), the time histories of one
+point (Figs. 4 and 9a, Sects. 5.1 and 5.5), and the impacts per period and the modal coefficient of restitution
+against the excitation level (Figs. D.2, D.3, Appendix D).
 
 They draw plain data (mappings of arrays), so that a result folder can be redrawn from its files (`ies plot`):
 a frequency response has the keys of `sim.protocol.SweepResult.to_dict` (eta, mean, mean_lo, mean_hi, max,
@@ -110,6 +111,51 @@ def plot_overview(data: Mapping[str, Any], path: str | os.PathLike, title: str, 
     with plot_to(path, figsize=(6.5, 4.4)) as (fig, ax):
         draw_overview(ax, data, title, paper_optimum=paper_optimum)
         ax.legend(fontsize=7, loc="upper left")  # the low SMR levels leave that corner free
+
+
+def plot_scattering(overview: Mapping[str, Any], runs: Sequence[Mapping[str, Any]], path: str | os.PathLike,
+                    title: str, figure: str) -> None:
+    """Fig. D.2 ("figD2": all and significant impacts per excitation period) or Fig. D.3 ("figD3": the modal
+    coefficient of restitution r, Eq. D.1, from the tip and from the wall, at the levels whose resonant response
+    is almost periodic) against the excitation level, at the resonant eta (`sim.tables.overview_data` keys), each
+    with the range of the runs' own values as error bars (`runs`: rows with level and the measures; Appendix D)."""
+    import numpy as np
+
+    levels = np.asarray(overview["levels"], dtype=float)
+    if figure == "figD2":
+        curves = (("impacts_per_period", "all contact onsets", "s--", "tab:gray"),
+                  ("significant_impacts_per_period", "significant impacts", "o-", "tab:blue"))
+        ylabel = "impacts per excitation period"
+        keep = np.ones(levels.size, dtype=bool)
+    else:
+        curves = (("restitution", "r from the tip (Eq. D.1)", "o-", "tab:blue"),
+                  ("restitution_wall", "r from the wall", "s--", "tab:red"))
+        ylabel = "modal coefficient of restitution r"
+        keep = np.array([regime == "APR" for regime in overview["regime"]])
+    with plot_to(path, figsize=(6.5, 4.4)) as (fig, ax):
+        for key, label, style, color in curves:
+            value = np.asarray(overview[key], dtype=float)[keep]
+            per_run = [[float(r[key]) for r in runs if float(r["level"]) == level and key in r]
+                       for level in levels[keep]]
+            lo = np.array([np.nanmin(v) if np.isfinite(v).any() else np.nan for v in map(np.asarray, per_run)])
+            hi = np.array([np.nanmax(v) if np.isfinite(v).any() else np.nan for v in map(np.asarray, per_run)])
+            spread = [np.clip(value - lo, 0, None), np.clip(hi - value, 0, None)]
+            if runs and key in runs[0]:
+                ax.errorbar(levels[keep], value, yerr=spread, fmt=style, color=color, ms=4, capsize=2, lw=1.2,
+                            label=f"{label} (bars: range of the runs)")
+            else:
+                ax.plot(levels[keep], value, style, color=color, ms=4, lw=1.2, label=label)
+        if figure == "figD3":
+            ax.axhline(0.8, color="k", lw=1, ls="-.", alpha=0.6, label="paper: r ~ 0.8 (Fig. D.3)")
+            ax.axhline(1.0, color="k", lw=0.8, alpha=0.3)
+        else:
+            ax.axhline(2.0, color="k", lw=1, ls="-.", alpha=0.6, label="paper: 2 per period in APR (Fig. D.2)")
+        ax.set_xlabel(r"$a_{base} / a^*_{base}$")
+        ax.set_ylabel(ylabel)
+        ax.set_ylim(bottom=0)
+        ax.set_title(title, fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
 
 
 def sweep_title(data: Mapping[str, Any]) -> str:

@@ -31,7 +31,9 @@ class StateLayout(NamedTuple):
     Y[x + j], Y[v + j]: homogeneous deviation x_j of mode j and its rate (m sqrt(kg), m sqrt(kg) / s);
     Y[z], Y[zd]: sphere coordinate z = u_a + a_base cos(Omega t) and its rate (m, m/s); these 2 n + 2
     components (up to `acc`) are the mechanical state. From `acc` on, integrals carried through the period:
-    Y[F_l], Y[F_l + 1] = Re, Im of F_l = int f_l e^{-i Omega t} dt (N s), the same for F_r.
+    Y[F_l], Y[F_l + 1] = Re, Im of F_l = int f_l e^{-i Omega t} dt (N s), the same for F_r;
+    Y[G + j] = int (phi_l,j f_l + phi_r,j f_r) x_j' dt, the work of mode j's deviation on the contacts (J),
+    the one integral of the energy bookkeeping (`sim.energy`) that free flight does not give in closed form.
     """
 
     n: int
@@ -42,6 +44,7 @@ class StateLayout(NamedTuple):
     acc: int
     F_l: int
     F_r: int
+    G: int
     size: int
 
 
@@ -55,8 +58,9 @@ def state_layout(n: int) -> StateLayout:
     acc = zd + 1
     F_l = acc
     F_r = F_l + 2
-    size = F_r + 2
-    return StateLayout(n=n, x=x, v=v, z=z, zd=zd, acc=acc, F_l=F_l, F_r=F_r, size=size)
+    G = F_r + 2
+    size = G + n
+    return StateLayout(n=n, x=x, v=v, z=z, zd=zd, acc=acc, F_l=F_l, F_r=F_r, G=G, size=size)
 
 
 #: The constants of mode j in one run (a record per mode; Eqs. 7, 9 and the scales of the contact steps).
@@ -75,6 +79,10 @@ MODE = np.dtype([
     ("S_im", np.float64),
     ("rho_re", np.float64),  # phi_tip,j / Delta_j (the Fourier coefficient from the deviations)
     ("rho_im", np.float64),
+    ("idelta_re", np.float64),  # 1 / Delta_j (s^2): the Fourier integral of x_j over a period (`sim.exact`)
+    ("idelta_im", np.float64),
+    ("gamma", np.float64),  # participation phi_j^T M b (sqrt(kg))
+    ("phi_tip", np.float64),  # mode value at the tip (1/sqrt(kg))
     ("err_x", np.float64),  # inverse error scales of a Dormand-Prince step: of x_j (1/(m sqrt(kg)))
     ("err_v", np.float64),  # ... and of x_j' (s/(m sqrt(kg)))
     ("grid_a", np.float64),  # the transition (`transition`) over a free-flight grid step h (`sim.exact`)
@@ -107,6 +115,7 @@ RUN = np.dtype([
     ("err_zd", np.float64),
     ("h_max", np.float64),  # longest Dormand-Prince contact step (s)
     ("h_fixed", np.float64),  # > 0: fixed Dormand-Prince contact step instead of error control (s)
+    ("book", np.float64),  # 1: keep the energy bookkeeping's contact work and the impact log, 0: not (`sim.energy`)
 ], align=True)
 
 
@@ -140,11 +149,61 @@ class Constants(NamedTuple):
 class Output(NamedTuple):
     """What the period loop of an integrator writes (contract of `sim.system`): per period |c_1| of q_tip (m)
     and the number of contact onsets, and the state [s, s', u_a, u_a'] at the record instants into the rows
-    of `record` (none: 0 rows)."""
+    of `record` (none: 0 rows); the energy bookkeeping per period into the rows of `ledger` (columns `LEDGER`
+    then the dissipation of each mode; none: 0 rows) and the impacts into the rows of `log` (columns `IMPACT`;
+    `log_count[0]` counts every impact, also those beyond the log's rows)."""
 
     amplitudes: np.ndarray
     impacts: np.ndarray
     record: np.ndarray
+    ledger: np.ndarray
+    log: np.ndarray
+    log_count: np.ndarray
+
+
+class LedgerColumns(NamedTuple):
+    """Columns of a period's row of `Output.ledger` (Sect. 5.5; `sim.energy`): the work of the base excitation
+    `input` (J), the dissipation in the contacts `contact` (J), the complex fundamental Fourier coefficients
+    c_1 = (2/T) int_T q e^{-i Omega t} dt (m) of the tip and of both walls (relative to the base), and from
+    column `modes` on the dissipation of each mode's modal damping int 2 D_j omega_j s_j'^2 dt (J)."""
+
+    input: int
+    contact: int
+    tip_re: int
+    tip_im: int
+    left_re: int
+    left_im: int
+    right_re: int
+    right_im: int
+    modes: int
+
+
+LEDGER = LedgerColumns(*range(len(LedgerColumns._fields)))
+
+
+class ImpactColumns(NamedTuple):
+    """Columns of an impact's row of `Output.log` (one contact, onset to release; Appendix D): the wall (0 left,
+    1 right), the period of the onset (from 0 in the run_step call) and its phase time in that period (s), the
+    duration (s), the impulse int |f| dt (N s), the approach speed (closing rate at the onset, m/s), the sphere's
+    velocity relative to the base u_a' before and after (m/s), and the modal energies (s_j'^2 + omega_j^2 s_j^2)/2
+    of mode 1 and of modes 2..N at the onset and at the release (J). A contact still open at the call's end
+    has NaN release fields."""
+
+    wall: int
+    period: int
+    t_onset: int
+    duration: int
+    impulse: int
+    approach_speed: int
+    sphere_before: int
+    sphere_after: int
+    fundamental_onset: int
+    higher_onset: int
+    fundamental_release: int
+    higher_release: int
+
+
+IMPACT = ImpactColumns(*range(len(ImpactColumns._fields)))
 
 
 class Phase(NamedTuple):
@@ -207,15 +266,15 @@ def _fly_mode(Y, Ynew, j, tr, lay):
 
 @kernel(inline="always")
 def _fly_sphere(Y, Ynew, tau, lay):
-    """The sphere of a free flight over tau s (constant velocity); the carried integrals do not change."""
+    """The sphere of a free flight over tau s (constant velocity). The carried integrals do not change in free
+    flight: they are not written (the callers copy the mechanical state, `lay.acc` components, back)."""
     Ynew[lay.z] = Y[lay.z] + tau * Y[lay.zd]
-    for i in range(lay.zd, Y.size):
-        Ynew[i] = Y[i]
+    Ynew[lay.zd] = Y[lay.zd]
 
 
 @kernel
 def grid_flight(Y, Ynew, h, md):
-    """Ynew = free flight of Y over one grid step h (s) with the transitions of the records (grid_a ... grid_d)."""
+    """Ynew[:acc] = free flight of Y over one grid step h (s) with the transitions of the records (grid_a ... grid_d)."""
     lay = state_layout(md.size)
     for j in range(lay.n):
         _fly_mode(Y, Ynew, j, (md[j].grid_a, md[j].grid_b, md[j].grid_c, md[j].grid_d), lay)
@@ -224,7 +283,7 @@ def grid_flight(Y, Ynew, h, md):
 
 @kernel
 def free_flight(Y, Ynew, tau, md):
-    """Ynew = free flight of Y over tau s (Eq. 9)."""
+    """Ynew[:acc] = free flight of Y over tau s (Eq. 9)."""
     lay = state_layout(md.size)
     for j in range(lay.n):
         _fly_mode(Y, Ynew, j, transition(tau, md, j), lay)

@@ -19,6 +19,12 @@ eta ~ 1: N ~ 2600, h shorter than dt by < 0.04 %).
 Per period the kernel returns |c_1| of q_tip = phi_tip^T s, c_1 = (2/T) int_T q_tip exp(-i Omega t) dt by the
 trapezoidal rule on the step points, and the number of contact onsets (open -> closed at either wall,
 checked at the step points).
+
+Energy bookkeeping (Sect. 5.5, `sim.energy.Ledger`) by the scheme's own quadrature: the work of the base
+excitation a_base Omega^2 cos(Omega t) (gamma^T s' + m_a u_a') and each mode's dissipation 2 D_j omega_j s_j'^2
+are integrated like extra components of the state (the Bogacki-Shampine weights on the stage values), and
+the Fourier coefficients of tip and walls by the trapezoidal rule. Its energy balance closes only to the
+scheme's truncation error (third order in h). ode3 keeps no impact records.
 """
 from __future__ import annotations
 
@@ -28,7 +34,8 @@ from typing import NamedTuple
 import numpy as np
 
 from sim.errors import SimulationDiverged, SimulationInputError
-from sim.flight import Output, state_layout
+from sim.energy import Ledger, integrator_output, stored_energy
+from sim.flight import LEDGER, state_layout
 from sim.jit import kernel
 from sim.system import SystemArrays, check_run_step
 
@@ -99,11 +106,12 @@ class Steps(NamedTuple):
 
 
 class Coefficients(NamedTuple):
-    """Eqs. 3-7 as the kernel evaluates them: w2 = omega^2, c = 2 D omega (1/s), the wall values phi_l, phi_r,
+    """Eqs. 3-7 as the kernel evaluates them: w2 = omega^2, c = 2 D omega (1/s), gamma = phi^T M b, the wall values phi_l, phi_r,
     the base forcing amplitudes f_modal = gamma a_base Omega^2 and f_sphere = a_base Omega^2, m_a, k_H, g."""
 
     w2: np.ndarray
     c: np.ndarray
+    gamma: np.ndarray
     phi_l: np.ndarray
     phi_r: np.ndarray
     f_modal: np.ndarray
@@ -148,13 +156,25 @@ def _tip(y, phi_tip, lay):
     return q
 
 
+@kernel(inline="always", fastmath=_FAST)
+def _book(y, cos_t, weight, co, lay, ledger_row):
+    """Add weight times the integrands of the energy bookkeeping at a stage (state y, cos(Omega t)) to the
+    period's ledger row: the base excitation's power and each mode's damping power (W)."""
+    p_in = co.m_a * y[lay.zd]
+    for j in range(lay.n):
+        v = y[lay.v + j]
+        p_in += co.gamma[j] * v
+        ledger_row[LEDGER.modes + j] += weight * co.c[j] * v * v
+    ledger_row[LEDGER.input] += weight * co.f_sphere * cos_t * p_in
+
+
 @kernel(fastmath=_FAST)
 def _advance(y, sys, steps, out):
     """Advance y in place over the periods of `out`, N ode3 steps each; returns (status, step index of a failure)."""
     lay = state_layout(sys.omega.size)
     N = steps.N
     Omega, a_base = steps.Omega, steps.a_base
-    co = Coefficients(w2=sys.omega * sys.omega, c=2.0 * sys.D * sys.omega, phi_l=sys.phi_l, phi_r=sys.phi_r,
+    co = Coefficients(w2=sys.omega * sys.omega, c=2.0 * sys.D * sys.omega, gamma=sys.gamma, phi_l=sys.phi_l, phi_r=sys.phi_r,
                       f_modal=sys.gamma * (a_base * Omega * Omega), f_sphere=a_base * Omega * Omega, m_a=sys.m_a,
                       k_H=sys.k_H, g=sys.g)
     ny = lay.acc
@@ -178,29 +198,45 @@ def _advance(y, sys, steps, out):
     closed_l = dl > 0.0 and has_contact
     closed_r = dr < 0.0 and has_contact
     for p in range(out.amplitudes.size):
+        row = out.ledger[p]
         re = 0.5 * _tip(y, phi_tip, lay)  # trapezoid end weight, phase 0: cos = 1, sin = 0
         im = 0.0
+        dl, dr = _indentations(y, co, lay)
+        lre = 0.5 * (dl + y[lay.z] + co.g)  # phi_l^T s, phi_r^T s: the walls relative to the base
+        rre = 0.5 * (dr + y[lay.z] - co.g)
+        lim = rim = 0.0
         onsets = 0
         for k in range(N):
             # the Bogacki-Shampine stages of the module docstring (Sect. 3.2)
             _deriv(y, cos_stage[0, k], co, lay, k1)
+            _book(y, cos_stage[0, k], b1, co, lay, row)
             for i in range(ny):
                 yt[i] = y[i] + 0.5 * h * k1[i]
             _deriv(yt, cos_stage[1, k], co, lay, k2)
+            _book(yt, cos_stage[1, k], b2, co, lay, row)
             for i in range(ny):
                 yt[i] = y[i] + 0.75 * h * k2[i]
             _deriv(yt, cos_stage[2, k], co, lay, k3)
+            _book(yt, cos_stage[2, k], b3, co, lay, row)
             for i in range(ny):
                 y[i] += b1 * k1[i] + b2 * k2[i] + b3 * k3[i]
             # measures at the new step point t_{k+1}
             dl, dr = _indentations(y, co, lay)
             q = _tip(y, phi_tip, lay)
             kk = k + 1
+            ql = dl + y[lay.z] + co.g
+            qr = dr + y[lay.z] - co.g
             if kk < N:
                 re += q * cos0[kk]
                 im -= q * sin0[kk]
+                lre += ql * cos0[kk]
+                lim -= ql * sin0[kk]
+                rre += qr * cos0[kk]
+                rim -= qr * sin0[kk]
             else:
                 re += 0.5 * q
+                lre += 0.5 * ql
+                rre += 0.5 * qr
             now_l = dl > 0.0 and has_contact
             now_r = dr < 0.0 and has_contact
             if now_l and not closed_l:
@@ -214,6 +250,12 @@ def _advance(y, sys, steps, out):
             if recording and kk % stride == 0:
                 record[p * rows_per_period + kk // stride, :] = y
         out.amplitudes[p] = 2.0 / N * math.sqrt(re * re + im * im)
+        row[LEDGER.tip_re] = 2.0 / N * re
+        row[LEDGER.tip_im] = 2.0 / N * im
+        row[LEDGER.left_re] = 2.0 / N * lre
+        row[LEDGER.left_im] = 2.0 / N * lim
+        row[LEDGER.right_re] = 2.0 / N * rre
+        row[LEDGER.right_im] = 2.0 / N * rim
         out.impacts[p] = onsets
         for i in range(ny):
             if not math.isfinite(y[i]):
@@ -222,7 +264,8 @@ def _advance(y, sys, steps, out):
 
 
 def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: SystemArrays,
-             record: np.ndarray | None = None, *, dt_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+             record: np.ndarray | None = None, *, dt_scale: float = 1.0,
+             ledger: Ledger | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Advance the state y in place over `n_periods` whole excitation periods with ode3 (Sect. 3.2).
 
     Integrator contract of `sim.system`: y = [s, s', u_a, u_a'] at excitation phase 0 (float64, length
@@ -234,6 +277,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     instants are step points (h <= dt still holds).
 
     dt_scale: multiplies the paper's dt = 2 pi/(15 omega_max) (tests, order studies).
+    ledger: optional `sim.energy.Ledger` that receives the energy bookkeeping per period (the scheme's own
+    quadrature, module docstring; no impact records).
     Raises SimulationInputError for bad arguments or an unstable step, SimulationDiverged if the state
     becomes non-finite or an indentation exceeds the clearance (the contact was stepped over).
     """
@@ -253,7 +298,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
         cos_stage[row] = np.cos(phase + c_stage * Omega * h)
     steps = Steps(N=N, h=h, stride=N // samples, Omega=Omega, a_base=a_base, cos_stage=cos_stage,
                   cos0=np.cos(phase), sin0=np.sin(phase))
-    out = Output(amplitudes=np.empty(n_periods), impacts=np.zeros(n_periods, dtype=np.int64), record=record_arr)
+    out = integrator_output(n_periods, sys.omega.size, record_arr, None)
+    stored_start = stored_energy(y, sys) if ledger is not None else math.nan
     kernel_sys = sys._replace(m_a=float(sys.m_a), k_H=float(sys.k_H), g=float(sys.g))
     status, where = _advance(y, kernel_sys, steps, out)
     if status != _OK:
@@ -261,4 +307,6 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
         why = "non-finite state" if status == _NONFINITE else "an indentation larger than the clearance"
         raise SimulationDiverged(
             f"ode3 diverged after {t:.4g} s of this step ({why}); reduce dt_scale or check k_H, g and the level")
+    if ledger is not None:
+        ledger.fill(out.ledger, out.log, 0, stored_start, stored_energy(y, sys), Omega, sys)
     return out.amplitudes, out.impacts

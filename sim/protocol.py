@@ -57,7 +57,8 @@ from typing import Callable, Iterator
 import numpy as np
 
 from sim.errors import SimulationInputError
-from sim.measures import APR, LINEAR, REGIME_CV_THRESHOLD, classify_regime, hold_measures
+from sim.energy import Ledger
+from sim.measures import APR, LINEAR, REGIME_CV_THRESHOLD, SCATTERING_MEASURES, classify_regime, point_measures
 from sim.system import (CLEARANCE_NOMINAL, SPHERE_MASS, Impactor, ModalModel, Nominal, SystemArrays,
                         a_base_star, a_noabs_star, system_arrays)
 
@@ -165,7 +166,8 @@ class SweepRun:
 
     eta: nominal grid value; eta_actual: the perturbed value simulated; leg: leg index (0, 1, ...);
     mean, max, min, std: per-period amplitudes over the hold / a_noabs*; impacts_per_period: contact
-    onsets per period over the hold; hold_periods: hold length in periods.
+    onsets per period over the hold; hold_periods: hold length in periods; scattering: per point the
+    energy scattering and impact measures (`sim.measures.SCATTERING_MEASURES` -> array; NaN where not available).
     level = a_base/a_base*; a_base, a_noabs (m); wall_time_s of the run.
     """
 
@@ -186,6 +188,7 @@ class SweepRun:
     protocol: SteppedSine
     impactor: Impactor | None
     wall_time_s: float = 0.0
+    scattering: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def cv(self) -> np.ndarray:
@@ -204,7 +207,9 @@ class SweepResult:
     they occur; regime: the regime at eta_resonant_mean; resonant_*_samples: the repetition samples at
     eta_resonant_mean / eta_resonant_max, whose average the resonant level is (their range and standard error
     are its spread: `resonant_spread`); mean/max/cv/impacts_samples: the (n_samples, n_eta) data behind the
-    averages, samples ordered run by run, leg by leg.
+    averages, samples ordered run by run, leg by leg. scattering: per name of `sim.measures.SCATTERING_MEASURES`
+    the average over the samples per eta (NaN-aware; balance_error: the largest magnitude), scattering_samples:
+    their (n_samples, n_eta) data.
     """
 
     eta: np.ndarray
@@ -238,6 +243,8 @@ class SweepResult:
     protocol: SteppedSine
     wall_time_s: float
     extra: dict = field(default_factory=dict)
+    scattering: dict[str, np.ndarray] = field(default_factory=dict)
+    scattering_samples: dict[str, np.ndarray] = field(default_factory=dict)
 
     def resonant_spread(self, output: str) -> tuple[float, float, float]:
         """(lo, hi, standard error) of the resonant level `output` ("mean" or "max"): the range of its repetition
@@ -257,8 +264,22 @@ class SweepResult:
             "mean_samples", "max_samples", "cv_samples", "impacts_samples", "n_samples", "n_runs", "wall_time_s")}
         out["protocol"] = asdict(self.protocol)
         out["regime_cv_threshold"] = REGIME_CV_THRESHOLD
+        out.update(scattering_keys(self.scattering))
         out.update(self.extra)
         return out
+
+
+def scattering_keys(measures: dict) -> dict:
+    """The JSON keys of the scattering measures (Sect. 5.5, Appendix D) of `ies sweep` / `ies overview`: each
+    measure by its name, and "dissipation" {fundamental, higher_modes, contact (shares of the input work),
+    input (mean input power, W), balance_error} (values or arrays over eta as given)."""
+    out = {name: measures[name] for name in SCATTERING_MEASURES if not name.startswith("dissipation_")
+           and name not in ("input_power", "balance_error")}
+    out["dissipation"] = {"fundamental": measures["dissipation_fundamental"],
+                          "higher_modes": measures["dissipation_higher_modes"],
+                          "contact": measures["dissipation_contact"], "input": measures["input_power"],
+                          "balance_error": measures["balance_error"]}
+    return out
 
 
 def simulated_system(model: ModalModel, impactor: Impactor | None) -> SystemArrays:
@@ -345,9 +366,11 @@ def run_sweep(model: ModalModel, impactor: Impactor | None, level: float, protoc
     rows: list[tuple] = []
     for leg_index, eta, eta_actual, Omega in visit_points(model, sys, a_base, protocol, y, seed=seed, rep=rep):
         n_hold = protocol.periods(Omega)[1]
-        amplitudes, impacts = run_step(y, n_hold, Omega, a_base, sys, None)
-        m = hold_measures(amplitudes, impacts, a_noabs)
-        rows.append((eta, eta_actual, leg_index, m.mean, m.max, m.min, m.std, m.impacts_per_period, n_hold))
+        ledger = Ledger()
+        amplitudes, impacts = run_step(y, n_hold, Omega, a_base, sys, None, ledger=ledger)
+        m = point_measures(amplitudes, impacts, a_noabs, ledger)
+        rows.append((eta, eta_actual, leg_index, m.mean, m.max, m.min, m.std, m.impacts_per_period, n_hold,
+                     *(getattr(m.scattering, name) for name in SCATTERING_MEASURES)))
         if progress is not None:
             progress()
     cols = list(zip(*rows))
@@ -356,25 +379,31 @@ def run_sweep(model: ModalModel, impactor: Impactor | None, level: float, protoc
         eta=as_f(0), eta_actual=as_f(1), leg=np.array(cols[2], dtype=int), mean=as_f(3), max=as_f(4),
         min=as_f(5), std=as_f(6), impacts_per_period=as_f(7), hold_periods=np.array(cols[8], dtype=int),
         level=level, a_base=a_base, a_noabs=a_noabs, seed=seed, rep=rep, protocol=protocol, impactor=impactor,
-        wall_time_s=time.perf_counter() - started)
+        wall_time_s=time.perf_counter() - started,
+        scattering={name: as_f(9 + i) for i, name in enumerate(SCATTERING_MEASURES)})
+
+
+_SAMPLED = ("mean", "max", "std", "impacts_per_period", "hold_periods")
 
 
 def _samples(run: SweepRun, grid: np.ndarray) -> list[dict[str, np.ndarray]]:
     """The repetition samples of one run on the ascending grid (per leg, or pooled per run)."""
     n = grid.size
     per_leg = []
+    columns = {key: getattr(run, key) for key in _SAMPLED}
+    columns.update({name: run.scattering.get(name, np.full(run.eta.size, np.nan)) for name in SCATTERING_MEASURES})
     for leg in np.unique(run.leg):
         sel = run.leg == leg
         sample = {}
         if run.protocol.perturb == "each-point":  # back onto the grid from the frequencies simulated
             order = np.argsort(run.eta_actual[sel])
-            for key in ("mean", "max", "std", "impacts_per_period", "hold_periods"):
-                sample[key] = np.interp(grid, run.eta_actual[sel][order], getattr(run, key)[sel][order])
+            for key, values in columns.items():
+                sample[key] = np.interp(grid, run.eta_actual[sel][order], values[sel][order])
         else:
             idx = np.searchsorted(grid, run.eta[sel])
-            for key in ("mean", "max", "std", "impacts_per_period", "hold_periods"):
+            for key, values in columns.items():
                 sample[key] = np.empty(n)
-                sample[key][idx] = getattr(run, key)[sel]
+                sample[key][idx] = values[sel]
         per_leg.append(sample)
     if run.protocol.repetition == "leg" or len(per_leg) == 1:
         return per_leg
@@ -383,13 +412,31 @@ def _samples(run: SweepRun, grid: np.ndarray) -> list[dict[str, np.ndarray]]:
     mean = np.array([s["mean"] for s in per_leg])
     pooled_mean = np.sum(w * mean, axis=0) / w.sum(axis=0)
     second = np.sum(w * (np.array([s["std"] for s in per_leg]) ** 2 + mean**2), axis=0) / w.sum(axis=0)
+    weighted = lambda key: np.sum(w * np.array([s[key] for s in per_leg]), axis=0) / w.sum(axis=0)  # noqa: E731
     return [{
         "mean": pooled_mean,
         "max": np.max([s["max"] for s in per_leg], axis=0),
         "std": np.sqrt(np.clip(second - pooled_mean**2, 0.0, None)),
-        "impacts_per_period": np.sum(w * np.array([s["impacts_per_period"] for s in per_leg]), axis=0) / w.sum(axis=0),
+        "impacts_per_period": weighted("impacts_per_period"),
         "hold_periods": w.sum(axis=0),
+        **{name: weighted(name) for name in SCATTERING_MEASURES if name != "balance_error"},
+        "balance_error": _largest_magnitude(np.array([s["balance_error"] for s in per_leg])),
     }]
+
+
+def _largest_magnitude(samples: np.ndarray) -> np.ndarray:
+    """Per column the sample of largest magnitude (NaN where all are NaN): the worst balance error."""
+    magnitude = np.where(np.isnan(samples), -1.0, np.abs(samples))
+    picked = np.take_along_axis(samples, np.argmax(magnitude, axis=0)[None], axis=0)[0]
+    return picked
+
+
+def _scattering_average(stack: np.ndarray, name: str) -> np.ndarray:
+    """The repetition average of a scattering measure per eta (NaN-aware; the worst for balance_error)."""
+    if name == "balance_error":
+        return _largest_magnitude(stack)
+    counts = np.sum(np.isfinite(stack), axis=0)
+    return np.divide(np.nansum(stack, axis=0), counts, out=np.full(stack.shape[1], np.nan), where=counts > 0)
 
 
 def aggregate_runs(runs: list[SweepRun]) -> SweepResult:
@@ -403,6 +450,7 @@ def aggregate_runs(runs: list[SweepRun]) -> SweepResult:
     grid = first.protocol.eta
     samples = [s for run in runs for s in _samples(run, grid)]
     stack = {key: np.array([s[key] for s in samples]) for key in ("mean", "max", "std", "impacts_per_period")}
+    scattering = {name: np.array([s[name] for s in samples]) for name in SCATTERING_MEASURES}
     cv_samples = np.divide(stack["std"], stack["mean"], out=np.zeros_like(stack["std"]), where=stack["mean"] > 0)
     mean, mx = stack["mean"].mean(axis=0), stack["max"].mean(axis=0)
     cv = cv_samples.mean(axis=0)
@@ -418,7 +466,9 @@ def aggregate_runs(runs: list[SweepRun]) -> SweepResult:
         resonant_mean_samples=stack["mean"][:, i_mean], resonant_max_samples=stack["max"][:, i_max],
         mean_samples=stack["mean"], max_samples=stack["max"], cv_samples=cv_samples,
         impacts_samples=stack["impacts_per_period"], n_samples=len(samples), n_runs=len(runs), level=first.level, a_base=first.a_base, a_noabs=first.a_noabs,
-        protocol=first.protocol, wall_time_s=float(sum(r.wall_time_s for r in runs)))
+        protocol=first.protocol, wall_time_s=float(sum(r.wall_time_s for r in runs)),
+        scattering={name: _scattering_average(scattering[name], name) for name in SCATTERING_MEASURES},
+        scattering_samples=scattering)
 
 
 def sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *, reps: int,

@@ -23,7 +23,9 @@ Conventions shared by every integrator in `sim`
   (c_1 = (2/T) int_period q_tip exp(-i Omega t) dt, in m) and the number of contact onsets
   (open -> closed transitions at either wall) in that period.
   ``record`` is None, or a float64 array of shape (n_periods * M + 1, len(y)) that receives the state
-  at M equally spaced instants per period (first row: the initial state).
+  at M equally spaced instants per period (first row: the initial state). Both integrators also take
+  ``ledger=sim.energy.Ledger()``, which receives the energy bookkeeping per period and (exact) the impact
+  records of the call (Sect. 5.5, Appendix D).
 * Normalisations (Sects. 5, 5.3) always use the *nominal* (starred) parameters, so that results
   with varied D, g, k_H stay on the paper's axes:
   a_noabs* = phi_tip,1 (phi_1^T M b) a_base / (2 D*),  a_base* = 2 D* g* / (phi_c,1 phi_1^T M b).

@@ -7,25 +7,39 @@ from __future__ import annotations
 
 from typing import Any, Sequence
 
-from sim.protocol import SweepResult
+from sim.measures import SCATTERING_MEASURES
+from sim.protocol import SweepResult, scattering_keys
 
+#: the columns of the energy scattering and impact measures (Sect. 5.5, Appendix D; `sim.measures`), appended to
+#: both tables: the measure names, the input power with its unit (W) in the name
+SCATTERING_COLUMNS = tuple("input_power_W" if name == "input_power" else name for name in SCATTERING_MEASURES)
 #: sweep.csv: one row per eta of the grid (`SweepResult` arrays)
-SWEEP_COLUMNS = ("eta", "mean", "mean_lo", "mean_hi", "max", "max_lo", "max_hi", "cv", "impacts_per_period", "regime")
+SWEEP_COLUMNS = ("eta", "mean", "mean_lo", "mean_hi", "max", "max_lo", "max_hi", "cv", "impacts_per_period", "regime",
+                 *SCATTERING_COLUMNS)
 #: overview.csv: one row per excitation level (`overview_data`)
 OVERVIEW_COLUMNS = ("level", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "resonant_max", "resonant_max_lo",
                     "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max", "impacts_per_period", "regime",
-                    "a_base_m", "resonant_mean_se", "resonant_max_se")
+                    "a_base_m", "resonant_mean_se", "resonant_max_se", *SCATTERING_COLUMNS)
+
+
+def _scattering_column(column: str) -> str:
+    """The `sim.measures.SCATTERING_MEASURES` name of a SCATTERING_COLUMNS column."""
+    return "input_power" if column == "input_power_W" else column
 
 
 def sweep_rows(result: SweepResult) -> list[list[Any]]:
     """The rows of sweep.csv (SWEEP_COLUMNS) of one frequency response."""
-    columns = [result.regime_per_eta if name == "regime" else getattr(result, name) for name in SWEEP_COLUMNS]
+    n = result.eta.size
+    columns = [result.regime_per_eta if name == "regime" else
+               result.scattering.get(_scattering_column(name), [float("nan")] * n) if name in SCATTERING_COLUMNS else
+               getattr(result, name) for name in SWEEP_COLUMNS]
     return [list(row) for row in zip(*columns)]
 
 
 def overview_data(levels: Sequence[float], results: Sequence[SweepResult]) -> dict[str, list]:
     """The resonant levels (Sect. 5.3) of one frequency response per excitation level, as lists by key: the
-    OVERVIEW_COLUMNS ("levels" for the column "level"); spreads from `SweepResult.resonant_spread`."""
+    OVERVIEW_COLUMNS ("levels" for the column "level"); spreads from `SweepResult.resonant_spread`; the
+    scattering measures at the resonant mean's eta."""
     spread = {name: [r.resonant_spread(name) for r in results] for name in ("mean", "max")}
     return {
         "levels": [float(level) for level in levels],
@@ -42,7 +56,19 @@ def overview_data(levels: Sequence[float], results: Sequence[SweepResult]) -> di
         "eta_resonant_max": [r.eta_resonant_max for r in results],
         "regime": [r.regime for r in results],
         "impacts_per_period": [float(r.impacts_per_period[r.eta == r.eta_resonant_mean][0]) for r in results],
+        **{column: [_at_resonance(r, _scattering_column(column)) for r in results] for column in SCATTERING_COLUMNS},
     }
+
+
+def _at_resonance(result: SweepResult, name: str) -> float:
+    """A scattering measure of the frequency response at its resonant mean's eta (NaN if it has none)."""
+    values = result.scattering.get(name)
+    return float(values[result.eta == result.eta_resonant_mean][0]) if values is not None else float("nan")
+
+
+def dissipation_key(data: dict[str, list]) -> dict[str, list]:
+    """The JSON key "dissipation" of `ies overview` from `overview_data` (as `sim.protocol.scattering_keys`)."""
+    return scattering_keys({_scattering_column(column): data[column] for column in SCATTERING_COLUMNS})["dissipation"]
 
 
 def overview_rows(data: dict[str, list]) -> list[list[Any]]:
@@ -56,6 +82,18 @@ def overview_text(data: dict[str, list]) -> str:
     for i, level in enumerate(data["levels"]):
         lines.append(f"{level:7.3f} {data['resonant_mean'][i]:9.4f} {data['resonant_max'][i]:9.4f} "
                      f"{data['eta_resonant_mean'][i]:9.4f} {data['impacts_per_period'][i]:6.2f}  {data['regime'][i]}")
+    return "\n".join(lines)
+
+
+def scattering_text(data: dict[str, list]) -> str:
+    """Per level, at the resonant eta: all and significant impacts per period, r from the tip and from the wall,
+    the energy share of modes 2..N after impacts and the dissipation shares (Sect. 5.5, Appendix D)."""
+    lines = [f"{'level':>7} {'imp/T':>6} {'sig/T':>6} {'r_tip':>6} {'r_wall':>6} {'E2..N':>6} {'D_1':>6} {'D_2..N':>6}  regime"]
+    for i, level in enumerate(data["levels"]):
+        lines.append(f"{level:7.3f} {data['impacts_per_period'][i]:6.2f} {data['significant_impacts_per_period'][i]:6.2f} "
+                     f"{data['restitution'][i]:6.3f} {data['restitution_wall'][i]:6.3f} "
+                     f"{data['higher_mode_energy_share'][i]:6.3f} {data['dissipation_fundamental'][i]:6.3f} "
+                     f"{data['dissipation_higher_modes'][i]:6.3f}  {data['regime'][i]}")
     return "\n".join(lines)
 
 

@@ -5,8 +5,8 @@
 * `ies sobol STUDY.toml [--n N]`: Sobol' indices (S1, ST) of the resonant response levels.
 * `ies response STUDY.toml`: the nominal point's frequency responses and resonant levels over the excitation
   levels through the task store (resumable, parallel, on a cluster), Figs. 5 and 6.
-* `ies reproduce fig5|fig6|fig7|fig8|all [--quick] [--out DIR]`: the paper's figures, run from the shipped
-  study files (uq/studies/fig5.toml ... fig8.toml, or their -quick variants) into DIR/fig5 ... DIR/fig8.
+* `ies reproduce fig5|fig6|fig7|fig8|figD2|figD3|all [--quick] [--out DIR]`: the paper's figures, run from the
+  shipped study files (uq/studies/fig5.toml ... figD3.toml, or their -quick variants) into DIR/fig5 ... DIR/figD3.
   Before Figs. 7 and 8 it calibrates k_H on the shipped crater (the calibration `ies calibrate --json` prints,
   kept in DIR/calibration.json) and uses the calibrated k_H as the upper bound of k_H, as the paper does with
   its BEM result 1.52 k_H* (Sect. 4.1); the best estimate stays 1.25 k_H* unless the calibration falls below
@@ -38,10 +38,11 @@ INTERVAL_HELP = "interval bands of the resonant response level for D, g, k_H (pa
 SOBOL_HELP = "Sobol' sensitivity indices of the resonant response level per excitation level (SALib)"
 RESPONSE_HELP = ("frequency responses and resonant levels of the nominal point over the excitation levels, run as a "
                  "resumable study (paper Sects. 5.2-5.3, Figs. 5-6)")
-REPRODUCE_HELP = "reproduce the paper's Figs. 5 and 6 (nominal response) and 7 and 8 (uncertainty of D, g, k_H)"
+REPRODUCE_HELP = ("reproduce the paper's Figs. 5 and 6 (nominal response), 7 and 8 (uncertainty of D, g, k_H) and "
+                  "D.2 and D.3 (impacts per period, restitution)")
 PLOT_HELP = "redraw a result folder's figures from its saved data (formats, style, levels) without recomputing"
 #: the paper's figures that `ies reproduce` runs, in the order of `all`
-FIGURES = ("fig5", "fig6", "fig7", "fig8")
+FIGURES = ("fig5", "fig6", "fig7", "fig8", "figD2", "figD3")
 
 
 def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
@@ -170,15 +171,20 @@ def print_interval_result(folder: Path, summary: dict, name: str) -> None:
 
 
 def print_response_result(folder: Path, name: str) -> None:
-    """The resonant levels per excitation level and the optimum (Fig. 6)."""
+    """The resonant levels per excitation level and the optimum (Fig. 6); for Figs. D.2, D.3 the impacts and
+    scattering measures at the resonant eta."""
     import json
 
-    from sim.tables import optimum_line, overview_text
+    from sim.tables import optimum_line, overview_text, scattering_text
 
     from sim.variants import switch_line
 
     data = json.loads((folder / "study.json").read_text())
     overview = data["overview"]
+    if name in ("figD2", "figD3"):
+        print(f"{name}: impacts, restitution and energy scattering at the resonant eta of the nominal point:")
+        print(scattering_text(overview))
+        return
     print(f"{name}: resonant levels (a / a_noabs*) of the nominal point:")
     print(overview_text(overview))
     print(f"{name}: {optimum_line(overview)}")
@@ -192,7 +198,8 @@ def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies reproduce`."""
     parser.add_argument("figure", choices=(*FIGURES, "all"),
                         help="which figure(s): fig5 (frequency responses), fig6 (resonant level vs excitation level), "
-                             "fig7 and fig8 (uncertainty of D, g, k_H), all")
+                             "fig7 and fig8 (uncertainty of D, g, k_H), figD2 and figD3 (impacts per period and "
+                             "restitution vs excitation level), all")
     parser.add_argument("--quick", action="store_true",
                         help="reduced protocol (fewer levels, frequencies, repetitions, shorter holds); same trends")
     parser.add_argument("--out", type=Path, default=Path("ies-out/reproduce"), metavar="DIR",

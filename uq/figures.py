@@ -296,6 +296,15 @@ def response_figures(folder: str | Path, options: PlotOptions | None = None) -> 
         for path in options.paths(folder, "fig5"):
             plot_sweeps(panels, path, f"Frequency responses (cf. Fig. 5), nominal parameters, {runs}; bands: "
                                       "range of the runs")
+    for figure in ("figD2", "figD3"):
+        if figure in meta["study"]["response"]["figures"]:
+            from sim.figures import plot_scattering
+
+            what = "impacts per period (cf. Fig. D.2)" if figure == "figD2" else "restitution, APR levels (cf. Fig. D.3)"
+            runs_rows = _rows(folder / "runs.csv", options)
+            for path in options.paths(folder, figure):
+                plot_scattering(overview, runs_rows, path, f"{what} at the resonant eta, nominal parameters, {runs}", figure)
+            paths += options.paths(folder, figure)
     if "fig6" in meta["study"]["response"]["figures"]:
         paths += options.paths(folder, "fig6")
         for path in options.paths(folder, "fig6"):
@@ -306,7 +315,7 @@ def response_figures(folder: str | Path, options: PlotOptions | None = None) -> 
 
 register("ies interval", _kind_is("interval"))(interval_figures)
 register("ies sobol", _kind_is("sobol"))(sobol_figure)
-register("response study (ies reproduce fig5, fig6)", _kind_is("response"))(response_figures)
+register("response study (ies reproduce fig5, fig6, figD2, figD3)", _kind_is("response"))(response_figures)
 
 
 def _result_children(folder: Path) -> list[Path]:

@@ -28,6 +28,7 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
+from sim.measures import SCATTERING_MEASURES
 from uq.errors import StudyError
 from uq.space import Parameter, ParameterSpace, table2_space
 
@@ -70,11 +71,12 @@ class IESModel:
     modal_file: str | None = None
     variant: Mapping[str, float] = field(default_factory=dict)
     rig: Any = field(default=None, compare=False, repr=False)
-
+    banded_outputs: tuple[str, ...] = ("mean", "max")
 
     parameters = ("D", "g", "k_H")
-    outputs = ("mean", "max", "apr")
-    banded_outputs = ("mean", "max")
+    #: the resonant levels, the regime (1 = APR) and the scattering measures of `sim.measures` at the resonant
+    #: mean's eta (Sect. 5.5, Appendix D)
+    outputs = ("mean", "max", "apr", *SCATTERING_MEASURES)
 
     def default_space(self) -> ParameterSpace:
         return table2_space()
@@ -161,9 +163,11 @@ class IESModel:
         run = run_sweep(model, self._impactor(params), level, self._stepped_sine(), seed=seed, rep=rep)
         own = aggregate_runs([run])
         trace = {key: getattr(run, key).tolist() for key in _TRACE}
+        trace["scattering"] = {name: values.tolist() for name, values in run.scattering.items()}
         trace.update(level=run.level, a_base=run.a_base, a_noabs=run.a_noabs, seed=run.seed, rep=run.rep)
+        at = own.eta == own.eta_resonant_mean
         return {"mean": own.resonant_mean, "max": own.resonant_max, "apr": 1.0 if own.regime == "APR" else 0.0,
-                "trace": trace}
+                **{name: float(own.scattering[name][at][0]) for name in SCATTERING_MEASURES}, "trace": trace}
 
     def sweep_result(self, records: list[Mapping[str, Any]]) -> Any:
         """The frequency response (`sim.protocol.SweepResult`, Fig. 5) of the runs of one (point, level), rebuilt
@@ -177,8 +181,9 @@ class IESModel:
         for rec in records:
             t = rec["trace"]
             arrays = {key: np.asarray(t[key], dtype=int if key in ("leg", "hold_periods") else float) for key in _TRACE}
+            scattering = {name: np.asarray(values, dtype=float) for name, values in t.get("scattering", {}).items()}
             runs.append(SweepRun(**arrays, level=t["level"], a_base=t["a_base"], a_noabs=t["a_noabs"], seed=t["seed"],
-                                 rep=t["rep"], protocol=protocol, impactor=None))
+                                 rep=t["rep"], protocol=protocol, impactor=None, scattering=scattering))
         return aggregate_runs(runs) if runs else None
 
     def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, Any]:
@@ -186,13 +191,22 @@ class IESModel:
         (largest repetition-averaged mean / max over eta, Sect. 5.2-5.3), with the standard error of the
         repetition samples at that eta (`SweepResult.resonant_spread`; NaN for a single sample: no noise
         estimate): {output: (value, standard error, number of samples)} and "regime": the regime there."""
+        import numpy as np
+
         res = self.sweep_result(records)
         if res is None:
             return {**{name: (float("nan"), float("nan"), 0) for name in self.outputs}, "regime": ""}
         n = int(res.n_samples)
+        at = res.eta == res.eta_resonant_mean
+        scattering = {}
+        for name in SCATTERING_MEASURES:  # at the resonant mean's eta, standard error of its samples
+            samples = res.scattering_samples[name][:, at][:, 0]
+            samples = samples[np.isfinite(samples)]
+            se = float(np.std(samples, ddof=1) / np.sqrt(samples.size)) if samples.size >= 2 else float("nan")
+            scattering[name] = (float(res.scattering[name][at][0]), se, int(samples.size))
         return {"mean": (res.resonant_mean, res.resonant_spread("mean")[2], n),
                 "max": (res.resonant_max, res.resonant_spread("max")[2], n),
-                "apr": (1.0 if res.regime == "APR" else 0.0, 0.0, n), "regime": res.regime}
+                "apr": (1.0 if res.regime == "APR" else 0.0, 0.0, n), **scattering, "regime": res.regime}
 
 
 _TRACE = ("eta", "eta_actual", "leg", "mean", "max", "min", "std", "impacts_per_period", "hold_periods")
@@ -296,12 +310,19 @@ class FunctionModel:
 
 
 def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, parameters: tuple[str, ...] = (),
-               modal_model: str | Path | None = None, variant: Mapping[str, float] | None = None) -> Any:
+               modal_model: str | Path | None = None, variant: Mapping[str, float] | None = None,
+               outputs: tuple[str, ...] = ()) -> Any:
     """The model named by a study's ``model`` key ("ies", "ishigami" or "module:function"); modal_model: a
-    modal-model file replacing the built-in rig of "ies"; variant: the [variant] table of "ies"."""
+    modal-model file replacing the built-in rig of "ies"; variant: the [variant] table of "ies"; outputs: the
+    outputs of "ies" whose bands and indices the study computes (default: the resonant mean and max)."""
     if spec == "ies":
+        unknown = [name for name in outputs if name not in IESModel.outputs]
+        if unknown:
+            raise StudyError(f"[study] unknown output(s) {', '.join(unknown)}; known: {', '.join(IESModel.outputs)}")
         return IESModel(dict(protocol or {}), modal_file=None if modal_model is None else str(modal_model),
-                        variant=dict(variant or {}))
+                        variant=dict(variant or {}), **({"banded_outputs": tuple(outputs)} if outputs else {}))
+    if outputs:
+        raise StudyError("[study] outputs only applies to model = \"ies\" (the simulator)")
     if spec == "ishigami":
         return IshigamiModel()
     if ":" in spec:

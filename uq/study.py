@@ -11,6 +11,9 @@ Layout (every table and key is optional except where noted; SI units)::
     seed = 1                     # random stream of the repetitions (Sect. 5.1: perturbed frequencies)
     repetitions = 5
     output = "results/fig7"      # default output folder (`--out` overrides), relative to the cwd
+    outputs = ["mean", "max"]    # model "ies": the outputs the bands / indices are computed for (default
+                                 # mean, max; also "restitution", "significant_impacts_per_period", ... of
+                                 # sim.measures.SCATTERING_MEASURES, at the resonant mean's eta)
 
     [variant]                    # optional, model "ies": modelling choices the paper leaves open (README,
     sphere_mass_factor = 1.537   # "Fidelity"): the sphere's effective mass in x over m_a (rolling: 1.4 on a
@@ -48,7 +51,8 @@ Layout (every table and key is optional except where noted; SI units)::
     confidence = 0.95
 
     [response]                   # kind "response": the frequency responses and resonant levels of the nominal
-    figures = ["fig5", "fig6"]   # point (the parameters' nominal values) at every level, as Figs. 5 and 6
+    figures = ["fig5", "fig6"]   # point (the parameters' nominal values) at every level, as Figs. 5 and 6, and
+                                 # "figD2", "figD3": impacts per period and r at the resonant eta (Appendix D)
 
 Unknown tables or keys, unknown parameters, min > max, non-positive bounds and the like are refused with
 a `StudyError` whose one line names the file, the key and the fix.
@@ -68,10 +72,10 @@ from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_
 
 KINDS = ("interval", "sobol", "response")
 #: the figures a response study draws (Figs. 5 and 6 of the seed paper)
-RESPONSE_FIGURES = ("fig5", "fig6")
+RESPONSE_FIGURES = ("fig5", "fig6", "figD2", "figD3")
 DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
-    "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output"},
+    "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output", "outputs"},
     "variant": {"sphere_mass_factor", "higher_mode_damping"},
     "parameters": None,  # one sub-table per parameter
     "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "perturb", "repetition",
@@ -107,10 +111,11 @@ class Study:
     modal_model: Path | None = None
     figures: tuple[str, ...] = RESPONSE_FIGURES
     variant: Mapping[str, float] = field(default_factory=dict)
+    outputs: tuple[str, ...] = ()
 
     def make_model(self) -> Any:
         return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
-                          modal_model=self.modal_model, variant=self.variant)
+                          modal_model=self.modal_model, variant=self.variant, outputs=self.outputs)
 
     def to_dict(self) -> dict:
         """The resolved study as plain data (written to the results' metadata)."""
@@ -122,6 +127,7 @@ class Study:
             "interval": {"designs": list(self.designs), "interior": self.interior, "z": self.z, "fix": dict(self.fix)},
             "sobol": {"n": self.sobol_n, "bootstrap": self.bootstrap, "confidence": self.confidence},
             "response": {"figures": list(self.figures)}, "variant": dict(self.variant),
+            "outputs": list(self.outputs),
         }
 
 
@@ -235,8 +241,11 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
     if kind == "response" and model_spec != "ies":
         raise StudyError("a response study runs the simulator: model = \"ies\"")
 
+    outputs = head.get("outputs", [])
+    if not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs) or len(set(outputs)) != len(outputs):
+        raise StudyError(f"[study] outputs must be a list of distinct output names, e.g. [\"mean\", \"restitution\"], got {outputs!r}")
     study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
-                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures), variant)
+                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures), variant, tuple(outputs))
     model = study.make_model()  # unknown model -> one line now
     if modal_model is not None or variant:
         model.check()  # an unreadable modal file -> one line now

@@ -8,6 +8,7 @@ import pytest
 
 from sim import collocation as C
 from sim import exact
+from sim.flight import state_layout
 from sim.errors import SimulationInputError
 from sim.system import Impactor, system_arrays
 
@@ -56,7 +57,7 @@ def test_tables_are_converged_in_their_quadrature(beam, kind):
 def _state_in_contact(sys):
     """A deviation state with the modes ringing and the sphere moving (the steps below do not solve for F)."""
     rng = np.random.default_rng(3)
-    Y = np.zeros(2 * N9 + 6)
+    Y = np.zeros(state_layout(N9).size)
     Y[:N9] = 1e-7 * rng.standard_normal(N9) / np.arange(1, N9 + 1)
     Y[N9:2 * N9] = 1e-7 * rng.standard_normal(N9) * sys.omega / np.arange(1, N9 + 1)
     Y[2 * N9] = sys.phi_l @ Y[:N9] - sys.g
@@ -114,7 +115,7 @@ def test_observed_order_of_a_collocation_step(beam):
     for n_steps in (2, 3, 4, 6):
         h = span / n_steps
         tab, off = _table(cst, C.REGULAR, h, nodes=nodes)
-        Y = np.zeros(2 * N9 + 6)
+        Y = np.zeros(state_layout(N9).size)
         Y[:2 * N9 + 2] = y0
         ratio = np.ones(4)
         step = C.Step(tab, _phases(tab, off, 4, Omega=cst.par["Omega"]), off)

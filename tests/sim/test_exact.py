@@ -166,7 +166,7 @@ def test_release_is_located_when_the_first_guess_ends_short():
     Omega = 2 * math.pi * 1000.0
     cst, _ = exact._prepare(Omega, 0.0, sys, 48, 1e-7, 0.5 / sys.omega.max())
     n = N9
-    Y = np.zeros(2 * n + 6)
+    Y = np.zeros(flight.state_layout(n).size)
     Y[2 * n] = -sys.g - 1e-7  # 0.1 um into the left wall ...
     Y[2 * n + 1] = 0.2  # ... opening at 0.2 m/s: the release is ~0.5 us ahead
     work = dopri5.work(Y.size, np.zeros(len(flight.COUNT), dtype=np.int64))
