@@ -628,20 +628,25 @@ _OVERLAP_X, _OVERLAP_W = (0.5 * (np.polynomial.legendre.leggauss(8)[0] + 1.0), 0
 @kernel
 def _overlap_work(S, Fs, sigma, wall, cst, Y, scratch):
     """Y[G + j] -= int over [t_e - sigma, t_e] of sgn phi_w,j F x_j' dt: the contact work of the overlap, by
-    Gauss-Legendre quadrature of the series of the force (Fs) and of the state (S, evaluated into `scratch`),
-    both in the backward time (`_series`)."""
+    Gauss-Legendre quadrature of the series of the force (Fs) and of the modal velocities (S, evaluated into
+    `scratch`), both in the backward time (`_series`)."""
     md = cst.modes
     lay = state_layout(md.size)
     sgn = 1.0 if wall == 0 else -1.0
+    p = S.shape[0]
     for q in range(_OVERLAP_X.size):
         u = sigma * _OVERLAP_X[q]
-        _series_at(S, u, scratch, lay.acc)
+        for j in range(lay.n):  # the modal velocities only (Horner, all modes at once)
+            scratch[j] = S[p - 1, lay.v + j]
+        for k in range(p - 2, -1, -1):
+            for j in range(lay.n):
+                scratch[j] = scratch[j] * u + S[k, lay.v + j]
         f = Fs[Fs.size - 1]
         for k in range(Fs.size - 2, -1, -1):
             f = f * u + Fs[k]
         weight = sgn * sigma * _OVERLAP_W[q] * f
         for j in range(lay.n):
-            Y[lay.G + j] -= weight * _phi(md, j, wall) * scratch[lay.v + j]
+            Y[lay.G + j] -= weight * _phi(md, j, wall) * scratch[j]
 
 
 # ----------------------------------------------------------------------------------------------------------

@@ -127,18 +127,20 @@ def point_measures(amplitudes: np.ndarray, impacts: np.ndarray, a_noabs: float, 
 
 
 def significant_impacts(impacts: np.ndarray, theta: float = SIGNIFICANT_IMPULSE_FRACTION) -> np.ndarray:
-    """Mask of the significant impacts among complete impact records (`sim.energy.IMPACT_DTYPE`): impulse
-    >= theta * J_ref, J_ref the median over the periods with impacts of each period's largest impulse."""
+    """Mask of the significant impacts among complete impact records (`sim.energy.IMPACT_DTYPE`, in onset
+    order): impulse >= theta * J_ref, J_ref the median over the periods with impacts of each period's largest
+    impulse."""
     if not 0.0 <= theta <= 1.0:
         raise ValueError(f"theta must lie in [0, 1], got {theta!r}")
-    complete = np.isfinite(impacts["impulse"])
+    impulse = impacts["impulse"]
+    complete = np.isfinite(impulse)
     if not complete.any():
         return complete
-    periods = impacts["period"][complete].astype(np.int64)
-    largest = np.zeros(periods.max() + 1)
-    np.maximum.at(largest, periods, impacts["impulse"][complete])
+    periods = impacts["period"][complete]  # in onset order: non-decreasing
+    starts = np.flatnonzero(np.r_[True, np.diff(periods) != 0])
+    largest = np.maximum.reduceat(impulse[complete], starts)  # each period's largest impulse
     reference = float(np.median(largest[largest > 0])) if np.any(largest > 0) else 0.0
-    return complete & (np.nan_to_num(impacts["impulse"]) >= theta * reference) & (reference > 0)
+    return complete & (np.nan_to_num(impulse) >= theta * reference) & (reference > 0)
 
 
 def modal_restitution(impacts: np.ndarray, fundamental: np.ndarray, Omega: float) -> np.ndarray:
