@@ -5,8 +5,10 @@ before) is walked to its last point; after that point's wait, `periods` excitati
 simulated with the state recorded at M = round(fs / f_exc) instants per period, exactly at those instants
 (the integrator's states, not interpolated: `sim.system` record contract). The sampling rate is therefore
 M f_exc, the nearest to the requested one that puts a whole number of samples in every period. The recorded
-states become the signal columns of `sim.signals.simulated_signal` (SI units), the simulator's contacts
-between samples the impact list of `sim.signals.simulated_contacts`.
+states become the signal columns of `sim.signals.simulated_signal` (SI units). The impact list comes from the
+integrator's own impact records (`sim.energy.Ledger`: exact onset time, duration, impulse, velocities and modal
+energies of each contact) with the stretch's scattering measures (Sect. 5.5, Appendix D); an integrator that keeps
+no records (ode3) falls back to the contacts seen between samples (`sim.signals.simulated_contacts`).
 """
 from __future__ import annotations
 
@@ -17,7 +19,8 @@ from typing import Any
 import numpy as np
 
 from sim.errors import SimulationInputError
-from sim.measures import hold_measures
+from sim.energy import Ledger
+from sim.measures import SCATTERING_MEASURES, hold_measures, point_measures
 from sim.protocol import SteppedSine, check_level, simulated_system, visit_points
 from sim.signals import Signal, SimulatedContacts, simulated_contacts, simulated_signal
 from sim.system import Impactor, ModalModel, Nominal, a_base_star, a_noabs_star
@@ -42,7 +45,7 @@ class Trace:
     contacts: the simulator's contacts between samples; samples_per_period M; fs = M Omega / (2 pi) (Hz);
     amplitudes: |c_1| of q_tip per recorded period (m, Sect. 5); impacts: contact onsets per period;
     level a_base/a_base*, a_base, a_noabs (m); eta, eta_actual: the point's nominal and simulated
-    Omega / omega_1; Omega (rad/s).
+    Omega / omega_1; Omega (rad/s); ledger: the energy bookkeeping and impact records of the recorded stretch.
     """
 
     signal: Signal
@@ -58,6 +61,7 @@ class Trace:
     eta: float
     eta_actual: float
     Omega: float
+    ledger: Ledger | None = None
 
     @property
     def normalised_amplitudes(self) -> np.ndarray:
@@ -105,10 +109,11 @@ def record_trace(model: ModalModel, impactor: Impactor | None, level: float, pro
         run_step(y, protocol.periods(Omega)[1], Omega, a_base, sys, None)
     M = samples_per_period(fs, Omega)
     states = np.empty((int(periods) * M + 1, y.size))
-    amplitudes, impacts = run_step(y, int(periods), Omega, a_base, sys, states)
+    ledger = Ledger()
+    amplitudes, impacts = run_step(y, int(periods), Omega, a_base, sys, states, ledger=ledger)
     return Trace(simulated_signal(states, M, Omega, a_base, sys), states,
                  simulated_contacts(states, M, Omega, a_base, sys), M, M * Omega / (2.0 * math.pi), amplitudes,
-                 impacts, level, a_base, a_noabs, eta, eta_actual, Omega)
+                 impacts, level, a_base, a_noabs, eta, eta_actual, Omega, ledger)
 
 
 def trace_rows(trace: Trace) -> np.ndarray:
@@ -119,10 +124,11 @@ def trace_rows(trace: Trace) -> np.ndarray:
 def trace_data(trace: Trace, settings: dict[str, Any]) -> dict[str, Any]:
     """The JSON object of a trace (SI units): `settings` (the command's parameters), the actual sampling rate,
     the per-period amplitudes a / a_noabs* with their mean and max (Fig. 4), the contact onsets per period, and
-    the simulator's impacts (`sim.signals.simulated_contacts`: onset time known to one sample interval)."""
+    the simulator's impacts (`impact_list`) and the stretch's scattering measures (`sim.measures`)."""
     a = trace.normalised_amplitudes
     m = hold_measures(trace.amplitudes, trace.impacts, trace.a_noabs)
-    contacts = trace.contacts
+    scattering = {} if trace.ledger is None else point_measures(trace.amplitudes, trace.impacts, trace.a_noabs,
+                                                                trace.ledger).scattering
     return {
         **settings,
         "level": trace.level, "a_base": trace.a_base, "a_noabs": trace.a_noabs, "eta": trace.eta,
@@ -131,7 +137,29 @@ def trace_data(trace: Trace, settings: dict[str, Any]) -> dict[str, Any]:
         "periods": int(a.size), "n_samples": int(trace.signal.t.size),
         "amplitudes": a, "mean": m.mean, "max": m.max, "cv": m.cv,
         "impacts_per_period": m.impacts_per_period, "onsets_per_period": trace.impacts,
-        "impacts": [{"t": t, "wall": wall, "impulse": impulse}
-                    for t, wall, impulse in zip(contacts.times, contacts.walls, contacts.impulses)],
+        **impact_list(trace),
+        **{name: getattr(scattering, name, math.nan) for name in SCATTERING_MEASURES},
         "columns": list(COLUMNS), "units": UNITS,
     }
+
+
+def impact_list(trace: Trace) -> dict[str, Any]:
+    """{"impacts": [...], "impacts_source": ...}: one entry per contact of the recorded stretch with its onset
+    time "t" (s, from the stretch's start) and "wall" ("left"/"right"). From the integrator's records
+    ("integrator": exact onset; also duration (s), impulse int |f| dt (N s), approach_speed (m/s), the sphere's
+    velocity relative to the base before/after (m/s) and the energies of mode 1 and modes 2..N at onset and
+    release (J), Appendix D) when it keeps them, else from the samples ("samples": onset to one sample interval,
+    signed impulse, `sim.signals.simulated_contacts`)."""
+    records = None if trace.ledger is None else trace.ledger.impacts
+    if records is None or (records.size == 0 and trace.impacts.sum() > 0):
+        contacts = trace.contacts
+        return {"impacts_source": "samples",
+                "impacts": [{"t": t, "wall": wall, "impulse": impulse}
+                            for t, wall, impulse in zip(contacts.times, contacts.walls, contacts.impulses)]}
+    T = 2.0 * math.pi / trace.Omega
+    rows = []
+    for r in records:
+        row = {"t": float(r["period"] * T + r["t_onset"]), "wall": "left" if r["wall"] == 0 else "right"}
+        row.update({name: float(r[name]) for name in records.dtype.names if name not in ("wall", "period", "t_onset")})
+        rows.append(row)
+    return {"impacts_source": "integrator", "impacts": rows}

@@ -31,11 +31,21 @@ def test_trace_json_csv_plot_and_redraw(tmp_path, model_file, capsys):
     assert data["fs_requested"] == 51200 and data["periods"] == 4 and len(data["amplitudes"]) == 4
     assert data["mean"] == pytest.approx(np.mean(data["amplitudes"])) and data["max"] == max(data["amplitudes"])
     assert data["impacts"] and {"t", "wall", "impulse"} <= set(data["impacts"][0])
+    # the impact list is the integrator's exact records: one per contact onset, each onset between the samples
+    # where the sampled contact force switches on
+    assert data["impacts_source"] == "integrator" and len(data["impacts"]) == sum(data["onsets_per_period"])
+    assert {"duration", "approach_speed", "sphere_before", "sphere_after", "higher_release"} <= set(data["impacts"][0])
+    assert all(0 <= i["t"] <= 4 / f_exc and i["wall"] in ("left", "right") for i in data["impacts"])
+    assert abs(data["balance_error"]) < 1e-6
     table = np.genfromtxt(out / "trace.csv", delimiter=",", names=True)
     assert table.dtype.names == COLUMNS and table.size == 4 * M + 1
     np.testing.assert_allclose(np.diff(table["t"]), 1 / data["fs"], rtol=1e-9)
     # the per-period |c_1| of the sampled q_tip (rectangle rule, exact for harmonics below M/2) against the
     # kernel's exact quadrature: the CSV holds the states at the sample instants
+    force = np.abs(table["f_left"]) + np.abs(table["f_right"])
+    first = data["impacts"][0]
+    k = int(first["t"] * data["fs"])  # the sample interval of the first onset
+    assert force[k] == 0 or k == 0
     q = table["q_tip"][:-1].reshape(4, M)
     c1 = np.abs(2 / M * (q * np.exp(-2j * np.pi * np.arange(M) / M)).sum(axis=1))
     np.testing.assert_allclose(c1 / data["a_noabs"], data["amplitudes"], rtol=1e-3)
