@@ -20,7 +20,7 @@ from typing import Any, Mapping, Sequence
 from sim.files import plot_to, save_figure
 from sim.redraw import PlotOptions, register, selected
 
-from sim.variants import PAPER_APR_LEVEL, PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, PAPER_REDUCTION_MEAN
+from sim.measures import PAPER_APR_LEVEL, PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, PAPER_REDUCTION_MEAN
 
 
 def draw_sweep(ax: Any, data: Mapping[str, Any], title: str) -> None:

@@ -53,6 +53,15 @@ if TYPE_CHECKING:  # sim.energy imports the kernels (numba); the measures need o
 #: eta = 0.974-0.980 cv = 0.03-0.08, SMR eta = 0.982-1.02 cv = 0.43-0.53, the branch's lower edge
 #: (eta = 0.968-0.972) 0.12-0.15.
 REGIME_CV_THRESHOLD = 0.1
+#: The paper's Fig. 6 landmarks (Sect. 5.3, Appendix B): the optimum at a_base/a_base* ~ 6.7 with the resonant
+#: mean (max) level reduced 20x (10x); at 7.4 the resonance near eta = 0.976 is almost periodic with about two
+#: significant impacts per period, its measured tip amplitude 0.58-0.95 mm = 0.14-0.19 a^noabs* (Eq. B.1).
+PAPER_OPTIMUM_LEVEL = 6.7
+PAPER_REDUCTION_MEAN = 20.0
+PAPER_REDUCTION_MAX = 10.0
+PAPER_APR_ETA = 0.976
+PAPER_APR_LEVEL = (0.14, 0.19)
+PAPER_IMPACTS_PER_PERIOD = 2.0
 APR, SMR, LINEAR = "APR", "SMR", "linear"
 #: theta: an impact is significant when its impulse is at least theta times the hold's reference impulse.
 SIGNIFICANT_IMPULSE_FRACTION = 0.1

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Any, Sequence
 
-from sim.measures import SCATTERING_MEASURES
+from sim.measures import PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, PAPER_REDUCTION_MEAN, SCATTERING_MEASURES
 from sim.protocol import SweepResult, scattering_keys
 
 #: the columns of the energy scattering and impact measures (Sect. 5.5, Appendix D; `sim.measures`), appended to
@@ -104,4 +104,4 @@ def optimum_line(data: dict[str, list]) -> str:
     return (f"optimum: a_base/a_base* = {data['levels'][i]:g} ({data['regime'][i]}), resonant mean "
             f"{data['resonant_mean'][i]:.4f} and max {data['resonant_max'][i]:.4f} of a_noabs*: reduced "
             f"{1 / data['resonant_mean'][i]:.0f}x (mean) and {1 / data['resonant_max'][i]:.0f}x (max); the paper: "
-            "6.7, 20x and 10x")
+            f"{PAPER_OPTIMUM_LEVEL:g}, {PAPER_REDUCTION_MEAN:.0f}x and {PAPER_REDUCTION_MAX:.0f}x")

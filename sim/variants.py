@@ -17,15 +17,8 @@ from typing import Sequence
 import numpy as np
 
 from sim.errors import SimulationInputError
-from sim.measures import REGIME_CV_THRESHOLD
+from sim.measures import PAPER_APR_ETA, PAPER_APR_LEVEL, PAPER_OPTIMUM_LEVEL, REGIME_CV_THRESHOLD
 from sim.solid import NECK_UPDATED_GEOMETRY, UPDATED_SOLID_GEOMETRY, SolidGeometry
-
-PAPER_OPTIMUM_LEVEL = 6.7
-PAPER_REDUCTION_MEAN = 20.0
-PAPER_REDUCTION_MAX = 10.0
-PAPER_APR_ETA = 0.976
-PAPER_APR_LEVEL = (0.14, 0.19)
-PAPER_IMPACTS_PER_PERIOD = 2.0
 
 
 @dataclass(frozen=True)
