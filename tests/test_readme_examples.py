@@ -102,10 +102,11 @@ def test_the_sweep_example(tmp_path, monkeypatch, capsys):
     with --seed 0..9 gave resonant means 0.283-0.297 and maxima 0.308-0.319, always at eta 0.978 in the almost
     periodic regime; the almost periodic rows' means varied by up to 5 % and maxima by up to 10 %, the strongly
     modulated rows' means and maxima by factors up to 1.38 and 1.59 (cv by up to 0.12, impacts per period by up
-    to 0.13); the regime of a row with cv near the threshold 0.1 (eta 0.970, 0.974: cv 0.06-0.13) flipped.
-    Here: almost periodic rows (cv <= 0.15) within 10 %, the others within 50 %, cv within 0.06 / 0.3, impacts
-    per period within 0.3, the regime where cv is 0.05 or more from 0.1, and the grid, the place and the regime
-    of the resonance exactly."""
+    to 0.13); the regime of a row with cv near the threshold 0.1 (eta 0.970, 0.974: cv 0.06-0.13) flipped, and
+    on another machine eta 0.970 gave cv 0.141. Here: almost periodic rows (cv <= 0.15, 0.05 or more from the
+    threshold) within 10 % and cv within 0.06; the others, those near the threshold included, within 50 % and
+    cv within 0.3; impacts per period within 0.3, the regime where cv is 0.05 or more from 0.1, and the grid,
+    the place and the regime of the resonance exactly."""
     (command, expected), = [(c, e) for c, e in EXAMPLES if c.startswith("ies sweep")]
     printed = run(command, tmp_path, monkeypatch, capsys).splitlines()
     header, rows, summary, written = sweep_table(printed)
@@ -113,7 +114,8 @@ def test_the_sweep_example(tmp_path, monkeypatch, capsys):
     assert header == readme_header and printed[1] == expected[1] and written == readme_written
     assert [r[0] for r in rows] == [r[0] for r in readme_rows]
     for (eta, mean, peak, cv, impacts, regime), (_, mean0, peak0, cv0, impacts0, regime0) in zip(rows, readme_rows):
-        periodic = cv0 <= 0.15
+        borderline = abs(cv0 - 0.1) < 0.05  # between the regimes: its cv is as noisy as a modulated row's
+        periodic = cv0 <= 0.15 and not borderline
         rel = 0.1 if periodic else 0.5
         assert mean == pytest.approx(mean0, rel=rel) and peak == pytest.approx(peak0, rel=rel), eta
         assert cv == pytest.approx(cv0, abs=0.06 if periodic else 0.3), eta
