@@ -70,9 +70,24 @@ _FAST = False
 
 
 @kernel(inline="always", fastmath=_FAST)
+def _wall_rate(ct, st, Y, left, cst):
+    """d/dt of delta_l (left) or delta_r in m/s at cos, sin(Omega t) = ct, st: the harmonic wall motion's rate
+    -Omega (W_re sin + W_im cos), the deviations' phi^T x' and the sphere's -z'."""
+    md, par = cst.modes, cst.par
+    lay = flight.state_layout(md.size)
+    W_re = par.W_l_re if left else par.W_r_re
+    W_im = par.W_l_im if left else par.W_r_im
+    rate = -par.Omega * (W_re * st + W_im * ct) - Y[lay.zd]
+    for j in range(lay.n):
+        rate += (md[j].phi_l if left else md[j].phi_r) * Y[lay.v + j]
+    return rate
+
+
+@kernel(inline="always", fastmath=_FAST)
 def rhs(ct, st, Y, out, cst):
-    """Eqs. 3-7 in the deviation coordinates at cos, sin(Omega t) = ct, st, plus the integrands of F_l, F_r and
-    of each mode's contact work G_j (`sim.flight.StateLayout`)."""
+    """Eqs. 3-7 (with Eq. 10 when par.c_damp > 0) in the deviation coordinates at cos, sin(Omega t) = ct, st,
+    plus the integrands of F_l, F_r, of each mode's contact work G_j and of the contact's dissipation Dc
+    (`sim.flight.StateLayout`)."""
     md, par = cst.modes, cst.par
     lay = flight.state_layout(md.size)
     g = par.g
@@ -86,6 +101,21 @@ def rhs(ct, st, Y, out, cst):
     kH = par.k_H
     fl = kH * dl * math.sqrt(dl) if dl > 0.0 else 0.0
     fr = -kH * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
+    p_contact = 0.0
+    if par.c_damp > 0.0:  # Eq. 10: d_H delta' while the wall approaches
+        if dl > 0.0:
+            rate = _wall_rate(ct, st, Y, True, cst)
+            if rate > 0.0:
+                damping = par.c_damp * math.sqrt(math.sqrt(dl)) * rate
+                fl += damping
+                p_contact += damping * rate
+        if dr < 0.0:
+            rate = -_wall_rate(ct, st, Y, False, cst)
+            if rate > 0.0:
+                damping = par.c_damp * math.sqrt(math.sqrt(-dr)) * rate
+                fr -= damping
+                p_contact += damping * rate
+    out[lay.Dc] = p_contact
     for j in range(lay.n):
         v = Y[lay.v + j]
         out[lay.x + j] = v

@@ -491,7 +491,7 @@ def _close_period(Y, X0, T, cst, row):
         row[LEDGER.modes + j] = w_in - work - dE
         total_in += w_in
     row[LEDGER.input] = total_in
-    row[LEDGER.contact] = 0.0  # the elastic contact law (Eq. 4) dissipates nothing
+    row[LEDGER.contact] = Y[lay.Dc]  # the damped law's dissipation (Eq. 10); 0 for the elastic law (Eq. 4)
     scale = 2.0 / T
     row[LEDGER.tip_re] = scale * tr
     row[LEDGER.tip_im] = scale * ti
@@ -694,7 +694,8 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
         err_x=wpos / atol, err_v=wpos / (atol * omega),
         grid_a=unset, grid_b=unset, grid_c=unset, grid_d=unset,  # below, from the records' transition
         grid_decay=np.exp(-sig * hg), grid_kappa=np.minimum(omega**2 * hg * hg / 8.0, 2.0))
-    par = run_record(Omega=Omega, a_base=a_base, m_a=sys.m_a, inv_m_a=1.0 / sys.m_a, k_H=sys.k_H, g=sys.g,
+    par = run_record(Omega=Omega, a_base=a_base, m_a=sys.m_a, inv_m_a=1.0 / sys.m_a, k_H=sys.k_H, c_damp=sys.c_damp,
+                     g=sys.g,
                      W_l_re=Wl.real, W_l_im=Wl.imag, W_r_re=Wr.real, W_r_im=Wr.imag, P_re=P.real, P_im=P.imag,
                      gap_tol=GAP_TOLERANCE * sys.g, v_min=MIN_APPROACH_SPEED, M_l0=abs(Wl) * Omega**2,
                      M_r0=abs(Wr) * Omega**2, err_z=1.0 / atol, err_zd=1.0 / (atol * omega[0]),
@@ -734,7 +735,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     fixed_contact_step: > 0 replaces the error control in contacts by this fixed step in s (order studies;
     Dormand-Prince only).
     contacts: "collocation" (default: `sim.collocation`, Dormand-Prince where it falls back) or "dopri5"
-    (every contact by the Dormand-Prince 5(4) pair with error control at rtol).
+    (every contact by the Dormand-Prince 5(4) pair with error control at rtol). With the damped contact law
+    (Eq. 10, sys.c_damp > 0) every contact takes the Dormand-Prince pair: collocation solves Eq. 4 only.
     stats: optional dict that receives the kernel's counters (the fields of `sim.flight.Counters`: grid
     steps, searches, contact steps, ...).
     ledger: optional `sim.energy.Ledger` that receives the energy bookkeeping per period (exact closed forms,
@@ -760,7 +762,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     work = _work(cst)
     out = integrator_output(n_periods, sys.omega.size, record_arr, ledger)
     stored_start = stored_energy(y, sys) if ledger is not None else math.nan
-    use_collocation = contacts == "collocation" and fixed_contact_step <= 0.0
+    # collocation solves the elastic law (Eq. 4); the damped law (Eq. 10) takes the Dormand-Prince contact
+    use_collocation = contacts == "collocation" and fixed_contact_step <= 0.0 and sys.c_damp == 0.0
     recorder = Recorder(Y=np.zeros(work.Y.size), Ynew=np.zeros(work.Y.size),
                         dp=dopri5.work(work.Y.size, np.zeros_like(work.counters)))
     run = Run(cst, grid, out, work, dopri5.work(work.Y.size, work.counters), collocation.context(cst), use_collocation,

@@ -33,7 +33,8 @@ class StateLayout(NamedTuple):
     components (up to `acc`) are the mechanical state. From `acc` on, integrals carried through the period:
     Y[F_l], Y[F_l + 1] = Re, Im of F_l = int f_l e^{-i Omega t} dt (N s), the same for F_r;
     Y[G + j] = int (phi_l,j f_l + phi_r,j f_r) x_j' dt, the work of mode j's deviation on the contacts (J),
-    the one integral of the energy bookkeeping (`sim.energy`) that free flight does not give in closed form.
+    the one integral of the energy bookkeeping (`sim.energy`) that free flight does not give in closed form;
+    Y[Dc] = the energy the damped contact law of Eq. 10 dissipates (J; stays 0 for the elastic law).
     """
 
     n: int
@@ -45,6 +46,7 @@ class StateLayout(NamedTuple):
     F_l: int
     F_r: int
     G: int
+    Dc: int
     size: int
 
 
@@ -59,8 +61,9 @@ def state_layout(n: int) -> StateLayout:
     F_l = acc
     F_r = F_l + 2
     G = F_r + 2
-    size = G + n
-    return StateLayout(n=n, x=x, v=v, z=z, zd=zd, acc=acc, F_l=F_l, F_r=F_r, G=G, size=size)
+    Dc = G + n
+    size = Dc + 1
+    return StateLayout(n=n, x=x, v=v, z=z, zd=zd, acc=acc, F_l=F_l, F_r=F_r, G=G, Dc=Dc, size=size)
 
 
 #: The constants of mode j in one run (a record per mode; Eqs. 7, 9 and the scales of the contact steps).
@@ -100,6 +103,7 @@ RUN = np.dtype([
     ("m_a", np.float64),  # sphere mass (kg) and its inverse
     ("inv_m_a", np.float64),
     ("k_H", np.float64),  # Hertz constant (N/m^1.5)
+    ("c_damp", np.float64),  # damping factor of Eq. 10, d_H = c_damp delta^0.25 (N s / m^1.25; 0: elastic)
     ("g", np.float64),  # clearance (m)
     ("W_l_re", np.float64),  # W_w = phi_w^T S + a_base: harmonic wall motion relative to the base (m)
     ("W_l_im", np.float64),

@@ -5,7 +5,8 @@ Eqs. 3-7 in the relative coordinates of `sim.system` (y = [s, s', u_a, u_a'], u_
     s_j''  = -2 D_j w_j s_j' - w_j^2 s_j - phi_l,j f_l - phi_r,j f_r + gamma_j a_base Omega^2 cos(Omega t)
     u_a''  = (f_l + f_r) / m_a + a_base Omega^2 cos(Omega t)
 
-with the Hertz forces of Eqs. 4-6 (`sim.system.contact_forces`). The scheme is the explicit 3-stage
+with the Hertz forces of Eqs. 4-6 (`sim.system.contact_forces`), or the damped law of Eq. 10 (each force
+gains c_damp delta^0.25 delta' while its wall approaches). The scheme is the explicit 3-stage
 Bogacki-Shampine tableau without error control, exactly MATLAB's fixed-step ``ode3``:
 
     k1 = f(t, y),  k2 = f(t + h/2, y + h/2 k1),  k3 = f(t + 3h/4, y + 3h/4 k2),
@@ -22,7 +23,8 @@ checked at the step points).
 
 Energy bookkeeping (Sect. 5.5, `sim.energy.Ledger`) by the scheme's own quadrature: the work of the base
 excitation a_base Omega^2 cos(Omega t) (gamma^T s' + m_a u_a') and each mode's dissipation 2 D_j omega_j s_j'^2
-are integrated like extra components of the state (the Bogacki-Shampine weights on the stage values), and
+are integrated like extra components of the state (the Bogacki-Shampine weights on the stage values), as is
+the damped law's dissipation c_damp delta^0.25 delta'^2 (Eq. 10, in approach), and
 the Fourier coefficients of tip and walls by the trapezoidal rule. Its energy balance closes only to the
 scheme's truncation error (third order in h). ode3 keeps no impact records.
 """
@@ -107,7 +109,8 @@ class Steps(NamedTuple):
 
 class Coefficients(NamedTuple):
     """Eqs. 3-7 as the kernel evaluates them: w2 = omega^2, c = 2 D omega (1/s), gamma = phi^T M b, the wall values phi_l, phi_r,
-    the base forcing amplitudes f_modal = gamma a_base Omega^2 and f_sphere = a_base Omega^2, m_a, k_H, g."""
+    the base forcing amplitudes f_modal = gamma a_base Omega^2 and f_sphere = a_base Omega^2, m_a, k_H, g, and
+    c_damp of Eq. 10 (0: elastic)."""
 
     w2: np.ndarray
     c: np.ndarray
@@ -119,6 +122,7 @@ class Coefficients(NamedTuple):
     m_a: float
     k_H: float
     g: float
+    c_damp: float
 
 
 @kernel(inline="always", fastmath=_FAST)
@@ -134,17 +138,42 @@ def _indentations(y, co, lay):
 
 
 @kernel(inline="always", fastmath=_FAST)
+def _approach_rate(y, phi, co, lay):
+    """d/dt of phi^T s - u_a: the rate of delta_l (phi = phi_l) or of delta_r (phi = phi_r) in m/s."""
+    rate = -y[lay.zd]
+    for j in range(lay.n):
+        rate += phi[j] * y[lay.v + j]
+    return rate
+
+
+@kernel(inline="always", fastmath=_FAST)
 def _deriv(y, cos_t, co, lay, out):
-    """Right-hand side of Eqs. 3-7 in relative coordinates (see module docstring)."""
+    """Right-hand side of Eqs. 3-7 in relative coordinates (see module docstring); returns the power the
+    damped law of Eq. 10 dissipates in the contacts (W; 0 for the elastic law)."""
     dl, dr = _indentations(y, co, lay)
     fl = co.k_H * dl * math.sqrt(dl) if dl > 0.0 else 0.0
     fr = -co.k_H * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
+    p_contact = 0.0
+    if co.c_damp > 0.0:  # Eq. 10: d_H delta' in approach only
+        if dl > 0.0:
+            rate = _approach_rate(y, co.phi_l, co, lay)
+            if rate > 0.0:
+                damping = co.c_damp * math.sqrt(math.sqrt(dl)) * rate
+                fl += damping
+                p_contact += damping * rate
+        if dr < 0.0:
+            rate = -_approach_rate(y, co.phi_r, co, lay)
+            if rate > 0.0:
+                damping = co.c_damp * math.sqrt(math.sqrt(-dr)) * rate
+                fr -= damping
+                p_contact += damping * rate
     for j in range(lay.n):
         out[lay.x + j] = y[lay.v + j]
         out[lay.v + j] = (-co.c[j] * y[lay.v + j] - co.w2[j] * y[lay.x + j] - co.phi_l[j] * fl - co.phi_r[j] * fr
                           + co.f_modal[j] * cos_t)
     out[lay.z] = y[lay.zd]
     out[lay.zd] = (fl + fr) / co.m_a + co.f_sphere * cos_t
+    return p_contact
 
 
 @kernel(inline="always", fastmath=_FAST)
@@ -157,9 +186,10 @@ def _tip(y, phi_tip, lay):
 
 
 @kernel(inline="always", fastmath=_FAST)
-def _book(y, cos_t, weight, co, lay, ledger_row):
+def _book(y, cos_t, weight, p_contact, co, lay, ledger_row):
     """Add weight times the integrands of the energy bookkeeping at a stage (state y, cos(Omega t)) to the
-    period's ledger row: the base excitation's power and each mode's damping power (W)."""
+    period's ledger row: the base excitation's power, each mode's damping power and the contact's (W)."""
+    ledger_row[LEDGER.contact] += weight * p_contact
     p_in = co.m_a * y[lay.zd]
     for j in range(lay.n):
         v = y[lay.v + j]
@@ -176,7 +206,7 @@ def _advance(y, sys, steps, out):
     Omega, a_base = steps.Omega, steps.a_base
     co = Coefficients(w2=sys.omega * sys.omega, c=2.0 * sys.D * sys.omega, gamma=sys.gamma, phi_l=sys.phi_l, phi_r=sys.phi_r,
                       f_modal=sys.gamma * (a_base * Omega * Omega), f_sphere=a_base * Omega * Omega, m_a=sys.m_a,
-                      k_H=sys.k_H, g=sys.g)
+                      k_H=sys.k_H, g=sys.g, c_damp=sys.c_damp)
     ny = lay.acc
     # arrays bound once: read from a tuple inside the step loop, numba would count references at every step
     h = steps.h
@@ -208,16 +238,16 @@ def _advance(y, sys, steps, out):
         onsets = 0
         for k in range(N):
             # the Bogacki-Shampine stages of the module docstring (Sect. 3.2)
-            _deriv(y, cos_stage[0, k], co, lay, k1)
-            _book(y, cos_stage[0, k], b1, co, lay, row)
+            pc = _deriv(y, cos_stage[0, k], co, lay, k1)
+            _book(y, cos_stage[0, k], b1, pc, co, lay, row)
             for i in range(ny):
                 yt[i] = y[i] + 0.5 * h * k1[i]
-            _deriv(yt, cos_stage[1, k], co, lay, k2)
-            _book(yt, cos_stage[1, k], b2, co, lay, row)
+            pc = _deriv(yt, cos_stage[1, k], co, lay, k2)
+            _book(yt, cos_stage[1, k], b2, pc, co, lay, row)
             for i in range(ny):
                 yt[i] = y[i] + 0.75 * h * k2[i]
-            _deriv(yt, cos_stage[2, k], co, lay, k3)
-            _book(yt, cos_stage[2, k], b3, co, lay, row)
+            pc = _deriv(yt, cos_stage[2, k], co, lay, k3)
+            _book(yt, cos_stage[2, k], b3, pc, co, lay, row)
             for i in range(ny):
                 y[i] += b1 * k1[i] + b2 * k2[i] + b3 * k3[i]
             # measures at the new step point t_{k+1}
@@ -300,7 +330,7 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
                   cos0=np.cos(phase), sin0=np.sin(phase))
     out = integrator_output(n_periods, sys.omega.size, record_arr, None)
     stored_start = stored_energy(y, sys) if ledger is not None else math.nan
-    kernel_sys = sys._replace(m_a=float(sys.m_a), k_H=float(sys.k_H), g=float(sys.g))
+    kernel_sys = sys._replace(m_a=float(sys.m_a), k_H=float(sys.k_H), g=float(sys.g), c_damp=float(sys.c_damp))
     status, where = _advance(y, kernel_sys, steps, out)
     if status != _OK:
         t = where * h

@@ -12,6 +12,8 @@ Conventions shared by every integrator in `sim`
 * Indentations (Eqs. 5, 6) with absolute wall displacements q_c = phi^T s + q_base:
   delta_l = q_cl - q_a - g,  delta_r = q_cr - q_a + g.
   Forces (Eq. 4): f_l = k_H delta_l^1.5 if delta_l > 0;  f_r = -k_H (-delta_r)^1.5 if delta_r < 0.
+  With the damped law (Eq. 10, `sim.contact_law`) each force gains c_damp delta^0.25 delta' while the wall
+  approaches (delta' > 0 at the left wall, -delta_r' > 0 at the right), c_damp = 2 xi sqrt(k_H m_red).
 * State exchanged between the integrators and the stepped-sine protocol, always at an excitation
   phase that is a multiple of 2 pi (q_base = a_base, q_base' = 0):
   ``y = [s_1..s_n, s_1'..s_n', u_a, u_a']`` with u_a = q_a - q_base (sphere relative to the base).
@@ -38,6 +40,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from sim.contact_law import ContactLaw
 from sim.errors import SimulationInputError
 
 # Table 1 and Sect. 2, 4.1 of the seed paper; Table 2 for the nominal contact parameters.
@@ -126,11 +129,13 @@ class ModalModel:
 
 @dataclass(frozen=True)
 class Impactor:
-    """The sphere and its contacts (Eqs. 3-6): mass m_a (kg), clearance g (m), k_H (N/m^1.5)."""
+    """The sphere and its contacts (Eqs. 3-6): mass m_a (kg), clearance g (m), k_H (N/m^1.5), and the normal
+    contact law at both walls (Eq. 4 by default, or the damped law of Eq. 10)."""
 
     mass: float = SPHERE_MASS
     clearance: float = CLEARANCE_NOMINAL
     k_H: float = K_H_NOMINAL
+    contact_law: ContactLaw = ContactLaw()
 
     def __post_init__(self) -> None:
         for name, label in (("mass", "sphere mass"), ("clearance", "clearance g"), ("k_H", "k_H")):
@@ -169,7 +174,8 @@ class SystemArrays(NamedTuple):
     """Flat, numba-friendly view of the coupled system, passed to the integrator kernels.
 
     omega, D, phi_l, phi_r, phi_tip, gamma: float64 arrays (n_modes,), gamma = phi^T M b;
-    m_a (kg), k_H (N/m^1.5), g (m): floats.
+    m_a (kg), k_H (N/m^1.5), g (m): floats; c_damp (N s / m^1.25): the damping factor of Eq. 10,
+    d_H = c_damp delta^0.25 = 2 xi sqrt(k_H m_red) delta^0.25 (0 for the elastic law of Eq. 4).
     """
 
     omega: np.ndarray
@@ -181,6 +187,17 @@ class SystemArrays(NamedTuple):
     m_a: float
     k_H: float
     g: float
+    c_damp: float = 0.0
+
+
+def damping_factor(model: ModalModel, impactor: Impactor) -> float:
+    """c_damp = 2 xi sqrt(k_H m_red) of Eq. 10 (N s / m^1.25), m_red = m_beam m_a / (m_beam + m_a); 0 for the
+    elastic law. The damped law refuses a model without beam mass with one line (`ContactLaw.reduced_mass`)."""
+    law = impactor.contact_law
+    if not law.dissipative:
+        return 0.0
+    m_red = law.reduced_mass(model.beam_mass, impactor.mass, model.source)
+    return 2.0 * law.xi * math.sqrt(impactor.k_H * m_red)
 
 
 def system_arrays(model: ModalModel, impactor: Impactor) -> SystemArrays:
@@ -189,7 +206,7 @@ def system_arrays(model: ModalModel, impactor: Impactor) -> SystemArrays:
     return SystemArrays(
         as_f8(model.omega), as_f8(model.damping_ratios), as_f8(model.phi_wall_left), as_f8(model.phi_wall_right),
         as_f8(model.phi_tip), as_f8(model.participation), float(impactor.mass), float(impactor.k_H),
-        float(impactor.clearance),
+        float(impactor.clearance), damping_factor(model, impactor),
     )
 
 
