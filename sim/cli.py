@@ -246,6 +246,13 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
                         help="Hertz constant k_H in N/m^1.5, or with a unit: 282e3N/mm^1.5 (default 282e3 N/mm^1.5 = "
                              "8.918e9 N/m^1.5)")
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
+    parser.add_argument("--contact-law", dest="contact_law", choices=("hertz", "hertz-damped"), default=None,  # sim.contact_law.CONTACT_LAWS
+                        help="normal contact law at both walls: hertz (Eq. 4, elastic, default) or hertz-damped (Eq. 10; "
+                             "needs the model's beam mass; the exact integrator then takes every contact by "
+                             "Dormand-Prince)")
+    parser.add_argument("--r-cont", dest="r_cont", type=float, default=None, metavar="R",
+                        help="r_cont,diss of Eq. 10 in (0, 1]: the coefficient of restitution the damped law is designed "
+                             "for (1 = elastic, bit for bit); implies --contact-law hertz-damped (default there 0.99)")
 
 
 def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int) -> None:
@@ -344,23 +351,36 @@ def model_file(path: str) -> Any:
 def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     """(modal model, impactor or None) of the system and impactor options (Eqs. 3-7, Table 2)."""
     from sim.rig import seed_rig_model
-    from sim.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor
+    from sim.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor, damping_factor
 
     model = model_file(args.model) if args.model else seed_rig_model(n_modes=9)
     if args.D is not None:
         model = model.with_damping(args.D)
     clearance = CLEARANCE_NOMINAL if args.g is None else args.g
     k_H = K_H_NOMINAL if args.k_H is None else args.k_H
-    impactor = Impactor(SPHERE_MASS, clearance, k_H)  # validates g and k_H even with --no-impactor
+    impactor = Impactor(SPHERE_MASS, clearance, k_H, contact_law(args))  # validated even with --no-impactor
+    if not args.no_impactor:
+        damping_factor(model, impactor)  # the damped law needs the model's beam mass: fail before any work
     return model, (None if args.no_impactor else impactor)
+
+
+def contact_law(args: argparse.Namespace) -> Any:
+    """The `sim.contact_law.ContactLaw` of --contact-law and --r-cont (--r-cont alone implies the damped law)."""
+    from sim.contact_law import DEFAULT_R_CONT, ContactLaw
+
+    name = args.contact_law or ("hertz-damped" if args.r_cont is not None else "hertz")
+    r_cont = args.r_cont if args.r_cont is not None else (DEFAULT_R_CONT if name == "hertz-damped" else 1.0)
+    return ContactLaw(name, r_cont)
 
 
 def system_data(model: Any, impactor: Any) -> dict:
     """The JSON keys of the simulated system: `model` (its source), `impactor` (`mass_kg`, `g_m`,
-    `k_H_N_per_m1p5`; None without impactor) and `D1` (damping ratio of mode 1)."""
+    `k_H_N_per_m1p5`, `contact_law`, `r_cont`; None without impactor) and `D1` (damping ratio of mode 1)."""
     return {"model": model.source, "D1": float(model.damping_ratios[0]),
             "impactor": None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
-                                                       "k_H_N_per_m1p5": impactor.k_H}}
+                                                       "k_H_N_per_m1p5": impactor.k_H,
+                                                       "contact_law": impactor.contact_law.name,
+                                                       "r_cont": impactor.contact_law.r_cont}}
 
 
 def build_protocol(args: argparse.Namespace) -> Any:

@@ -113,6 +113,25 @@ def plot_overview(data: Mapping[str, Any], path: str | os.PathLike, title: str, 
         ax.legend(fontsize=7, loc="upper left")  # the low SMR levels leave that corner free
 
 
+def plot_series(series: Sequence[tuple[str, Mapping[str, Any]]], path: str | os.PathLike, title: str) -> None:
+    """Fig. 11: the resonant mean level against the excitation level, one curve per value of a series (`series`:
+    [(label, `sim.tables.overview_data` keys)]), each with the range of its runs as error bars."""
+    import numpy as np
+
+    with plot_to(path, figsize=(6.5, 4.4)) as (fig, ax):
+        for label, data in series:
+            levels = np.asarray(data["levels"], dtype=float)
+            value = np.asarray(data["resonant_mean"], dtype=float)
+            spread = [value - np.asarray(data["resonant_mean_lo"], dtype=float),
+                      np.asarray(data["resonant_mean_hi"], dtype=float) - value]
+            ax.errorbar(levels, value, yerr=spread, fmt="o-", ms=3, capsize=2, lw=1.2, label=label)
+        ax.axvline(7.5, color="k", lw=1, ls="-.", alpha=0.6, label="paper: contact dissipation matters above 7.5")
+        ax.set_xlabel("excitation level a_base / a_base*")
+        ax.set_ylabel("resonant mean a / a_noabs*")
+        ax.set_title(title, fontsize=8)
+        ax.legend(fontsize=7, loc="upper left")
+
+
 def plot_scattering(overview: Mapping[str, Any], runs: Sequence[Mapping[str, Any]], path: str | os.PathLike,
                     title: str, figure: str) -> None:
     """Fig. D.2 ("figD2": all and significant impacts per excitation period) or Fig. D.3 ("figD3": the modal

@@ -97,6 +97,24 @@ def scattering_text(data: dict[str, list]) -> str:
     return "\n".join(lines)
 
 
+def series_text(series: list[tuple[str, dict[str, list]]]) -> str:
+    """Fig. 11's table: per level, the resonant mean of each value of the series, and the shares of the input
+    dissipated in the contact, mode 1 and modes 2..N at the resonant eta (Sect. 5.5) for each value."""
+    head = f"{'level':>7} " + " ".join(f"{label:>24}" for label, _ in series)
+    lines = [head, f"{'':>7} " + " ".join(f"{'mean  contact/D_1/D_2..N':>24}" for _ in series)]
+    for i, level in enumerate(series[0][1]["levels"]):
+        cells = []
+        for _, data in series:
+            at = data["levels"].index(level) if level in data["levels"] else None
+            if at is None:
+                cells.append(f"{'-':>24}")
+                continue
+            cells.append(f"{data['resonant_mean'][at]:6.3f} {100 * data['dissipation_contact'][at]:5.1f}/"
+                         f"{100 * data['dissipation_fundamental'][at]:4.1f}/{100 * data['dissipation_higher_modes'][at]:4.1f}%")
+        lines.append(f"{level:7.3f} " + " ".join(f"{c:>24}" for c in cells))
+    return "\n".join(lines)
+
+
 def optimum_line(data: dict[str, list]) -> str:
     """Where the resonant mean level is lowest (the optimum, Sect. 5.3) and the reductions there, 1 / level (the
     levels are normalised by the linear resonant amplitude a_noabs* at the same excitation)."""

@@ -338,3 +338,19 @@ def test_bad_trace_options_create_nothing(tmp_path, model_file, capsys, monkeypa
     base = ["trace", "--level", "6", "--eta", "0.99", "--wait", "0.02", "--model", model_file, "--out", "res"]
     refused(capsys, main([*base, *args, "--plot", "trace.png"]), phrase)
     assert [p.name for p in files_in(tmp_path)] == ["three.toml"]
+
+
+# ---- the damped contact law (Eq. 10) ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("args, phrase", [
+    (["--r-cont", "1.2"], "r_cont must lie in (0, 1]"),
+    (["--r-cont", "0"], "r_cont must lie in (0, 1]"),
+    (["--contact-law", "hertz", "--r-cont", "0.9"], "needs the contact law 'hertz-damped'"),
+    (["--r-cont", "0.9"], "has no 'beam_mass_kg'"),  # the three-mode file has no beam mass
+])
+@pytest.mark.parametrize("command", [["sweep", "--level", "6", *FAST], ["overview", "--levels", "5,6", *FAST],
+                                     ["trace", "--level", "6", "--eta", "0.98", "--periods", "2"]])
+def test_bad_contact_law_options_create_nothing(tmp_path, model_file, capsys, monkeypatch, command, args, phrase):
+    monkeypatch.chdir(tmp_path)
+    refused(capsys, main([*command, "--model", model_file, "--out", "res", *args]), phrase)
+    assert [p.name for p in files_in(tmp_path)] == ["three.toml"]

@@ -43,6 +43,8 @@ REPRODUCE_HELP = ("reproduce the paper's Figs. 5 and 6 (nominal response), 7 and
 PLOT_HELP = "redraw a result folder's figures from its saved data (formats, style, levels) without recomputing"
 #: the paper's figures that `ies reproduce` runs, in the order of `all`
 FIGURES = ("fig5", "fig6", "fig7", "fig8", "figD2", "figD3")
+#: figures `ies reproduce` runs when named, not in `all` (Fig. 11: five contact laws, minutes even when quick)
+EXTRA_FIGURES = ("fig11",)
 
 
 def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
@@ -180,6 +182,14 @@ def print_response_result(folder: Path, name: str) -> None:
     from sim.variants import switch_line
 
     data = json.loads((folder / "study.json").read_text())
+    if "series_folders" in data:
+        from uq.figures import series_overviews
+        from sim.tables import series_text
+
+        print(f"{name}: resonant mean (a / a_noabs*) and the input's dissipation shares at the resonant eta "
+              f"(contact / mode 1 / modes 2..N) for each value:")
+        print(series_text(series_overviews(folder)))
+        return
     overview = data["overview"]
     if name in ("figD2", "figD3"):
         print(f"{name}: impacts, restitution and energy scattering at the resonant eta of the nominal point:")
@@ -196,10 +206,10 @@ def print_response_result(folder: Path, name: str) -> None:
 
 def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies reproduce`."""
-    parser.add_argument("figure", choices=(*FIGURES, "all"),
+    parser.add_argument("figure", choices=(*FIGURES, *EXTRA_FIGURES, "all"),
                         help="which figure(s): fig5 (frequency responses), fig6 (resonant level vs excitation level), "
                              "fig7 and fig8 (uncertainty of D, g, k_H), figD2 and figD3 (impacts per period and "
-                             "restitution vs excitation level), all")
+                             "restitution vs excitation level), fig11 (damped contact law, Eq. 10; not in all), all")
     parser.add_argument("--quick", action="store_true",
                         help="reduced protocol (fewer levels, frequencies, repetitions, shorter holds); same trends")
     parser.add_argument("--out", type=Path, default=Path("ies-out/reproduce"), metavar="DIR",

@@ -315,6 +315,9 @@ def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     from sim.tables import OVERVIEW_COLUMNS, SWEEP_COLUMNS, overview_data, overview_rows, sweep_rows
     from sim.variants import landmarks
 
+    if study.series:
+        return _run_response_series(study, out=out, jobs=jobs, scheduler=scheduler, resume=resume, progress=progress,
+                                    client=client)
     model = _checked_model(study)
     point = study.space.nominal()
     model, result, results, ran, elapsed = _run_points(study, model, [point], out, resume, jobs, scheduler, progress,
@@ -345,4 +348,25 @@ def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
                       "wall_time_s": elapsed, "points": 1}
     result.files.append(_metadata(study, model, result, {"summary": result.summary, "overview": overview,
                                                          "landmarks": landmarks(sweeps).summary()}))
+    return result
+
+
+def _run_response_series(study: Study, *, out: Path | None, jobs: int, scheduler: str | None, resume: bool,
+                         progress: bool, client: Any) -> StudyResult:
+    """[response] series (Fig. 11): the response study once per value of the series' parameter, each in its own
+    folder OUT/NAME=VALUE (resumable like any study), and OUT/study.json naming them."""
+    folder = Path(out) if out is not None else study.output
+    result = StudyResult(folder)
+    totals = {"tasks": 0, "ran": 0, "reused": 0, "failed_runs": 0, "wall_time_s": 0.0, "points": 0}
+    parts = []
+    for sub, one in study.series_studies():
+        part = run_response_study(one, out=folder / sub, jobs=jobs, scheduler=scheduler, resume=resume,
+                                  progress=progress, client=client)
+        result.files += part.files
+        result.warnings += part.warnings
+        for key in totals:
+            totals[key] += part.summary[key]
+        parts.append(sub)
+    result.summary = totals
+    result.files.append(_metadata(study, study.make_model(), result, {"summary": totals, "series_folders": parts}))
     return result

@@ -279,6 +279,8 @@ def response_figures(folder: str | Path, options: PlotOptions | None = None) -> 
     folder = Path(folder)
     options = options or PlotOptions()
     meta = _study(folder)
+    if "series_folders" in meta:
+        return _series_figure(folder, meta, options)
     overview = _overview_of(_rows(folder / "overview.csv", options))
     selected([float(r["level"]) for r in _rows(folder / "overview.csv")], options, folder)
     protocol = meta["study"]["protocol_resolved"]
@@ -310,6 +312,26 @@ def response_figures(folder: str | Path, options: PlotOptions | None = None) -> 
         for path in options.paths(folder, "fig6"):
             plot_overview(overview, path, f"Resonant level vs excitation level (cf. Fig. 6), nominal parameters, {runs}",
                           paper_optimum=True)
+    return paths
+
+
+def series_overviews(folder: Path, options: PlotOptions | None = None) -> list[tuple[str, dict[str, list]]]:
+    """[(NAME=VALUE, overview)] of a series response study (Fig. 11), from each value's overview.csv."""
+    meta = _study(folder)
+    return [(sub, _overview_of(_rows(folder / sub / "overview.csv", options))) for sub in meta["series_folders"]]
+
+
+def _series_figure(folder: Path, meta: dict, options: PlotOptions) -> list[Path]:
+    """Fig. 11: the resonant mean against the excitation level for each value of the series."""
+    from sim.figures import plot_series
+
+    protocol = meta["study"]["protocol_resolved"]
+    name = next(iter(meta["study"]["series"]))
+    runs = f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold"
+    paths = options.paths(folder, "fig11")
+    for path in paths:
+        plot_series(series_overviews(folder, options), path,
+                    f"Resonant mean for each {name} (cf. Fig. 11), contact law {meta['study']['contact_law']}, {runs}")
     return paths
 
 

@@ -72,14 +72,25 @@ class IESModel:
     variant: Mapping[str, float] = field(default_factory=dict)
     rig: Any = field(default=None, compare=False, repr=False)
     banded_outputs: tuple[str, ...] = ("mean", "max")
+    contact_law: str = "hertz"
 
     parameters = ("D", "g", "k_H")
+    #: parameters a study may add to Table 2's (they enter a task's point, and so its key, only when listed):
+    #: r_cont,diss of the damped contact law (Eq. 10; listing it implies contact_law = "hertz-damped")
+    optional_parameters = ("r_cont",)
     #: the resonant levels, the regime (1 = APR) and the scattering measures of `sim.measures` at the resonant
     #: mean's eta (Sect. 5.5, Appendix D)
     outputs = ("mean", "max", "apr", *SCATTERING_MEASURES)
 
     def default_space(self) -> ParameterSpace:
         return table2_space()
+
+    def optional_parameter(self, name: str) -> Parameter:
+        """The default of an optional parameter (`optional_parameters`), before the study's table fills it in."""
+        from sim.contact_law import DEFAULT_R_CONT
+
+        return Parameter("r_cont", DEFAULT_R_CONT, DEFAULT_R_CONT, DEFAULT_R_CONT, "-",
+                         "r_cont,diss of the damped contact law (Eq. 10)")
 
     def version(self) -> str:
         return _source_version("sim", "uq/models.py")
@@ -109,7 +120,14 @@ class IESModel:
             get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
         except SimulationInputError as exc:
             raise StudyError(f"[excitation]: {exc}") from None
-        self._rig()
+        rig = self._rig()
+        if self.contact_law != "hertz":
+            from sim.system import damping_factor
+
+            try:  # the damped law needs the model's beam mass (Eq. 10)
+                damping_factor(rig, self._impactor({"g": 1e-3, "k_H": 1e9, "r_cont": 0.5}))
+            except SimulationInputError as exc:
+                raise StudyError(f"[study] contact_law = \"{self.contact_law}\": {exc}") from None
 
     def _rig(self):
         from sim.errors import SimulationInputError
@@ -128,11 +146,15 @@ class IESModel:
         return rig
 
     def _impactor(self, params: Mapping[str, float]):
-        """The sphere of Eqs. 3-6 with this run's g and k_H, its mass scaled by [variant] sphere_mass_factor."""
+        """The sphere of Eqs. 3-6 with this run's g and k_H, its mass scaled by [variant] sphere_mass_factor, and the
+        study's contact law (Eq. 10 with this run's r_cont when damped)."""
+        from sim.contact_law import DEFAULT_R_CONT, ContactLaw
         from sim.system import SPHERE_MASS, Impactor
 
         mass = SPHERE_MASS * self.variant.get("sphere_mass_factor", 1.0)
-        return Impactor(mass=mass, clearance=params["g"], k_H=params["k_H"])
+        law = (ContactLaw(self.contact_law, params.get("r_cont", DEFAULT_R_CONT)) if self.contact_law != "hertz"
+               else ContactLaw())
+        return Impactor(mass=mass, clearance=params["g"], k_H=params["k_H"], contact_law=law)
 
     def warm_up(self) -> None:
         """Compile the integrator's kernels in this process (`sim.integrators.warm_up`; minutes on a first run)."""
@@ -148,6 +170,8 @@ class IESModel:
         """Settings that define a task's computation (part of its cache key; the built-in rig is covered by
         version, a modal file by its content)."""
         out = {"class": type(self).__name__, "protocol": dict(self.protocol), "n_modes": self.n_modes}
+        if self.contact_law != "hertz":
+            out["contact_law"] = self.contact_law
         if self.variant:
             out["variant"] = dict(self.variant)
         if self.modal_file is not None:
@@ -311,16 +335,20 @@ class FunctionModel:
 
 def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, parameters: tuple[str, ...] = (),
                modal_model: str | Path | None = None, variant: Mapping[str, float] | None = None,
-               outputs: tuple[str, ...] = ()) -> Any:
+               outputs: tuple[str, ...] = (), contact_law: str = "hertz") -> Any:
     """The model named by a study's ``model`` key ("ies", "ishigami" or "module:function"); modal_model: a
     modal-model file replacing the built-in rig of "ies"; variant: the [variant] table of "ies"; outputs: the
-    outputs of "ies" whose bands and indices the study computes (default: the resonant mean and max)."""
+    outputs of "ies" whose bands and indices the study computes (default: the resonant mean and max);
+    contact_law: the normal contact law of "ies" ("hertz", Eq. 4, or "hertz-damped", Eq. 10)."""
     if spec == "ies":
         unknown = [name for name in outputs if name not in IESModel.outputs]
         if unknown:
             raise StudyError(f"[study] unknown output(s) {', '.join(unknown)}; known: {', '.join(IESModel.outputs)}")
         return IESModel(dict(protocol or {}), modal_file=None if modal_model is None else str(modal_model),
-                        variant=dict(variant or {}), **({"banded_outputs": tuple(outputs)} if outputs else {}))
+                        variant=dict(variant or {}), **({"banded_outputs": tuple(outputs)} if outputs else {}),
+                        contact_law=contact_law)
+    if contact_law != "hertz":
+        raise StudyError("[study] contact_law only applies to model = \"ies\" (the simulator)")
     if outputs:
         raise StudyError("[study] outputs only applies to model = \"ies\" (the simulator)")
     if spec == "ishigami":

@@ -14,6 +14,8 @@ Layout (every table and key is optional except where noted; SI units)::
     outputs = ["mean", "max"]    # model "ies": the outputs the bands / indices are computed for (default
                                  # mean, max; also "restitution", "significant_impacts_per_period", ... of
                                  # sim.measures.SCATTERING_MEASURES, at the resonant mean's eta)
+    contact_law = "hertz"        # model "ies": "hertz" (Eq. 4) or "hertz-damped" (Eq. 10, r_cont,diss from
+                                 # [parameters.r_cont], default 0.99; a table there implies "hertz-damped")
 
     [variant]                    # optional, model "ies": modelling choices the paper leaves open (README,
     sphere_mass_factor = 1.537   # "Fidelity"): the sphere's effective mass in x over m_a (rolling: 1.4 on a
@@ -26,6 +28,8 @@ Layout (every table and key is optional except where noted; SI units)::
     [parameters.k_H]             # N/m^1.5, or "1.52 k_H*", or "calibrated:calib.json"
     max = "1.52 k_H*"
     best_estimate = "1.25 k_H*"  # the value k_H is fixed at in the residual band (Fig. 8)
+    [parameters.r_cont]          # model "ies", optional: r_cont,diss of Eq. 10 in (0, 1] (fixed: nominal only)
+    nominal = 0.99
 
     [excitation]                 # passed to the stepped-sine protocol (sim.protocol.SteppedSine)
     levels = [5.3, 6.7, 7.4]     # a_base / a_base* (Sect. 5.3; nominal D*, g*)
@@ -52,7 +56,10 @@ Layout (every table and key is optional except where noted; SI units)::
 
     [response]                   # kind "response": the frequency responses and resonant levels of the nominal
     figures = ["fig5", "fig6"]   # point (the parameters' nominal values) at every level, as Figs. 5 and 6, and
-                                 # "figD2", "figD3": impacts per period and r at the resonant eta (Appendix D)
+                                 # "figD2", "figD3": impacts per period and r at the resonant eta (Appendix D),
+                                 # "fig11": the resonant mean of each value of `series` (Sect. 5.5)
+    series = { r_cont = [1.0, 0.99, 0.9] }   # optional: the whole study once per value of one listed
+                                 # parameter (a response study each, in OUT/NAME=VALUE), as Fig. 11
 
 Unknown tables or keys, unknown parameters, min > max, non-positive bounds and the like are refused with
 a `StudyError` whose one line names the file, the key and the fix.
@@ -72,17 +79,17 @@ from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_
 
 KINDS = ("interval", "sobol", "response")
 #: the figures a response study draws (Figs. 5 and 6 of the seed paper)
-RESPONSE_FIGURES = ("fig5", "fig6", "figD2", "figD3")
+RESPONSE_FIGURES = ("fig5", "fig6", "figD2", "figD3", "fig11")
 DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
-    "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output", "outputs"},
+    "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output", "outputs", "contact_law"},
     "variant": {"sphere_mass_factor", "higher_mode_damping"},
     "parameters": None,  # one sub-table per parameter
     "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "perturb", "repetition",
                    "start", "dt_scale"},
     "interval": {"designs", "interior", "z", "fix"},
     "sobol": {"n", "bootstrap", "confidence"},
-    "response": {"figures"},
+    "response": {"figures", "series"},
 }
 _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
 
@@ -112,10 +119,13 @@ class Study:
     figures: tuple[str, ...] = RESPONSE_FIGURES
     variant: Mapping[str, float] = field(default_factory=dict)
     outputs: tuple[str, ...] = ()
+    contact_law: str = "hertz"
+    series: tuple[str, tuple[float, ...]] | None = None
 
     def make_model(self) -> Any:
         return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
-                          modal_model=self.modal_model, variant=self.variant, outputs=self.outputs)
+                          modal_model=self.modal_model, variant=self.variant, outputs=self.outputs,
+                          contact_law=self.contact_law)
 
     def to_dict(self) -> dict:
         """The resolved study as plain data (written to the results' metadata)."""
@@ -127,8 +137,23 @@ class Study:
             "interval": {"designs": list(self.designs), "interior": self.interior, "z": self.z, "fix": dict(self.fix)},
             "sobol": {"n": self.sobol_n, "bootstrap": self.bootstrap, "confidence": self.confidence},
             "response": {"figures": list(self.figures)}, "variant": dict(self.variant),
-            "outputs": list(self.outputs),
+            "outputs": list(self.outputs), "contact_law": self.contact_law,
+            **({"series": {self.series[0]: list(self.series[1])}} if self.series else {}),
         }
+
+    def series_studies(self) -> list[tuple[str, "Study"]]:
+        """[(folder name NAME=VALUE, the study with that parameter fixed at VALUE)] of [response] series; [] without."""
+        if not self.series:
+            return []
+        from dataclasses import replace
+
+        name, values = self.series
+        out = []
+        for value in values:
+            params = tuple(p.fixed_at(value) if p.name == name else p for p in self.space.parameters)
+            space = ParameterSpace(params, self.space.extras)
+            out.append((f"{name}={value:g}", replace(self, space=space, series=None, name=f"{self.name} {name}={value:g}")))
+        return out
 
 
 def load_study(path: str | Path) -> Study:
@@ -244,12 +269,54 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
     outputs = head.get("outputs", [])
     if not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs) or len(set(outputs)) != len(outputs):
         raise StudyError(f"[study] outputs must be a list of distinct output names, e.g. [\"mean\", \"restitution\"], got {outputs!r}")
+    contact_law = _parse_contact_law(head, space)
+    series = _parse_series(data.get("response", {}).get("series"), kind, space)
     study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
-                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures), variant, tuple(outputs))
+                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures), variant, tuple(outputs),
+                  contact_law, series)
+    for _, one in study.series_studies():
+        _parse_contact_law({"contact_law": contact_law}, one.space)  # every value in range
     model = study.make_model()  # unknown model -> one line now
-    if modal_model is not None or variant:
+    if modal_model is not None or variant or contact_law != "hertz":
         model.check()  # an unreadable modal file -> one line now
     return study
+
+
+def _parse_series(table: Any, kind: str, space: ParameterSpace) -> tuple[str, tuple[float, ...]] | None:
+    """[response] series = { NAME = [values] }: one listed parameter and its distinct values (kind "response")."""
+    if table is None:
+        return None
+    if kind != "response":
+        raise StudyError("[response] series only applies to kind = \"response\"")
+    if not isinstance(table, Mapping) or len(table) != 1:
+        raise StudyError(f"[response] series must name one parameter and its values, e.g. series = {{ r_cont = [1.0, 0.99] }}, "
+                         f"got {table!r}")
+    (name, values), = table.items()
+    if name not in space.names:
+        raise StudyError(f"[response] series: '{name}' is not a parameter of the study; list it as [parameters.{name}]")
+    if not isinstance(values, list) or not values or len(set(values)) != len(values):
+        raise StudyError(f"[response] series: {name} needs a list of distinct values, got {values!r}")
+    return name, tuple(float(_number("response", f"series.{name}", v)) for v in values)
+
+
+def _parse_contact_law(head: Mapping[str, Any], space: ParameterSpace) -> str:
+    """[study] contact_law (Eq. 4 "hertz" or Eq. 10 "hertz-damped"); [parameters.r_cont] implies the damped law,
+    and its values must lie in (0, 1]."""
+    from sim.contact_law import CONTACT_LAWS, ContactLaw
+    from sim.errors import SimulationInputError
+
+    listed = "r_cont" in space.names
+    law = head.get("contact_law", "hertz-damped" if listed else "hertz")
+    if law not in CONTACT_LAWS:
+        raise StudyError(f"[study] contact_law must be one of {', '.join(CONTACT_LAWS)}, got {law!r}")
+    if listed:
+        r = space["r_cont"]
+        for value in (r.min, r.nominal, r.max):
+            try:
+                ContactLaw(law, value)
+            except SimulationInputError as exc:
+                raise StudyError(f"[parameters.r_cont] {exc}") from None
+    return law
 
 
 def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir: Path, source: str) -> ParameterSpace:
@@ -269,19 +336,24 @@ def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir
         return ParameterSpace(tuple(params))
     if table is None:
         return default
+    optional = tuple(getattr(model, "optional_parameters", ()))
     for pname in table:
-        if pname not in default.names:
-            raise StudyError(f"unknown parameter '{pname}' for model '{model_spec}'; known: {', '.join(default.names)}")
+        if pname not in default.names and pname not in optional:
+            raise StudyError(f"unknown parameter '{pname}' for model '{model_spec}'; known: "
+                             f"{', '.join((*default.names, *optional))}")
     extras = dict(default.extras)
     params = []
-    for p in default.parameters:
+    listed_optional = [model.optional_parameter(name) for name in optional if name in table]
+    for p in (*default.parameters, *listed_optional):
         if p.name not in table:
             params.append(p.fixed_at(p.nominal))
             continue
         spec = _check_param_table(p.name, table[p.name])
         values = {}
         for key in ("nominal", "min", "max"):
-            values[key] = resolve_value(p.name, spec.get(key, getattr(p, key)), base_dir=base_dir)
+            # an optional parameter's missing bound is its nominal value (a fixed value needs nominal only)
+            fallback = spec.get("nominal", p.nominal) if p in listed_optional else getattr(p, key)
+            values[key] = resolve_value(p.name, spec.get(key, fallback), base_dir=base_dir)
             _warn_implausible(source, f"[parameters.{p.name}] {key}", p.name, values[key])
         if "best_estimate" in spec:
             if p.name != "k_H":
