@@ -1,16 +1,21 @@
-"""A worker process for same-run A/B timings of one stepped-sine point (tests/benchmarks/test_energy_speed.py):
-imports `sim` from the tree given on the command line, prepares the start state, then answers every line
-"run" on stdin with the CPU seconds of one point (3 s wait + 5 s hold at a_base/a_base* = 7.4), with the
-energy bookkeeping and impact measures where the tree has them (`sim.energy.Ledger`)."""
+"""A worker process for same-run A/B timings of one stepped-sine point (tests/benchmarks/test_energy_speed.py,
+test_contact_law_speed.py): imports `sim` from the tree given on the command line, prepares the start state, then
+answers every line "run" on stdin with the CPU seconds of one point (3 s wait + 5 s hold at a_base/a_base* = 7.4),
+with the energy bookkeeping and impact measures where the tree has them (`sim.energy.Ledger`).
+
+Arguments: TREE ETA PREPARE [INTEGRATOR [R_CONT]]: PREPARE "-" starts from the base velocity, else a down-sweep
+from that eta; INTEGRATOR exact (default) or ode3; R_CONT < 1: the damped contact law of Eq. 10."""
 import sys
 import time
 
 sys.path.insert(0, sys.argv[1])
 ETA, PREPARE = float(sys.argv[2]), (float(sys.argv[3]) if sys.argv[3] != "-" else None)
+INTEGRATOR = sys.argv[4] if len(sys.argv) > 4 else "exact"
+R_CONT = float(sys.argv[5]) if len(sys.argv) > 5 else 1.0
 
 import numpy as np  # noqa: E402
 
-from sim import exact  # noqa: E402
+from sim import exact, ode3  # noqa: E402
 from sim.rig import seed_rig_model  # noqa: E402
 from sim.system import Impactor, a_base_star, a_noabs_star, system_arrays  # noqa: E402
 
@@ -25,7 +30,13 @@ except ImportError:
 
 LEVEL = 7.4
 model = seed_rig_model(n_modes=9)
-sys_ = system_arrays(model, Impactor())
+if R_CONT < 1.0:
+    from sim.contact_law import ContactLaw
+
+    sys_ = system_arrays(model, Impactor(contact_law=ContactLaw("hertz-damped", R_CONT)))
+else:
+    sys_ = system_arrays(model, Impactor())
+integrator = {"exact": exact, "ode3": ode3}[INTEGRATOR]
 a_base = LEVEL * a_base_star(model)
 y0 = np.zeros(2 * model.n_modes + 2)
 if PREPARE is None:
@@ -33,7 +44,7 @@ if PREPARE is None:
 else:
     for e in np.arange(PREPARE, ETA + 1e-9, -0.004):
         Om = e * model.omega[0]
-        exact.run_step(y0, int(round(8.0 * Om / (2 * np.pi))), Om, a_base, sys_)
+        integrator.run_step(y0, int(round(8.0 * Om / (2 * np.pi))), Om, a_base, sys_)
 
 
 def one_point() -> float:
@@ -42,12 +53,12 @@ def one_point() -> float:
     n_wait, n_hold = int(round(3.0 * periods)), int(round(5.0 * periods))
     y = y0.copy()
     started = time.thread_time()
-    exact.run_step(y, n_wait, Omega, a_base, sys_, None)
+    integrator.run_step(y, n_wait, Omega, a_base, sys_, None)
     if Ledger is None:
-        exact.run_step(y, n_hold, Omega, a_base, sys_, None)
+        integrator.run_step(y, n_hold, Omega, a_base, sys_, None)
     else:
         ledger = Ledger()
-        amplitudes, impacts = exact.run_step(y, n_hold, Omega, a_base, sys_, None, ledger=ledger)
+        amplitudes, impacts = integrator.run_step(y, n_hold, Omega, a_base, sys_, None, ledger=ledger)
         if point_measures is not None:
             point_measures(amplitudes, impacts, a_noabs_star(model, a_base), ledger)
     return time.thread_time() - started

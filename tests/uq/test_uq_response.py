@@ -94,3 +94,43 @@ def test_regime_labels_come_from_the_simulator(tmp_path, capsys):
     assert regimes == {float(r["level"]): r["regime"] for r in overview}  # the same runs, the same label
     assert set(regimes.values()) <= {"APR", "SMR", "linear"}
     assert np.isfinite([float(r["resonant_mean_se"]) for r in overview]).all()
+
+
+DAMPED = ("[study]\nkind = 'response'\nseed = 3\nrepetitions = 1\ncontact_law = 'hertz-damped'\n"
+          "[parameters.r_cont]\nnominal = 0.9\n[excitation]\nlevels = [6.7]\n"
+          "eta = { start = 0.98, stop = 0.985, n = 2 }\nwait = 0.1\nhold = 0.1\n[response]\nfigures = ['fig11']\n"
+          "series = { r_cont = [1.0, 0.9] }\n")
+
+
+def test_a_series_of_contact_laws_gives_what_ies_overview_gives(tmp_path, capsys):
+    """Fig. 11's study: one response study per r_cont (OUT/r_cont=VALUE), each the numbers of `ies overview --r-cont`,
+    the figure and the table of resonant means and dissipation shares."""
+    study = tmp_path / "fig11.toml"
+    study.write_text(DAMPED)
+    assert main(["response", str(study), "--out", str(tmp_path / "series"), "--quiet", "--jobs", "1"]) == 0
+    printed = capsys.readouterr().out
+    assert "contact / mode 1 / modes 2..N" in printed and "r_cont=0.9" in printed
+    assert (tmp_path / "series" / "fig11.png").is_file()
+    for r_cont in ("1", "0.9"):
+        assert main(["overview", "--levels", "6.7", "--eta", "0.98:0.985:2", "--wait", "0.1", "--hold", "0.1",
+                     "--reps", "1", "--seed", "3", "--r-cont", r_cont, "--out", str(tmp_path / f"o{r_cont}")]) == 0
+        got = rows(tmp_path / "series" / f"r_cont={r_cont}" / "overview.csv")
+        direct = rows(tmp_path / f"o{r_cont}" / "overview.csv")
+        assert got[0]["resonant_mean"] == direct[0]["resonant_mean"]
+        contact = float(got[0]["dissipation_contact"])
+        assert contact == 0.0 if r_cont == "1" else contact > 0.01
+    tasks = json.loads(next((tmp_path / "series" / "r_cont=0.9" / "tasks").glob("*.json")).read_text())
+    assert "r_cont" in json.dumps(tasks)
+
+
+@pytest.mark.parametrize("extra, phrase", [
+    ("[parameters.r_cont]\nnominal = 1.2\n", "r_cont must lie in (0, 1]"),
+    ("[study2]\n", "unknown table"),
+    ("[response]\nseries = { mass = [0.02] }\n", "'mass' is not a parameter of the study"),
+])
+def test_bad_contact_law_study_is_one_line(tmp_path, capsys, extra, phrase):
+    path = tmp_path / "bad.toml"
+    path.write_text(TINY.format(extra=extra).replace("[study]\n", "[study]\ncontact_law = 'hertz-damped'\n", 1))
+    assert main(["response", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert phrase in err and len(err.strip().splitlines()) == 1 and not (tmp_path / "o").exists()
