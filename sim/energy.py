@@ -35,8 +35,14 @@ def energy_parts(states: np.ndarray, sys: SystemArrays) -> dict[str, np.ndarray]
 def stored_energy(y: np.ndarray, sys: SystemArrays) -> float:
     """The stored mechanical energy E (J) of the state y = [s, s', u_a, u_a'] in the frame moving with the base
     (Eq. 2): modes, sphere and Hertz potential (`energy_parts`); its rate is the base excitation's power minus
-    the modal damping (and contact damping) dissipation (Sect. 5.5)."""
-    return float(energy_parts(y, sys)["total"][0])
+    the modal damping (and contact damping) dissipation (Sect. 5.5); with friction the Jenkins spring's energy
+    (Appendix C) is included."""
+    total = float(energy_parts(y, sys)["total"][0])
+    if sys.slip_force > 0:  # the friction spring's k_t w^2 / 2 (Appendix C), w = u_a - phi_f^T s - z
+        n = sys.omega.size
+        w = float(y[2 * n] - sys.phi_f @ y[:n] - sys.slider[0])
+        total += 0.5 * sys.k_t * w * w
+    return total
 
 
 #: One impact (onset to release) of a run_step call (Appendix D, Sect. 5.5): the fields of
@@ -99,6 +105,11 @@ class Ledger:
         return self.periods[:, LEDGER.contact]
 
     @property
+    def friction(self) -> np.ndarray:
+        """Energy dissipated by dry friction at the cavity floor per period (J; Appendix C, zero without)."""
+        return self.periods[:, LEDGER.friction]
+
+    @property
     def dissipation(self) -> np.ndarray:
         """Energy dissipated by each mode's modal damping per period, (n_periods, n_modes) (J)."""
         return self.periods[:, LEDGER.modes:]
@@ -127,7 +138,7 @@ class Ledger:
     def balance_error(self) -> float:
         """(input - dissipated - (E_end - E_start)) / input over the call (-)."""
         total_in = float(self.input.sum())
-        residual = total_in - float(self.dissipation.sum()) - float(self.contact.sum()) - (
+        residual = total_in - float(self.dissipation.sum()) - float(self.contact.sum()) - float(self.friction.sum()) - (
             self.stored_end - self.stored_start)
         return residual / total_in if total_in != 0.0 else math.nan
 

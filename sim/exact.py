@@ -748,6 +748,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     rtol = float(rtol)
     if not math.isfinite(rtol) or not 0.0 < rtol < 1e-2:
         raise SimulationInputError(f"rtol must lie in (0, 0.01), got {rtol!r}")
+    if sys.slip_force > 0:
+        raise SimulationInputError("dry friction (Appendix C) is in the ode3 integrator only; use --integrator ode3")
     if contacts not in ("collocation", "dopri5"):
         raise SimulationInputError(f"contacts must be 'collocation' or 'dopri5', got {contacts!r}")
     if not (sys.m_a > 0 and sys.k_H >= 0 and sys.g > 0):

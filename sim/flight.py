@@ -167,12 +167,14 @@ class Output(NamedTuple):
 
 class LedgerColumns(NamedTuple):
     """Columns of a period's row of `Output.ledger` (Sect. 5.5; `sim.energy`): the work of the base excitation
-    `input` (J), the dissipation in the contacts `contact` (J), the complex fundamental Fourier coefficients
+    `input` (J), the dissipation in the contacts `contact` and by dry friction `friction` (J, Appendix C; ode3
+    only), the complex fundamental Fourier coefficients
     c_1 = (2/T) int_T q e^{-i Omega t} dt (m) of the tip and of both walls (relative to the base), and from
     column `modes` on the dissipation of each mode's modal damping int 2 D_j omega_j s_j'^2 dt (J)."""
 
     input: int
     contact: int
+    friction: int
     tip_re: int
     tip_im: int
     left_re: int

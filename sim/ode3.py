@@ -21,10 +21,20 @@ Per period the kernel returns |c_1| of q_tip = phi_tip^T s, c_1 = (2/T) int_T q_
 trapezoidal rule on the step points, and the number of contact onsets (open -> closed at either wall,
 checked at the step points).
 
+Dry friction (Appendix C, `sim.friction`): the Jenkins element between the sphere and the cavity floor, with the
+sphere's displacement relative to the floor u = u_a - phi_f^T s and the slider at z: in stick the force on the
+sphere is -k_t (u - z), in slip of sense sigma it is -sigma mu N (z follows u at u - sigma mu N / k_t). Stick and
+slip are separate phases; a step whose end lies beyond its phase's boundary (|k_t (u - z)| > mu N in stick, a
+reversal of u' in slip) is cut at the transition, located by Illinois false position on the length of a
+Bogacki-Shampine step from the step's start (to 1e-13 of the step), and continued in the new phase: the force is
+continuous there and the scheme keeps its order. The slider state is `SystemArrays.slider`, carried from call to
+call like y.
+
 Energy bookkeeping (Sect. 5.5, `sim.energy.Ledger`) by the scheme's own quadrature: the work of the base
 excitation a_base Omega^2 cos(Omega t) (gamma^T s' + m_a u_a') and each mode's dissipation 2 D_j omega_j s_j'^2
 are integrated like extra components of the state (the Bogacki-Shampine weights on the stage values), as is
-the damped law's dissipation c_damp delta^0.25 delta'^2 (Eq. 10, in approach), and
+the damped law's dissipation c_damp delta^0.25 delta'^2 (Eq. 10, in approach), the slider's mu N |u'| of
+dry friction, and
 the Fourier coefficients of tip and walls by the trapezoidal rule. Its energy balance closes only to the
 scheme's truncation error (third order in h). ode3 keeps no impact records.
 """
@@ -83,6 +93,9 @@ def check_stability(sys: SystemArrays, h: float) -> None:
         delta = STABILITY_INDENTATION_FRACTION * sys.g
         w_contact = math.sqrt(1.5 * sys.k_H * math.sqrt(delta) / sys.m_a)
         candidates.append((w_contact, 0.0, f"the Hertz contact ({w_contact / (2 * math.pi):.6g} Hz at delta = {delta:.3g} m)"))
+    if sys.slip_force > 0:  # the sphere stuck to the floor by the Jenkins spring (Appendix C)
+        w_stick = math.sqrt(sys.k_t / sys.m_a)
+        candidates.append((w_stick, 0.0, f"the friction spring k_t ({w_stick / (2 * math.pi):.6g} Hz)"))
     for w, d, label in candidates:
         z = h * w * complex(-d, math.sqrt(max(0.0, 1.0 - d * d)))
         if stability_factor(z) > 1.0 + 1e-12:
@@ -123,6 +136,9 @@ class Coefficients(NamedTuple):
     k_H: float
     g: float
     c_damp: float
+    phi_f: np.ndarray
+    k_t: float
+    slip_force: float
 
 
 @kernel(inline="always", fastmath=_FAST)
@@ -147,9 +163,22 @@ def _approach_rate(y, phi, co, lay):
 
 
 @kernel(inline="always", fastmath=_FAST)
-def _deriv(y, cos_t, co, lay, out):
-    """Right-hand side of Eqs. 3-7 in relative coordinates (see module docstring); returns the power the
-    damped law of Eq. 10 dissipates in the contacts (W; 0 for the elastic law)."""
+def _floor_relative(y, co, lay):
+    """(u, u') of the sphere relative to the cavity floor, u = u_a - phi_f^T s (m, m/s; Appendix C)."""
+    u = y[lay.z]
+    ud = y[lay.zd]
+    for j in range(lay.n):
+        u -= co.phi_f[j] * y[lay.x + j]
+        ud -= co.phi_f[j] * y[lay.v + j]
+    return u, ud
+
+
+@kernel(inline="always", fastmath=_FAST)
+def _deriv(y, cos_t, co, lay, out, slider_z, sense):
+    """Right-hand side of Eqs. 3-7 in relative coordinates (see module docstring), with the friction force of the
+    slider at slider_z in phase `sense` (0 stick, +-1 slip) when co.slip_force > 0; returns the powers (W) the
+    damped law of Eq. 10 dissipates in the contacts and the slider dissipates (0, 0 for the elastic law without
+    friction)."""
     dl, dr = _indentations(y, co, lay)
     fl = co.k_H * dl * math.sqrt(dl) if dl > 0.0 else 0.0
     fr = -co.k_H * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
@@ -173,7 +202,18 @@ def _deriv(y, cos_t, co, lay, out):
                           + co.f_modal[j] * cos_t)
     out[lay.z] = y[lay.zd]
     out[lay.zd] = (fl + fr) / co.m_a + co.f_sphere * cos_t
-    return p_contact
+    p_friction = 0.0
+    if co.slip_force > 0.0:  # Appendix C: + f_t on the sphere, - phi_f,j f_t on the modes
+        u, ud = _floor_relative(y, co, lay)
+        if sense == 0.0:
+            ft = -co.k_t * (u - slider_z)
+        else:
+            ft = -sense * co.slip_force
+            p_friction = -ft * ud
+        out[lay.zd] += ft / co.m_a
+        for j in range(lay.n):
+            out[lay.v + j] -= co.phi_f[j] * ft
+    return p_contact, p_friction
 
 
 @kernel(inline="always", fastmath=_FAST)
@@ -186,16 +226,123 @@ def _tip(y, phi_tip, lay):
 
 
 @kernel(inline="always", fastmath=_FAST)
-def _book(y, cos_t, weight, p_contact, co, lay, ledger_row):
+def _book(y, cos_t, weight, powers, co, lay, ledger_row):
     """Add weight times the integrands of the energy bookkeeping at a stage (state y, cos(Omega t)) to the
-    period's ledger row: the base excitation's power, each mode's damping power and the contact's (W)."""
-    ledger_row[LEDGER.contact] += weight * p_contact
+    period's ledger row: the base excitation's power, each mode's damping power and the (contact, friction)
+    dissipation `powers` (W)."""
+    ledger_row[LEDGER.contact] += weight * powers[0]
+    ledger_row[LEDGER.friction] += weight * powers[1]
     p_in = co.m_a * y[lay.zd]
     for j in range(lay.n):
         v = y[lay.v + j]
         p_in += co.gamma[j] * v
         ledger_row[LEDGER.modes + j] += weight * co.c[j] * v * v
     ledger_row[LEDGER.input] += weight * co.f_sphere * cos_t * p_in
+
+
+@kernel(fastmath=_FAST)
+def _bs_step(y, t, L, Omega, co, lay, slider_z, sense, stages, row, book):
+    """One Bogacki-Shampine step of length L (s) from (t, y) with the slider in its phase: the state at t + L in
+    stages[3] (y unchanged); with `book` the bookkeeping's integrands into `row` (weights scaled to L)."""
+    k1, k2, k3, yt = stages[0], stages[1], stages[2], stages[4]
+    ny = lay.acc
+    c0 = math.cos(Omega * t)
+    c1 = math.cos(Omega * (t + 0.5 * L))
+    c2 = math.cos(Omega * (t + 0.75 * L))
+    pw = _deriv(y, c0, co, lay, k1, slider_z, sense)
+    if book:
+        _book(y, c0, L * 2.0 / 9.0, pw, co, lay, row)
+    for i in range(ny):
+        yt[i] = y[i] + 0.5 * L * k1[i]
+    pw = _deriv(yt, c1, co, lay, k2, slider_z, sense)
+    if book:
+        _book(yt, c1, L / 3.0, pw, co, lay, row)
+    for i in range(ny):
+        yt[i] = y[i] + 0.75 * L * k2[i]
+    pw = _deriv(yt, c2, co, lay, k3, slider_z, sense)
+    if book:
+        _book(yt, c2, L * 4.0 / 9.0, pw, co, lay, row)
+    end = stages[3]
+    for i in range(ny):
+        end[i] = y[i] + L * (2.0 / 9.0 * k1[i] + 1.0 / 3.0 * k2[i] + 4.0 / 9.0 * k3[i])
+
+
+@kernel(inline="always", fastmath=_FAST)
+def _phase_event(y, co, lay, slider_z, sense):
+    """The phase's boundary function, < 0 inside (Appendix C): in stick |k_t (u - z)| - mu N (N), in slip of sense
+    sigma -sigma u' (m/s)."""
+    u, ud = _floor_relative(y, co, lay)
+    if sense == 0.0:
+        return abs(co.k_t * (u - slider_z)) - co.slip_force
+    return -sense * ud
+
+
+#: at most this many stick/slip transitions are located within one ode3 step
+_MAX_TRANSITIONS_PER_STEP = 8
+
+
+@kernel(fastmath=_FAST)
+def _friction_step(y, t, h, Omega, co, lay, slider_z, sense, stages, row, trial_row):
+    """Advance y in place over one ode3 step (t, t + h) with dry friction (module docstring): sub-steps that end
+    on each located stick/slip transition, booked into `row` (`trial_row`: scratch of the same length). Returns the
+    slider's new (z, sense)."""
+    ny = lay.acc
+    end = stages[3]
+    left = h
+    located = 0
+    while True:
+        trial_row[:] = 0.0
+        _bs_step(y, t, left, Omega, co, lay, slider_z, sense, stages, trial_row, True)
+        if located == _MAX_TRANSITIONS_PER_STEP or _phase_event(end, co, lay, slider_z, sense) <= 0.0:
+            break  # the rest of the step in this phase
+        located += 1
+        # Illinois false position on the sub-step's length L: the event crosses 0 in (lo, hi]
+        lo, hi = 0.0, left
+        g_lo = min(_phase_event(y, co, lay, slider_z, sense), 0.0)
+        g_hi = _phase_event(end, co, lay, slider_z, sense)
+        side = 0
+        for _it in range(60):
+            if hi - lo <= 1e-13 * h:
+                break
+            L = (lo * g_hi - hi * g_lo) / (g_hi - g_lo)
+            if not lo < L < hi:
+                L = 0.5 * (lo + hi)
+            _bs_step(y, t, L, Omega, co, lay, slider_z, sense, stages, trial_row, False)
+            g = _phase_event(end, co, lay, slider_z, sense)
+            if g > 0.0:
+                hi, g_hi = L, g
+                if side == 1:
+                    g_lo *= 0.5
+                side = 1
+            else:
+                lo, g_lo = L, g
+                if side == -1:
+                    g_hi *= 0.5
+                side = -1
+        # the sub-step to the transition (its far side), booked; then the new phase from there
+        _bs_step(y, t, hi, Omega, co, lay, slider_z, sense, stages, row, True)
+        for i in range(ny):
+            y[i] = end[i]
+        u, _ = _floor_relative(y, co, lay)
+        w_s = co.slip_force / co.k_t
+        if sense == 0.0:  # stick -> slip in the sense of the spring's elongation, on the limit exactly
+            sense = 1.0 if u - slider_z > 0.0 else -1.0
+            slider_z = u - sense * w_s
+        else:  # slip -> stick: the slider stays where the spring is at the limit (continuous force)
+            slider_z = u - sense * w_s
+            sense = 0.0
+        t += hi
+        left -= hi
+        if left <= 1e-13 * h:
+            return slider_z, sense
+    for i in range(row.size):
+        row[i] += trial_row[i]
+    for i in range(ny):
+        y[i] = end[i]
+    if sense != 0.0:  # in slip the slider follows the sphere at the limit
+        u, _ = _floor_relative(y, co, lay)
+        slider_z = u - sense * co.slip_force / co.k_t
+    return slider_z, sense
 
 
 @kernel(fastmath=_FAST)
@@ -206,8 +353,13 @@ def _advance(y, sys, steps, out):
     Omega, a_base = steps.Omega, steps.a_base
     co = Coefficients(w2=sys.omega * sys.omega, c=2.0 * sys.D * sys.omega, gamma=sys.gamma, phi_l=sys.phi_l, phi_r=sys.phi_r,
                       f_modal=sys.gamma * (a_base * Omega * Omega), f_sphere=a_base * Omega * Omega, m_a=sys.m_a,
-                      k_H=sys.k_H, g=sys.g, c_damp=sys.c_damp)
+                      k_H=sys.k_H, g=sys.g, c_damp=sys.c_damp, phi_f=sys.phi_f, k_t=sys.k_t, slip_force=sys.slip_force)
     ny = lay.acc
+    friction = co.slip_force > 0.0
+    slider = sys.slider
+    slider_z, sense = slider[0], slider[1]
+    stages = np.empty((5, ny))  # the friction step's k1, k2, k3, end state and stage state
+    trial_row = np.empty(out.ledger.shape[1])
     # arrays bound once: read from a tuple inside the step loop, numba would count references at every step
     h = steps.h
     cos_stage, cos0, sin0, phi_tip = steps.cos_stage, steps.cos0, steps.sin0, sys.phi_tip
@@ -237,19 +389,22 @@ def _advance(y, sys, steps, out):
         lim = rim = 0.0
         onsets = 0
         for k in range(N):
-            # the Bogacki-Shampine stages of the module docstring (Sect. 3.2)
-            pc = _deriv(y, cos_stage[0, k], co, lay, k1)
-            _book(y, cos_stage[0, k], b1, pc, co, lay, row)
-            for i in range(ny):
-                yt[i] = y[i] + 0.5 * h * k1[i]
-            pc = _deriv(yt, cos_stage[1, k], co, lay, k2)
-            _book(yt, cos_stage[1, k], b2, pc, co, lay, row)
-            for i in range(ny):
-                yt[i] = y[i] + 0.75 * h * k2[i]
-            pc = _deriv(yt, cos_stage[2, k], co, lay, k3)
-            _book(yt, cos_stage[2, k], b3, pc, co, lay, row)
-            for i in range(ny):
-                y[i] += b1 * k1[i] + b2 * k2[i] + b3 * k3[i]
+            if friction:
+                slider_z, sense = _friction_step(y, k * h, h, Omega, co, lay, slider_z, sense, stages, row, trial_row)
+            else:
+                # the Bogacki-Shampine stages of the module docstring (Sect. 3.2)
+                pc = _deriv(y, cos_stage[0, k], co, lay, k1, 0.0, 0.0)
+                _book(y, cos_stage[0, k], b1, pc, co, lay, row)
+                for i in range(ny):
+                    yt[i] = y[i] + 0.5 * h * k1[i]
+                pc = _deriv(yt, cos_stage[1, k], co, lay, k2, 0.0, 0.0)
+                _book(yt, cos_stage[1, k], b2, pc, co, lay, row)
+                for i in range(ny):
+                    yt[i] = y[i] + 0.75 * h * k2[i]
+                pc = _deriv(yt, cos_stage[2, k], co, lay, k3, 0.0, 0.0)
+                _book(yt, cos_stage[2, k], b3, pc, co, lay, row)
+                for i in range(ny):
+                    y[i] += b1 * k1[i] + b2 * k2[i] + b3 * k3[i]
             # measures at the new step point t_{k+1}
             dl, dr = _indentations(y, co, lay)
             q = _tip(y, phi_tip, lay)
@@ -287,6 +442,8 @@ def _advance(y, sys, steps, out):
         row[LEDGER.right_re] = 2.0 / N * rre
         row[LEDGER.right_im] = 2.0 / N * rim
         out.impacts[p] = onsets
+        slider[0] = slider_z
+        slider[1] = sense
         for i in range(ny):
             if not math.isfinite(y[i]):
                 return _NONFINITE, (p + 1) * N
@@ -330,7 +487,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
                   cos0=np.cos(phase), sin0=np.sin(phase))
     out = integrator_output(n_periods, sys.omega.size, record_arr, None)
     stored_start = stored_energy(y, sys) if ledger is not None else math.nan
-    kernel_sys = sys._replace(m_a=float(sys.m_a), k_H=float(sys.k_H), g=float(sys.g), c_damp=float(sys.c_damp))
+    kernel_sys = sys._replace(m_a=float(sys.m_a), k_H=float(sys.k_H), g=float(sys.g), c_damp=float(sys.c_damp),
+                              k_t=float(sys.k_t), slip_force=float(sys.slip_force))
     status, where = _advance(y, kernel_sys, steps, out)
     if status != _OK:
         t = where * h

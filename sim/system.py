@@ -14,6 +14,9 @@ Conventions shared by every integrator in `sim`
   Forces (Eq. 4): f_l = k_H delta_l^1.5 if delta_l > 0;  f_r = -k_H (-delta_r)^1.5 if delta_r < 0.
   With the damped law (Eq. 10, `sim.contact_law`) each force gains c_damp delta^0.25 delta' while the wall
   approaches (delta' > 0 at the left wall, -delta_r' > 0 at the right), c_damp = 2 xi sqrt(k_H m_red).
+* Dry friction (Appendix C, `sim.friction`): a Jenkins element between the sphere and the cavity floor, whose
+  x-motion is phi_f^T s + q_base; its force f_t on the sphere enters Eq. 3 as + f_t and Eq. 7 as - phi_f,j f_t.
+  Its slider is state carried from call to call in `SystemArrays.slider` (ode3 only).
 * State exchanged between the integrators and the stepped-sine protocol, always at an excitation
   phase that is a multiple of 2 pi (q_base = a_base, q_base' = 0):
   ``y = [s_1..s_n, s_1'..s_n', u_a, u_a']`` with u_a = q_a - q_base (sphere relative to the base).
@@ -136,12 +139,17 @@ class Impactor:
     clearance: float = CLEARANCE_NOMINAL
     k_H: float = K_H_NOMINAL
     contact_law: ContactLaw = ContactLaw()
+    friction: float = 0.0  # Coulomb coefficient mu of the floor contact (Appendix C); 0: no friction
+    k_t: float = 22e6  # N/m, tangential stiffness of the floor contact (Appendix C: 22 kN/mm)
 
     def __post_init__(self) -> None:
-        for name, label in (("mass", "sphere mass"), ("clearance", "clearance g"), ("k_H", "k_H")):
+        for name, label in (("mass", "sphere mass"), ("clearance", "clearance g"), ("k_H", "k_H"), ("k_t", "k_t (N/m)")):
             value = float(getattr(self, name))
             if not np.isfinite(value) or value <= 0:
                 raise SimulationInputError(f"{label} must be a positive number, got {value!r}")
+        mu = float(self.friction)
+        if not np.isfinite(mu) or mu < 0:
+            raise SimulationInputError(f"the friction coefficient mu must be >= 0 (0: no friction, e.g. 0.07), got {mu!r}")
 
 
 @dataclass(frozen=True)
@@ -176,6 +184,9 @@ class SystemArrays(NamedTuple):
     omega, D, phi_l, phi_r, phi_tip, gamma: float64 arrays (n_modes,), gamma = phi^T M b;
     m_a (kg), k_H (N/m^1.5), g (m): floats; c_damp (N s / m^1.25): the damping factor of Eq. 10,
     d_H = c_damp delta^0.25 = 2 xi sqrt(k_H m_red) delta^0.25 (0 for the elastic law of Eq. 4).
+    Friction (Appendix C): phi_f the mode values at the cavity floor (1/sqrt(kg)), k_t (N/m), slip_force = mu m_a g
+    (N; 0: off), and slider = [z, sense]: the slider's position relative to the base (m) and the phase (0 stick,
+    +-1 slip in that sense), advanced in place by the integrator like y (a fresh system starts relaxed, in stick).
     """
 
     omega: np.ndarray
@@ -188,6 +199,10 @@ class SystemArrays(NamedTuple):
     k_H: float
     g: float
     c_damp: float = 0.0
+    phi_f: np.ndarray = np.zeros(0)
+    k_t: float = 0.0
+    slip_force: float = 0.0
+    slider: np.ndarray = np.zeros(2)
 
 
 def damping_factor(model: ModalModel, impactor: Impactor) -> float:
@@ -206,8 +221,20 @@ def system_arrays(model: ModalModel, impactor: Impactor) -> SystemArrays:
     return SystemArrays(
         as_f8(model.omega), as_f8(model.damping_ratios), as_f8(model.phi_wall_left), as_f8(model.phi_wall_right),
         as_f8(model.phi_tip), as_f8(model.participation), float(impactor.mass), float(impactor.k_H),
-        float(impactor.clearance), damping_factor(model, impactor),
+        float(impactor.clearance), damping_factor(model, impactor), *friction_arrays(model, impactor),
     )
+
+
+def friction_arrays(model: ModalModel, impactor: Impactor) -> tuple[np.ndarray, float, float, np.ndarray]:
+    """(phi_f, k_t, slip_force, slider) of `SystemArrays` for the impactor's friction (Appendix C): the floor values
+    of the model (one line if it has none and friction is on), k_t (N/m), mu m_a g (N) and a relaxed slider."""
+    from sim.friction import GRAVITY, floor_values
+
+    n = model.n_modes
+    if impactor.friction == 0.0:
+        return np.zeros(n), float(impactor.k_t), 0.0, np.zeros(2)
+    phi_f = np.ascontiguousarray(floor_values(model, model.source), dtype=np.float64).copy()
+    return phi_f, float(impactor.k_t), float(impactor.friction * impactor.mass * GRAVITY), np.zeros(2)
 
 
 def contact_forces(s: np.ndarray, u_a: float, sys: SystemArrays) -> tuple[float, float]:
