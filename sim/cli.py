@@ -22,7 +22,7 @@ from typing import Any, Iterator, Sequence
 
 from sim import signal_cli
 from sim.errors import SimulationInputError
-from sim.options import clearance, figure_file, hertz_constant, positive_int
+from sim.options import clearance, figure_file, friction_coefficient, hertz_constant, positive_int, tangential_stiffness
 
 MODES_HELP = "modal model of the host structure: frequencies, damping, mode values, participation (built-in rig or file)"
 SWEEP_HELP = "stepped-sine frequency response (mean and max amplitude per eta, spread over repetitions; Fig. 5)"
@@ -253,6 +253,12 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--r-cont", dest="r_cont", type=float, default=None, metavar="R",
                         help="r_cont,diss of Eq. 10 in (0, 1]: the coefficient of restitution the damped law is designed "
                              "for (1 = elastic, bit for bit); implies --contact-law hertz-damped (default there 0.99)")
+    parser.add_argument("--friction", type=friction_coefficient, default=0.0, metavar="MU",
+                        help="Coulomb coefficient of dry friction between the sphere and the cavity floor (Appendix C; "
+                             "0 = off, the default; the paper: 0.07); needs --integrator ode3 and the model's phi_floor")
+    parser.add_argument("--k-t", dest="k_t", type=tangential_stiffness, default=22e6, metavar="K_T",
+                        help="tangential stiffness of the floor contact in N/m, or with a unit: 22kN/mm (default, "
+                             "Appendix C)")
 
 
 def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int) -> None:
@@ -351,16 +357,19 @@ def model_file(path: str) -> Any:
 def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     """(modal model, impactor or None) of the system and impactor options (Eqs. 3-7, Table 2)."""
     from sim.rig import seed_rig_model
-    from sim.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor, damping_factor
+    from sim.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor, system_arrays
 
     model = model_file(args.model) if args.model else seed_rig_model(n_modes=9)
     if args.D is not None:
         model = model.with_damping(args.D)
     clearance = CLEARANCE_NOMINAL if args.g is None else args.g
     k_H = K_H_NOMINAL if args.k_H is None else args.k_H
-    impactor = Impactor(SPHERE_MASS, clearance, k_H, contact_law(args))  # validated even with --no-impactor
-    if not args.no_impactor:
-        damping_factor(model, impactor)  # the damped law needs the model's beam mass: fail before any work
+    impactor = Impactor(SPHERE_MASS, clearance, k_H, contact_law(args), args.friction, args.k_t)  # validated even
+    if not args.no_impactor:                                                                    # with --no-impactor
+        system_arrays(model, impactor)  # Eq. 10 needs the beam mass, friction phi_floor: fail before any work
+        if impactor.friction > 0 and args.integrator != "ode3":
+            raise SimulationInputError(f"dry friction (--friction {args.friction:g}, Appendix C) is in the ode3 integrator "
+                                       f"only; add --integrator ode3")
     return model, (None if args.no_impactor else impactor)
 
 
@@ -375,12 +384,14 @@ def contact_law(args: argparse.Namespace) -> Any:
 
 def system_data(model: Any, impactor: Any) -> dict:
     """The JSON keys of the simulated system: `model` (its source), `impactor` (`mass_kg`, `g_m`,
-    `k_H_N_per_m1p5`, `contact_law`, `r_cont`; None without impactor) and `D1` (damping ratio of mode 1)."""
+    `k_H_N_per_m1p5`, `contact_law`, `r_cont`, `friction` (mu), `k_t_N_per_m`; None without impactor) and `D1`
+    (damping ratio of mode 1)."""
     return {"model": model.source, "D1": float(model.damping_ratios[0]),
             "impactor": None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
                                                        "k_H_N_per_m1p5": impactor.k_H,
                                                        "contact_law": impactor.contact_law.name,
-                                                       "r_cont": impactor.contact_law.r_cont}}
+                                                       "r_cont": impactor.contact_law.r_cont,
+                                                       "friction": impactor.friction, "k_t_N_per_m": impactor.k_t}}
 
 
 def build_protocol(args: argparse.Namespace) -> Any:

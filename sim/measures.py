@@ -77,7 +77,8 @@ class ScatteringMeasures:
     significant_impacts_per_period (-); restitution, restitution_wall: r of Eq. D.1 from the tip / the wall (-);
     higher_mode_energy_share: E_{2..N} / E after significant impacts (-); higher_mode_energy_share_mean: the
     same of the time-averaged kinetic energies (-); dissipation_fundamental, dissipation_higher_modes,
-    dissipation_contact: shares of the input work (-); input_power (W); balance_error (-).
+    dissipation_contact: shares of the input work (-); input_power (W); balance_error (-); dissipation_friction:
+    the share the slider of dry friction dissipates (-, Appendix C).
     """
 
     significant_impacts_per_period: float = math.nan
@@ -90,6 +91,7 @@ class ScatteringMeasures:
     dissipation_contact: float = math.nan
     input_power: float = math.nan
     balance_error: float = math.nan
+    dissipation_friction: float = math.nan
 
 
 #: the names of the `ScatteringMeasures`, in their order (columns of ies sweep, keys of its JSON)
@@ -173,6 +175,7 @@ def scattering_measures(ledger: Ledger, theta: float = SIGNIFICANT_IMPULSE_FRACT
     energy = dict(dissipation_fundamental=float(dissipation[0]) / total_in,
                   dissipation_higher_modes=float(dissipation[1:].sum()) / total_in,
                   dissipation_contact=float(ledger.contact.sum()) / total_in,
+                  dissipation_friction=float(ledger.friction.sum()) / total_in,
                   input_power=total_in / (n_periods * ledger.period), balance_error=ledger.balance_error,
                   higher_mode_energy_share_mean=float(kinetic[1:].sum() / kinetic.sum()))
     records = ledger.impacts

@@ -14,11 +14,12 @@ from __future__ import annotations
 
 import argparse
 import functools
+import math
 import sys
 from pathlib import Path
 
 from sim.errors import SimulationInputError
-from sim.units import CLEARANCE, K_H, Quantity, implausible, parse_quantity
+from sim.units import CLEARANCE, K_H, K_T, Quantity, implausible, parse_quantity
 
 
 @functools.lru_cache(maxsize=1)
@@ -85,6 +86,22 @@ def quantity_value(text: str, quantity: Quantity) -> float:
 def clearance(text: str) -> float:
     """The clearance g in m: ``0.58e-3``, ``0.58mm``, ``580um``."""
     return quantity_value(text, CLEARANCE)
+
+
+def tangential_stiffness(text: str) -> float:
+    """The tangential stiffness k_t of the floor contact in N/m: ``22e6``, ``22kN/mm`` (Appendix C)."""
+    return quantity_value(text, K_T)
+
+
+def friction_coefficient(text: str) -> float:
+    """The Coulomb coefficient mu of the floor contact (-), >= 0 (0: no friction)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number; give the friction coefficient, e.g. 0.07") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"the friction coefficient must be >= 0 (0: no friction, e.g. 0.07), got {text}")
+    return value
 
 
 def hertz_constant(text: str) -> float:

@@ -272,13 +272,13 @@ class SweepResult:
 def scattering_keys(measures: dict) -> dict:
     """The JSON keys of the scattering measures (Sect. 5.5, Appendix D) of `ies sweep` / `ies overview`: each
     measure by its name, and "dissipation" {fundamental, higher_modes, contact (shares of the input work),
-    input (mean input power, W), balance_error} (values or arrays over eta as given)."""
+    input (mean input power, W), balance_error, friction (share)} (values or arrays over eta as given)."""
     out = {name: measures[name] for name in SCATTERING_MEASURES if not name.startswith("dissipation_")
            and name not in ("input_power", "balance_error")}
     out["dissipation"] = {"fundamental": measures["dissipation_fundamental"],
                           "higher_modes": measures["dissipation_higher_modes"],
                           "contact": measures["dissipation_contact"], "input": measures["input_power"],
-                          "balance_error": measures["balance_error"]}
+                          "balance_error": measures["balance_error"], "friction": measures["dissipation_friction"]}
     return out
 
 

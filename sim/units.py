@@ -35,6 +35,8 @@ class Quantity:
 CLEARANCE = Quantity("clearance g", "m", {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6}, (1e-5, 1e-2), "0.58mm")
 #: the Hertzian spring constant k_H (Eq. 8: 282e3 N/mm^1.5 = 8.918e9 N/m^1.5); plausible 1e6-1e14 N/m^1.5
 K_H = Quantity("Hertzian spring constant k_H", "N/m^1.5", {"N/m^1.5": 1.0, "N/mm^1.5": 1e3**1.5}, (1e6, 1e14), "282e3N/mm^1.5")
+#: the tangential stiffness k_t of the floor contact (Appendix C: 22 kN/mm = 2.2e7 N/m); plausible 1e4-1e10 N/m
+K_T = Quantity("tangential stiffness k_t", "N/m", {"N/m": 1.0, "N/mm": 1e3, "kN/mm": 1e6}, (1e4, 1e10), "22kN/mm")
 
 _NUMBER = re.compile(r"^\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(.*?)\s*$")
 

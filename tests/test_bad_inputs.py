@@ -354,3 +354,28 @@ def test_bad_contact_law_options_create_nothing(tmp_path, model_file, capsys, mo
     monkeypatch.chdir(tmp_path)
     refused(capsys, main([*command, "--model", model_file, "--out", "res", *args]), phrase)
     assert [p.name for p in files_in(tmp_path)] == ["three.toml"]
+
+
+# ---- dry friction (Appendix C) ----------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("args, phrase", [
+    (["--friction", "-0.1", "--integrator", "ode3"], "the friction coefficient must be >= 0"),
+    (["--friction", "0.07", "--k-t", "-5", "--integrator", "ode3"], "k_t (N/m) must be a positive number"),
+    (["--friction", "0.07", "--integrator", "ode3"], "has no 'phi_floor'"),  # the three-mode file has no floor values
+    (["--friction", "0.07"], "in the ode3 integrator only"),
+])
+@pytest.mark.parametrize("command", [["sweep", "--level", "6", *FAST], ["overview", "--levels", "5,6", *FAST],
+                                     ["trace", "--level", "6", "--eta", "0.98", "--periods", "2"]])
+def test_bad_friction_options_create_nothing(tmp_path, model_file, capsys, monkeypatch, command, args, phrase):
+    monkeypatch.chdir(tmp_path)
+    model = ["--model", model_file] if phrase == "has no 'phi_floor'" else []
+    refused(capsys, main([*command, *model, "--out", "res", *args]), phrase)
+    assert [p.name for p in files_in(tmp_path)] == ["three.toml"]
+
+
+def test_a_friction_study_on_the_exact_integrator_is_one_line(tmp_path, capsys):
+    study = tmp_path / "friction.toml"
+    study.write_text("[study]\nkind = 'response'\n[parameters.friction]\nnominal = 0.07\n[excitation]\nlevels = [1.26]\n"
+                     "eta = { start = 0.98, stop = 0.99, n = 2 }\nwait = 0.1\nhold = 0.1\n")
+    refused(capsys, main(["response", str(study), "--out", str(tmp_path / "o")]), "ode3 integrator only")
+    assert not (tmp_path / "o").exists()

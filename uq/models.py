@@ -76,8 +76,9 @@ class IESModel:
 
     parameters = ("D", "g", "k_H")
     #: parameters a study may add to Table 2's (they enter a task's point, and so its key, only when listed):
-    #: r_cont,diss of the damped contact law (Eq. 10; listing it implies contact_law = "hertz-damped")
-    optional_parameters = ("r_cont",)
+    #: r_cont,diss of the damped contact law (Eq. 10; listing it implies contact_law = "hertz-damped"), and the
+    #: friction coefficient mu and tangential stiffness k_t (N/m) of dry friction at the floor (Appendix C; ode3)
+    optional_parameters = ("r_cont", "friction", "k_t")
     #: the resonant levels, the regime (1 = APR) and the scattering measures of `sim.measures` at the resonant
     #: mean's eta (Sect. 5.5, Appendix D)
     outputs = ("mean", "max", "apr", *SCATTERING_MEASURES)
@@ -88,9 +89,12 @@ class IESModel:
     def optional_parameter(self, name: str) -> Parameter:
         """The default of an optional parameter (`optional_parameters`), before the study's table fills it in."""
         from sim.contact_law import DEFAULT_R_CONT
+        from sim.friction import K_T_PAPER, MU_PAPER
 
-        return Parameter("r_cont", DEFAULT_R_CONT, DEFAULT_R_CONT, DEFAULT_R_CONT, "-",
-                         "r_cont,diss of the damped contact law (Eq. 10)")
+        nominal, unit, label = {"r_cont": (DEFAULT_R_CONT, "-", "r_cont,diss of the damped contact law (Eq. 10)"),
+                                "friction": (MU_PAPER, "-", "friction coefficient mu at the floor (App. C)"),
+                                "k_t": (K_T_PAPER, "N/m", "tangential stiffness k_t at the floor (App. C)")}[name]
+        return Parameter(name, nominal, nominal, nominal, unit, label)
 
     def version(self) -> str:
         return _source_version("sim", "uq/models.py")
@@ -120,14 +124,25 @@ class IESModel:
             get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
         except SimulationInputError as exc:
             raise StudyError(f"[excitation]: {exc}") from None
-        rig = self._rig()
-        if self.contact_law != "hertz":
-            from sim.system import damping_factor
+        self._rig()
+        self.check_physics({})
 
-            try:  # the damped law needs the model's beam mass (Eq. 10)
-                damping_factor(rig, self._impactor({"g": 1e-3, "k_H": 1e9, "r_cont": 0.5}))
-            except SimulationInputError as exc:
-                raise StudyError(f"[study] contact_law = \"{self.contact_law}\": {exc}") from None
+    def check_physics(self, params: Mapping[str, float]) -> None:
+        """The model and protocol can simulate a point with these optional parameters (`optional_parameters`): Eq. 10
+        needs the model's beam mass, friction its phi_floor and the ode3 integrator; one line otherwise."""
+        from sim.errors import SimulationInputError
+        from sim.system import system_arrays
+
+        point = {"g": 1e-3, "k_H": 1e9, **params}
+        if self.contact_law == "hertz" and point.get("friction", 0.0) == 0.0:
+            return
+        try:
+            system_arrays(self._rig(), self._impactor(point))
+        except SimulationInputError as exc:
+            raise StudyError(f"[study] {exc}") from None
+        if point.get("friction", 0.0) > 0.0 and self._stepped_sine().integrator != "ode3":
+            raise StudyError("[parameters.friction] dry friction (Appendix C) is in the ode3 integrator only; set "
+                             "[excitation] integrator = \"ode3\"")
 
     def _rig(self):
         from sim.errors import SimulationInputError
@@ -146,15 +161,17 @@ class IESModel:
         return rig
 
     def _impactor(self, params: Mapping[str, float]):
-        """The sphere of Eqs. 3-6 with this run's g and k_H, its mass scaled by [variant] sphere_mass_factor, and the
-        study's contact law (Eq. 10 with this run's r_cont when damped)."""
+        """The sphere of Eqs. 3-6 with this run's g and k_H, its mass scaled by [variant] sphere_mass_factor, the
+        study's contact law (Eq. 10 with this run's r_cont when damped) and this run's friction (Appendix C)."""
         from sim.contact_law import DEFAULT_R_CONT, ContactLaw
+        from sim.friction import K_T_PAPER
         from sim.system import SPHERE_MASS, Impactor
 
         mass = SPHERE_MASS * self.variant.get("sphere_mass_factor", 1.0)
         law = (ContactLaw(self.contact_law, params.get("r_cont", DEFAULT_R_CONT)) if self.contact_law != "hertz"
                else ContactLaw())
-        return Impactor(mass=mass, clearance=params["g"], k_H=params["k_H"], contact_law=law)
+        return Impactor(mass=mass, clearance=params["g"], k_H=params["k_H"], contact_law=law,
+                        friction=params.get("friction", 0.0), k_t=params.get("k_t", K_T_PAPER))
 
     def warm_up(self) -> None:
         """Compile the integrator's kernels in this process (`sim.integrators.warm_up`; minutes on a first run)."""

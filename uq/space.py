@@ -21,7 +21,7 @@ import numpy as np
 
 from sim.errors import SimulationInputError
 from sim.system import CLEARANCE_NOMINAL, D1_NOMINAL, K_H_NOMINAL
-from sim.units import CLEARANCE, K_H, implausible, parse_quantity
+from sim.units import CLEARANCE, K_H, K_T, implausible, parse_quantity
 from uq.errors import StudyError
 
 # Table 2 of the seed paper (SI units); the nominal values are the simulator's (sim.system).
@@ -227,9 +227,9 @@ def resolve_value(name: str, value: object, *, base_dir: Path | None = None) -> 
     or a string with its unit ("0.58 mm", `sim.units`); other parameters unchanged (checked by `Parameter`)."""
     if name == "k_H":
         return resolve_k_H(value, base_dir=base_dir)
-    if name == "g" and isinstance(value, str):
+    if name in ("g", "k_t") and isinstance(value, str):
         try:
-            return parse_quantity(value, CLEARANCE)
+            return parse_quantity(value, CLEARANCE if name == "g" else K_T)
         except SimulationInputError as exc:
             raise StudyError(str(exc)) from None
     return value

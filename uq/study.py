@@ -30,6 +30,8 @@ Layout (every table and key is optional except where noted; SI units)::
     best_estimate = "1.25 k_H*"  # the value k_H is fixed at in the residual band (Fig. 8)
     [parameters.r_cont]          # model "ies", optional: r_cont,diss of Eq. 10 in (0, 1] (fixed: nominal only)
     nominal = 0.99
+    [parameters.friction]        # model "ies", optional: mu of dry friction at the floor (Appendix C; ode3 only),
+    nominal = 0.07               # with [parameters.k_t] (N/m, or "22kN/mm") the tangential stiffness
 
     [excitation]                 # passed to the stepped-sine protocol (sim.protocol.SteppedSine)
     levels = [5.3, 6.7, 7.4]     # a_base / a_base* (Sect. 5.3; nominal D*, g*)
@@ -279,6 +281,9 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
     model = study.make_model()  # unknown model -> one line now
     if modal_model is not None or variant or contact_law != "hertz":
         model.check()  # an unreadable modal file -> one line now
+    if "friction" in space.names:
+        model.check_physics({"friction": space["friction"].max, "k_t": space["k_t"].min if "k_t" in space.names
+                             else model.optional_parameter("k_t").nominal})
     return study
 
 
