@@ -262,7 +262,7 @@ def _stage(y, cos_t, weight, co, lay, out, slider_z, sense, row, book):
         row[LEDGER.friction] += weight * p_friction
 
 
-@kernel(fastmath=_FAST)
+@kernel(inline="always", fastmath=_FAST)
 def _bs_step(y, t, L, Omega, co, lay, slider_z, sense, stages, row, book):
     """One Bogacki-Shampine step of length L (s) from (t, y) with the slider in its phase: the state at t + L in
     stages[3] (y unchanged); with `book` the bookkeeping's integrands into `row` (weights scaled to L)."""
@@ -351,11 +351,11 @@ def _general_step(y, t, h, Omega, co, lay, slider_z, sense, stages, row, trial_r
         left -= hi
         if left <= 1e-13 * h:
             return slider_z, sense
-    if co.slip_force == 0.0:
-        trial_row[:] = 0.0
-        _bs_step(y, t, left, Omega, co, lay, slider_z, sense, stages, trial_row, True)
-    for i in range(row.size):
-        row[i] += trial_row[i]
+    if co.slip_force == 0.0:  # no transitions: the step booked directly
+        _bs_step(y, t, left, Omega, co, lay, slider_z, sense, stages, row, True)
+    else:
+        for i in range(row.size):
+            row[i] += trial_row[i]
     for i in range(ny):
         y[i] = end[i]
     if sense != 0.0:  # in slip the slider follows the sphere at the limit
