@@ -562,11 +562,10 @@ def add_trace_arguments(parser: argparse.ArgumentParser) -> None:
 
 def trace_command(args: argparse.Namespace) -> int:
     """`ies trace`: time histories of one stepped-sine point (Sects. 5.1, 5.5; Figs. 4, 9a)."""
-    from sim.figures import plot_trace
-    from sim.files import dumps, report_written, write_csv, write_text
+    from sim.files import dumps, report_written
     from sim.integrators import warm_up
     from sim.protocol import check_level
-    from sim.trace import COLUMNS, record_trace, trace_data, trace_rows
+    from sim.trace import record_trace, write_trace
 
     started = time.perf_counter()
     level = check_level(args.level)
@@ -579,19 +578,7 @@ def trace_command(args: argparse.Namespace) -> int:
         trace = record_trace(model, impactor, level, protocol, periods=args.periods, fs=args.fs, seed=args.seed)
         settings = {"integrator": protocol.integrator, "seed": args.seed, "protocol": dataclasses.asdict(protocol),
                     "fs_requested": args.fs, **system_data(model, impactor)}
-        data = trace_data(trace, settings)
-        written: list[Path | str] = []
-        try:
-            written.append(write_csv(folder / "trace.csv", COLUMNS, trace_rows(trace)))
-            data["wall_time_s"] = time.perf_counter() - started
-            written.append(write_text(folder / "trace.json", dumps(data) + "\n"))
-            if args.plot:
-                plot_trace(data, trace.signal.t, trace.signal["q_tip"], trace.signal["v_tip"], args.plot)
-                written.append(args.plot)
-        except BaseException:
-            for path in written:  # all or nothing
-                Path(path).unlink(missing_ok=True)
-            raise
+        data, written = write_trace(folder, trace, settings, args.plot, started)
     if args.json:
         print(dumps(data))
         report_written(written, json_mode=True)

@@ -113,9 +113,11 @@ def plot_overview(data: Mapping[str, Any], path: str | os.PathLike, title: str, 
         ax.legend(fontsize=7, loc="upper left")  # the low SMR levels leave that corner free
 
 
-def plot_series(series: Sequence[tuple[str, Mapping[str, Any]]], path: str | os.PathLike, title: str) -> None:
-    """Fig. 11: the resonant mean level against the excitation level, one curve per value of a series (`series`:
-    [(label, `sim.tables.overview_data` keys)]), each with the range of its runs as error bars."""
+def plot_series(series: Sequence[tuple[str, Mapping[str, Any]]], path: str | os.PathLike, title: str,
+                paper_line: tuple[float, str] | None = None) -> None:
+    """Figs. 11 and C.1a: the resonant mean level against the excitation level, one curve per value of a series
+    (`series`: [(label, `sim.tables.overview_data` keys)]), each with the range of its runs as error bars;
+    paper_line: (level, what the paper says there) marked as a vertical line."""
     import numpy as np
 
     with plot_to(path, figsize=(6.5, 4.4)) as (fig, ax):
@@ -125,7 +127,8 @@ def plot_series(series: Sequence[tuple[str, Mapping[str, Any]]], path: str | os.
             spread = [value - np.asarray(data["resonant_mean_lo"], dtype=float),
                       np.asarray(data["resonant_mean_hi"], dtype=float) - value]
             ax.errorbar(levels, value, yerr=spread, fmt="o-", ms=3, capsize=2, lw=1.2, label=label)
-        ax.axvline(7.5, color="k", lw=1, ls="-.", alpha=0.6, label="paper: contact dissipation matters above 7.5")
+        if paper_line is not None:
+            ax.axvline(paper_line[0], color="k", lw=1, ls="-.", alpha=0.6, label=paper_line[1])
         ax.set_xlabel("excitation level a_base / a_base*")
         ax.set_ylabel("resonant mean a / a_noabs*")
         ax.set_title(title, fontsize=8)
@@ -264,6 +267,21 @@ def plot_trace(data: Mapping[str, Any], t: Sequence[float], q_tip: Sequence[floa
         save_figure(fig, path)
     finally:
         plt.close(fig)
+
+
+def plot_motion(t: Sequence[float], signal: Mapping[str, Sequence[float]], path: str | os.PathLike, title: str) -> None:
+    """Fig. C.1b: the displacements of both walls and of the sphere relative to the base (mm) over a time history."""
+    import numpy as np
+
+    with plot_to(path, figsize=(7.0, 3.6)) as (fig, ax):
+        t = np.asarray(t)
+        for key, label, color in (("q_wall_left", "left wall", "tab:blue"), ("q_wall_right", "right wall", "tab:red"),
+                                  ("q_sphere", "sphere", "k")):
+            ax.plot(t, 1e3 * np.asarray(signal[key]), color=color, lw=0.9, label=label)
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel("displacement relative to the base (mm)")
+        ax.set_title(title, fontsize=8)
+        ax.legend(fontsize=7, loc="upper right", ncols=3)
 
 
 def trace_title(data: Mapping[str, Any]) -> str:

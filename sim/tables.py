@@ -98,20 +98,22 @@ def scattering_text(data: dict[str, list]) -> str:
 
 
 def series_text(series: list[tuple[str, dict[str, list]]]) -> str:
-    """Fig. 11's table: per level, the resonant mean of each value of the series, and the shares of the input
-    dissipated in the contact, mode 1 and modes 2..N at the resonant eta (Sect. 5.5) for each value."""
-    head = f"{'level':>7} " + " ".join(f"{label:>24}" for label, _ in series)
-    lines = [head, f"{'':>7} " + " ".join(f"{'mean  contact/D_1/D_2..N':>24}" for _ in series)]
-    for i, level in enumerate(series[0][1]["levels"]):
+    """Figs. 11 and C.1's table: per level, the resonant mean of each value of the series, and the shares (%) of the
+    input dissipated in the contact, by friction, in mode 1 and in modes 2..N at the resonant eta (Sect. 5.5)."""
+    width = 28
+    head = f"{'level':>7} " + " ".join(f"{label:>{width}}" for label, _ in series)
+    lines = [head, f"{'':>7} " + " ".join(f"{'mean cont/fric/D_1/D_2..N':>{width}}" for _ in series)]
+    for level in series[0][1]["levels"]:
         cells = []
         for _, data in series:
-            at = data["levels"].index(level) if level in data["levels"] else None
-            if at is None:
-                cells.append(f"{'-':>24}")
+            if level not in data["levels"]:
+                cells.append(f"{'-':>{width}}")
                 continue
-            cells.append(f"{data['resonant_mean'][at]:6.3f} {100 * data['dissipation_contact'][at]:5.1f}/"
-                         f"{100 * data['dissipation_fundamental'][at]:4.1f}/{100 * data['dissipation_higher_modes'][at]:4.1f}%")
-        lines.append(f"{level:7.3f} " + " ".join(f"{c:>24}" for c in cells))
+            at = data["levels"].index(level)
+            shares = "/".join(f"{100 * data[key][at]:.1f}" for key in ("dissipation_contact", "dissipation_friction",
+                                                                        "dissipation_fundamental", "dissipation_higher_modes"))
+            cells.append(f"{data['resonant_mean'][at]:.3f} {shares}%")
+        lines.append(f"{level:7.3f} " + " ".join(f"{c:>{width}}" for c in cells))
     return "\n".join(lines)
 
 

@@ -13,7 +13,9 @@ no records (ode3) falls back to the contacts seen between samples (`sim.signals.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -163,3 +165,27 @@ def impact_list(trace: Trace) -> dict[str, Any]:
         row.update({name: float(r[name]) for name in records.dtype.names if name not in ("wall", "period", "t_onset")})
         rows.append(row)
     return {"impacts_source": "integrator", "impacts": rows}
+
+
+def write_trace(folder: Path, trace: Trace, settings: dict[str, Any], plot: str | Path | None = None,
+                started: float | None = None) -> tuple[dict[str, Any], list[Path | str]]:
+    """Write trace.csv and trace.json into `folder` (and Figs. 4 / 9a to `plot`), all or nothing; returns (the JSON
+    data, the paths written). started: time.perf_counter() at the command's start (for wall_time_s)."""
+    from sim.figures import plot_trace
+    from sim.files import dumps, write_csv, write_text
+
+    data = trace_data(trace, settings)
+    written: list[Path | str] = []
+    try:
+        written.append(write_csv(folder / "trace.csv", COLUMNS, trace_rows(trace)))
+        if started is not None:
+            data["wall_time_s"] = time.perf_counter() - started
+        written.append(write_text(folder / "trace.json", dumps(data) + "\n"))
+        if plot:
+            plot_trace(data, trace.signal.t, trace.signal["q_tip"], trace.signal["v_tip"], plot)
+            written.append(plot)
+    except BaseException:
+        for path in written:  # all or nothing
+            Path(path).unlink(missing_ok=True)
+        raise
+    return data, written

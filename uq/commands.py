@@ -43,8 +43,10 @@ REPRODUCE_HELP = ("reproduce the paper's Figs. 5 and 6 (nominal response), 7 and
 PLOT_HELP = "redraw a result folder's figures from its saved data (formats, style, levels) without recomputing"
 #: the paper's figures that `ies reproduce` runs, in the order of `all`
 FIGURES = ("fig5", "fig6", "fig7", "fig8", "figD2", "figD3")
-#: figures `ies reproduce` runs when named, not in `all` (Fig. 11: five contact laws, minutes even when quick)
-EXTRA_FIGURES = ("fig11",)
+#: figures `ies reproduce` runs when named, not in `all` (five contact laws, friction: minutes even when quick)
+EXTRA_FIGURES = ("fig11", "figC1")
+#: the levels whose time histories a figure traces (Fig. C.1b: 1.26 and 5.3, with friction)
+TRACED = {"figC1": (1.26, 5.3)}
 
 
 def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
@@ -187,7 +189,7 @@ def print_response_result(folder: Path, name: str) -> None:
         from sim.tables import series_text
 
         print(f"{name}: resonant mean (a / a_noabs*) and the input's dissipation shares at the resonant eta "
-              f"(contact / mode 1 / modes 2..N) for each value:")
+              f"(contact / friction / mode 1 / modes 2..N) for each value:")
         print(series_text(series_overviews(folder)))
         return
     overview = data["overview"]
@@ -209,7 +211,8 @@ def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("figure", choices=(*FIGURES, *EXTRA_FIGURES, "all"),
                         help="which figure(s): fig5 (frequency responses), fig6 (resonant level vs excitation level), "
                              "fig7 and fig8 (uncertainty of D, g, k_H), figD2 and figD3 (impacts per period and "
-                             "restitution vs excitation level), fig11 (damped contact law, Eq. 10; not in all), all")
+                             "restitution vs excitation level), fig11 (damped contact law, Eq. 10) and figC1 (dry friction, "
+                             "Appendix C; both not in all), all")
     parser.add_argument("--quick", action="store_true",
                         help="reduced protocol (fewer levels, frequencies, repetitions, shorter holds); same trends")
     parser.add_argument("--out", type=Path, default=Path("ies-out/reproduce"), metavar="DIR",
@@ -321,6 +324,10 @@ def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list
                      else (run_interval_study, interval_figures))
         result = run(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet)
         paths = draw(result.folder)
+        if figure in TRACED:
+            from uq.execute import series_traces
+
+            paths += series_traces(study, folder, TRACED[figure])
         s = result.summary
         print(f"{figure}: {s['tasks']} runs ({s['ran']} run now), {s['failed_runs']} failed, "
               f"{s['wall_time_s']:.1f} s; figures: {', '.join(p.name for p in paths)}")

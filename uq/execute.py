@@ -370,3 +370,42 @@ def _run_response_series(study: Study, *, out: Path | None, jobs: int, scheduler
     result.summary = totals
     result.files.append(_metadata(study, study.make_model(), result, {"summary": totals, "series_folders": parts}))
     return result
+
+
+def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: int = 20) -> list[Path]:
+    """Fig. C.1b: with the series' last value (e.g. friction on), the time history (`sim.trace`, 51.2 kHz) of the
+    point of the resonant mean at each of `levels`, reached as the study's runs reach it (its grid up to that eta,
+    the first run's random offset), into folder/trace-LEVEL: trace.csv, trace.json, Figs. 4/9a (trace.png) and
+    the walls and the sphere (motion.png)."""
+    import csv
+    import dataclasses
+
+    from sim.figures import plot_motion
+    from sim.trace import record_trace, write_trace
+
+    sub, one = study.series_studies()[-1]
+    with open(folder / sub / "overview.csv", newline="") as fh:
+        resonant = {float(r["level"]): float(r["eta_resonant_mean"]) for r in csv.DictReader(fh)}
+    model = one.make_model().with_rig()
+    point = one.space.nominal()
+    rig, impactor = model.simulated_system(point)
+    protocol = model.stepped_sine()
+    grid = protocol.eta
+    written: list[Path] = []
+    for level in levels:
+        if level not in resonant:
+            raise StudyError(f"level {level:g} is not among the study's levels; it cannot be traced")
+        last = int(np.argmin(np.abs(grid - resonant[level])))
+        visit = dataclasses.replace(protocol, eta_stop=float(grid[last]), n_eta=last + 1) if last else \
+            dataclasses.replace(protocol, eta_stop=float(grid[0]), n_eta=1)
+        trace = record_trace(rig, impactor, level, visit, periods=periods, seed=study.seed)
+        out = folder / f"trace-{level:g}"
+        out.mkdir(parents=True, exist_ok=True)
+        settings = {"integrator": visit.integrator, "seed": study.seed, "protocol": dataclasses.asdict(visit),
+                    "series": sub, "study": study.name}
+        _, paths = write_trace(out, trace, settings, out / "trace.png")
+        title = (f"{sub}: a_base/a_base* = {level:g}, eta = {trace.eta_actual:.4f} (cf. Fig. C.1b), "
+                 f"{trace.amplitudes.size} periods")
+        plot_motion(trace.signal.t, trace.signal, out / "motion.png", title)
+        written += [Path(p) for p in paths] + [out / "motion.png"]
+    return written

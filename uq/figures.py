@@ -327,12 +327,20 @@ def _series_figure(folder: Path, meta: dict, options: PlotOptions) -> list[Path]
 
     protocol = meta["study"]["protocol_resolved"]
     name = next(iter(meta["study"]["series"]))
-    runs = f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold"
-    paths = options.paths(folder, "fig11")
+    figure = meta["study"]["response"]["figures"][0]
+    runs = (f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold, "
+            f"{protocol['integrator']}")
+    paper = SERIES_FIGURES.get(figure, ("", None))
+    paths = options.paths(folder, figure)
     for path in paths:
-        plot_series(series_overviews(folder, options), path,
-                    f"Resonant mean for each {name} (cf. Fig. 11), contact law {meta['study']['contact_law']}, {runs}")
+        plot_series(series_overviews(folder, options), path, f"Resonant mean for each {name} ({paper[0]}), contact law "
+                    f"{meta['study']['contact_law']}, {runs}", paper[1])
     return paths
+
+
+#: the paper's figure of a series study and what the paper says (a level marked on it)
+SERIES_FIGURES = {"fig11": ("cf. Fig. 11", (7.5, "paper: contact dissipation matters above 7.5")),
+                  "figC1": ("cf. Fig. C.1 and the low end of Fig. 6", None)}
 
 
 register("ies interval", _kind_is("interval"))(interval_figures)

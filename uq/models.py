@@ -94,7 +94,7 @@ class IESModel:
         nominal, unit, label = {"r_cont": (DEFAULT_R_CONT, "-", "r_cont,diss of the damped contact law (Eq. 10)"),
                                 "friction": (MU_PAPER, "-", "friction coefficient mu at the floor (App. C)"),
                                 "k_t": (K_T_PAPER, "N/m", "tangential stiffness k_t at the floor (App. C)")}[name]
-        return Parameter(name, nominal, nominal, nominal, unit, label)
+        return Parameter(name, nominal, nominal, nominal, unit, label, positive=name != "friction")  # mu = 0: off
 
     def version(self) -> str:
         return _source_version("sim", "uq/models.py")
@@ -173,6 +173,15 @@ class IESModel:
         return Impactor(mass=mass, clearance=params["g"], k_H=params["k_H"], contact_law=law,
                         friction=params.get("friction", 0.0), k_t=params.get("k_t", K_T_PAPER))
 
+    def simulated_system(self, params: Mapping[str, float]) -> tuple[Any, Any]:
+        """(modal model with this point's D, impactor) of a point of the study's space."""
+        rig = self.rig if self.rig is not None else self._rig()
+        return rig.with_damping(params["D"]), self._impactor(params)
+
+    def stepped_sine(self) -> Any:
+        """The study's stepped-sine protocol (`sim.protocol.SteppedSine`)."""
+        return self._stepped_sine()
+
     def warm_up(self) -> None:
         """Compile the integrator's kernels in this process (`sim.integrators.warm_up`; minutes on a first run)."""
         from sim.integrators import warm_up
@@ -199,9 +208,8 @@ class IESModel:
         """One run: its own resonant levels (outputs) and the per-point measures (trace) for aggregation."""
         from sim.protocol import aggregate_runs, run_sweep
 
-        rig = self.rig if self.rig is not None else self._rig()
-        model = rig.with_damping(params["D"])
-        run = run_sweep(model, self._impactor(params), level, self._stepped_sine(), seed=seed, rep=rep)
+        model, impactor = self.simulated_system(params)
+        run = run_sweep(model, impactor, level, self._stepped_sine(), seed=seed, rep=rep)
         own = aggregate_runs([run])
         trace = {key: getattr(run, key).tolist() for key in _TRACE}
         trace["scattering"] = {name: values.tolist() for name, values in run.scattering.items()}

@@ -59,7 +59,8 @@ Layout (every table and key is optional except where noted; SI units)::
     [response]                   # kind "response": the frequency responses and resonant levels of the nominal
     figures = ["fig5", "fig6"]   # point (the parameters' nominal values) at every level, as Figs. 5 and 6, and
                                  # "figD2", "figD3": impacts per period and r at the resonant eta (Appendix D),
-                                 # "fig11": the resonant mean of each value of `series` (Sect. 5.5)
+                                 # "fig11", "figC1": the resonant mean of each value of `series` (Sect. 5.5,
+                                 # Appendix C)
     series = { r_cont = [1.0, 0.99, 0.9] }   # optional: the whole study once per value of one listed
                                  # parameter (a response study each, in OUT/NAME=VALUE), as Fig. 11
 
@@ -81,7 +82,7 @@ from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_
 
 KINDS = ("interval", "sobol", "response")
 #: the figures a response study draws (Figs. 5 and 6 of the seed paper)
-RESPONSE_FIGURES = ("fig5", "fig6", "figD2", "figD3", "fig11")
+RESPONSE_FIGURES = ("fig5", "fig6", "figD2", "figD3", "fig11", "figC1")
 DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
     "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output", "outputs", "contact_law"},
@@ -281,9 +282,10 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
     model = study.make_model()  # unknown model -> one line now
     if modal_model is not None or variant or contact_law != "hertz":
         model.check()  # an unreadable modal file -> one line now
-    if "friction" in space.names:
-        model.check_physics({"friction": space["friction"].max, "k_t": space["k_t"].min if "k_t" in space.names
-                             else model.optional_parameter("k_t").nominal})
+    if "friction" in space.names:  # every mu of the study: >= 0, and > 0 needs ode3 and the floor values
+        k_t = space["k_t"].min if "k_t" in space.names else model.optional_parameter("k_t").nominal
+        for mu in (space["friction"].min, space["friction"].max, *(study.series[1] if study.series else ())):
+            model.check_physics({"friction": mu, "k_t": k_t})
     return study
 
 
@@ -301,7 +303,7 @@ def _parse_series(table: Any, kind: str, space: ParameterSpace) -> tuple[str, tu
         raise StudyError(f"[response] series: '{name}' is not a parameter of the study; list it as [parameters.{name}]")
     if not isinstance(values, list) or not values or len(set(values)) != len(values):
         raise StudyError(f"[response] series: {name} needs a list of distinct values, got {values!r}")
-    return name, tuple(float(_number("response", f"series.{name}", v)) for v in values)
+    return name, tuple(float(_number("response", f"series.{name}", v, positive=False)) for v in values)
 
 
 def _parse_contact_law(head: Mapping[str, Any], space: ParameterSpace) -> str:

@@ -109,7 +109,7 @@ def test_a_series_of_contact_laws_gives_what_ies_overview_gives(tmp_path, capsys
     study.write_text(DAMPED)
     assert main(["response", str(study), "--out", str(tmp_path / "series"), "--quiet", "--jobs", "1"]) == 0
     printed = capsys.readouterr().out
-    assert "contact / mode 1 / modes 2..N" in printed and "r_cont=0.9" in printed
+    assert "contact / friction / mode 1 / modes 2..N" in printed and "r_cont=0.9" in printed
     assert (tmp_path / "series" / "fig11.png").is_file()
     for r_cont in ("1", "0.9"):
         assert main(["overview", "--levels", "6.7", "--eta", "0.98:0.985:2", "--wait", "0.1", "--hold", "0.1",
