@@ -340,14 +340,17 @@ class CalculixResult:
 
 def calculix_modal_model(frd: str | os.PathLike, inp: str | os.PathLike, wall_left: str, wall_right: str,
                          tip: str, dat: str | os.PathLike | None = None, units: str = "m-kg-s", n_modes: int = 9,
-                         modes: Sequence[int] | None = None) -> CalculixResult:
+                         modes: Sequence[int] | None = None, floor: str | None = None,
+                         beam_mass: float | None = None) -> CalculixResult:
     """Modal model (Sect. 3.1, Eq. 7) from a CalculiX *FREQUENCY job: eigenvectors from `frd`, node sets from
     `inp`, frequencies and participation factors from `dat` (default: the .dat beside the .frd).
 
     wall_left, wall_right, tip: names of node sets in the .inp; each mode value is the mean x-displacement of the
     set's nodes. units: "m-kg-s" or "mm-t-s" (the job's consistent units). The first n_modes x-bending modes are
     selected by their participation (sim.solid.select_x_bending), or the given 1-based mode numbers `modes`.
-    Damping per sim.rig.damping_ratios. Raises SimulationInputError (one line) for missing files, a .frd without
+    Damping per sim.rig.damping_ratios. floor: the node set of the cavity floor under the sphere (its mean
+    x-values are the model's phi_floor, Appendix C); beam_mass: the beam's free length without the block (kg, Eq.
+    10; a .frd has no masses). Raises SimulationInputError (one line) for missing files, a .frd without
     eigenvectors, unknown node sets, node sets with nodes missing from the .frd, a .dat that does not belong to
     the .frd or eigenvectors that are not mass-normalised.
     """
@@ -359,8 +362,10 @@ def calculix_modal_model(frd: str | os.PathLike, inp: str | os.PathLike, wall_le
     frd, inp = Path(frd), Path(inp)
     dat = Path(dat) if dat is not None else frd.with_suffix(".dat")
     deck = read_inp(inp)
-    sets = {role: deck.node_set(name) for role, name in (("wall_left", wall_left), ("wall_right", wall_right),
-                                                          ("tip", tip))}
+    named = [("wall_left", wall_left), ("wall_right", wall_right), ("tip", tip)] + ([("floor", floor)] if floor else [])
+    sets = {role: deck.node_set(name) for role, name in named}
+    if beam_mass is not None and not (math.isfinite(beam_mass) and beam_mass > 0):
+        raise SimulationInputError(f"--beam-mass must be a positive mass in kg, got {beam_mass!r}")
     for role, ids in sets.items():
         if ids.size == 0:
             raise SimulationInputError(f"node set for {role.replace('_', ' ')} is empty in {inp}")
@@ -422,11 +427,12 @@ def calculix_modal_model(frd: str | os.PathLike, inp: str | os.PathLike, wall_le
     model = ModalModel(
         frequencies_hz=result.frequencies[chosen], damping_ratios=damping_ratios(chosen.size),
         phi_wall_left=values["wall_left"] * sign, phi_wall_right=values["wall_right"] * sign,
-        phi_tip=values["tip"] * sign, participation=gamma, source=f"CalculiX job {frd.name} (sim.calculix)")
+        phi_tip=values["tip"] * sign, participation=gamma, source=f"CalculiX job {frd.name} (sim.calculix)",
+        phi_floor=values["floor"] * sign if floor else None, beam_mass=beam_mass)
     coords = {node: xyz for node, xyz in zip(deck.node_ids, deck.coordinates * length_unit)}
     provenance = {
         "model": "CalculiX eigenvectors (sim.calculix)", "frd": str(frd), "inp": str(inp), "dat": str(dat),
-        "units": units, "node_sets": {"wall_left": wall_left, "wall_right": wall_right, "tip": tip},
+        "units": units, "node_sets": dict(named),
         "node_set_sizes": {role: int(ids.size) for role, ids in sets.items()},
         "node_set_centres_m": {role: np.mean([coords[n] for n in ids if n in coords], axis=0).tolist()
                                for role, ids in sets.items()},

@@ -64,6 +64,10 @@ def add_modes_arguments(parser: argparse.ArgumentParser) -> None:
     solid.add_argument("--wall-right", dest="wall_right", metavar="NSET", help="--from-calculix: node set of the right wall")
     solid.add_argument("--tip", metavar="NSET", help="--from-calculix: node set of the measurement point")
     solid.add_argument("--dat", metavar="JOB.dat", help="--from-calculix: the job's .dat (default: beside the .frd)")
+    solid.add_argument("--floor", metavar="NSET",
+                       help="--from-calculix: node set of the cavity floor under the sphere (phi_floor, for friction)")
+    solid.add_argument("--beam-mass", dest="beam_mass", type=float, metavar="KG",
+                       help="--from-calculix: mass of the beam's free length without the block in kg (for Eq. 10)")
     solid.add_argument("--units", default="m-kg-s", choices=("m-kg-s", "mm-t-s"),
                        help="--from-calculix: the job's consistent units (default m-kg-s)")
 
@@ -195,7 +199,8 @@ def _external_model(args: argparse.Namespace) -> tuple[Any, dict | None, list[st
     if missing:
         raise SimulationInputError(f"--from-calculix also needs {', '.join(missing)}")
     result = calculix_modal_model(args.from_calculix, args.mesh, args.wall_left, args.wall_right, args.tip,
-                                  dat=args.dat, units=args.units, n_modes=args.n_modes)
+                                  dat=args.dat, units=args.units, n_modes=args.n_modes, floor=args.floor,
+                                  beam_mass=args.beam_mass)
     return result.model, result.provenance, result.report
 
 
@@ -211,7 +216,8 @@ def modes_command(args: argparse.Namespace) -> int:
         raise SimulationInputError(f"--n-modes must lie in 1..30, got {args.n_modes}")
     if args.solid or args.from_calculix:
         model, provenance, report = _external_model(args)
-    elif args.mesh or args.geometry or args.wall_left or args.wall_right or args.tip or args.dat:
+    elif args.mesh or args.geometry or args.wall_left or args.wall_right or args.tip or args.dat or args.floor \
+            or args.beam_mass is not None:
         raise SimulationInputError("--mesh, --geometry, --wall-left, --wall-right, --tip and --dat belong to --solid "
                                    "or --from-calculix")
     elif args.model:

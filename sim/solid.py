@@ -665,14 +665,20 @@ def solve_solid_modes(solid: SolidMesh, n_modes: int = 9) -> SolidModes:
 def solid_modal_model(modes: SolidModes, patch_radius: float = 0.0,
                       wall_points: tuple[Sequence[float], Sequence[float]] | None = None) -> ModalModel:
     """The modal model of Eq. 7 from solid modes: frequencies, damping (sim.rig.damping_ratios), wall values (see
-    SolidModes.wall_values), tip values and x-participation, each mode signed so its mean wall value is positive."""
+    SolidModes.wall_values), tip values and x-participation, each mode signed so its mean wall value is positive;
+    the beam mass of Eq. 10 (density times the free length's volume) and the floor values of Appendix C (x-values
+    at the two groove edges the sphere rests on, averaged; without a groove the floor's centre)."""
     left, right = modes.wall_values(patch_radius=patch_radius, points=wall_points)
     sign = np.where(left + right < 0, -1.0, 1.0)
     s = modes.solid
+    g = s.geometry
+    half = 0.5 * g.groove_width if g.groove_depth > 0 else 0.0
+    floor = modes.values_at(np.array([[0.0, -half, g.floor_height], [0.0, half, g.floor_height]])).mean(axis=0)
     return ModalModel(
         frequencies_hz=modes.frequencies_hz, damping_ratios=damping_ratios(modes.n_modes),
         phi_wall_left=sign * left, phi_wall_right=sign * right, phi_tip=sign * modes.tip_values,
-        participation=sign * modes.participation[:, 0],
+        participation=sign * modes.participation[:, 0], beam_mass=s.material.rho * g.beam_volume,
+        phi_floor=sign * floor,
         source=f"3D solid model (sim.solid, {s.element}, element size {1e3 * s.element_size:g} mm, "
                f"{s.n_free} free DOFs, E = {s.material.E / 1e9:g} GPa)")
 

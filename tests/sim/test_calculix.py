@@ -56,6 +56,18 @@ def test_shipped_job_reads_and_matches_the_solid_model():
     np.testing.assert_allclose(result.model.participation, solid.participation, rtol=4e-3)
 
 
+def test_floor_node_set_and_beam_mass_reach_the_modal_file(tmp_path):
+    """--floor NSET gives phi_floor (the set's mean x-values, signed as the walls), --beam-mass the key of Eq. 10;
+    both survive the modal file."""
+    result = calculix_modal_model(DATA / "beam.frd", DATA / "beam.inp", n_modes=2, floor="TIP", beam_mass=0.0283, **SETS)
+    np.testing.assert_array_equal(result.model.phi_floor, result.model.phi_tip)
+    assert result.provenance["node_sets"]["floor"] == "TIP"
+    saved = load_modal_model(save_modal_model(result.model, tmp_path / "ccx.toml"))
+    assert saved.beam_mass == 0.0283 and np.allclose(saved.phi_floor, result.model.phi_tip)
+    with pytest.raises(SimulationInputError, match="--beam-mass must be a positive mass"):
+        calculix_modal_model(DATA / "beam.frd", DATA / "beam.inp", n_modes=2, beam_mass=-1.0, **SETS)
+
+
 def test_readers_on_the_shipped_job():
     frd = read_frd(DATA / "beam.frd")
     assert frd.mode_numbers.tolist() == [1, 2, 3, 4, 5]

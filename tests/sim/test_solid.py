@@ -100,6 +100,15 @@ def test_timoshenko_cantilever_frequencies_tip_values_participation(stocky_modes
     assert np.max(np.abs(model.phi_tip / tip_ref - 1)) < 1.5e-3
 
 
+def test_beam_mass_and_floor_values_for_eq_10_and_friction(stocky_modes):
+    """The modal file's keys of the damped law and friction: the free length's mass (rho times volume) and, without
+    a cavity, the floor values at the free end's centre, which are the cantilever's tip values (Timoshenko)."""
+    _, modes = stocky_modes
+    model = solid_modal_model(modes)
+    assert model.beam_mass == pytest.approx(RHO * 0.4 * 0.010 * 0.008, rel=1e-12)
+    np.testing.assert_allclose(model.phi_floor, TimoshenkoCantilever(0.4, 0.010, 0.008).modes(5)[1], rtol=5e-3)
+
+
 def test_euler_bernoulli_slender_cantilever():
     """L/h = 80: Euler-Bernoulli applies (Timoshenko's correction of mode 5 is 0.3 %); tip value 2/sqrt(rho A L).
     The section is 5 x 4 mm: a square one would make x- and y-bending degenerate, and their computed eigenvectors
