@@ -242,3 +242,78 @@ def simulated_contacts(states: np.ndarray, samples_per_period: int, Omega: float
     step = 2.0 * np.pi / Omega / M
     return SimulatedContacts(t0 + (first + 0.5) * step, tuple("left" if p > 0 else "right" for p in impulses),
                              impulses, first, last)
+
+
+def trace_restitution(signal: Signal, excitation_hz: float, a_base: float, clearance: float, m_a: float,
+                      wall: str = "tip") -> tuple[float, int]:
+    """The modal coefficient of restitution r of Eq. D.1 from a saved time history alone (the columns of `ies trace`:
+    t from phase 0 of q_base = a_base cos(Omega t), q_tip or q_wall_left/right, q_sphere, q_wall_left/right and the
+    contact forces f_left, f_right): an independent check of the simulator's `restitution` (`sim.measures`).
+
+    Contacts are the runs of samples with a contact force. Between contacts the sphere flies at constant absolute
+    velocity (Eq. 3), so a straight line through the absolute sphere displacement q_sphere + q_base of each free
+    flight gives its velocity and, where that line meets the wall (indentation 0 with the clearance, m), the onset and
+    release times. q_mod' is the velocity of the fundamental harmonic of the tip (`wall="tip"`) or of the wall that
+    is hit (`wall="wall"`), c_1 by the DFT of the samples of the impact's period. r is the median over the significant
+    impacts (`sim.measures.significant_impacts`, impulse = m_a (kg) times the change of the sphere's velocity) of the
+    last `sim.measures.RESTITUTION_PERIODS` periods. Returns (r, number of impacts used); excitation_hz (Hz),
+    a_base (m)."""
+    from sim.energy import IMPACT_DTYPE
+    from sim.measures import RESTITUTION_PERIODS, modal_restitution, significant_impacts
+
+    t = signal.t
+    Omega = 2.0 * np.pi * excitation_hz
+    M = int(round(signal.fs / excitation_hz))
+    n_periods = t.size // M
+    if n_periods < 1 or abs(M * excitation_hz / signal.fs - 1.0) > 1e-6:
+        raise SimulationInputError("trace_restitution needs a whole number of samples per excitation period (ies trace)")
+    q_abs = signal["q_sphere"] + a_base * np.cos(Omega * t)
+    touching = (signal["f_left"] > 0.0) | (signal["f_right"] < 0.0)
+    edges = np.flatnonzero(np.diff(touching.astype(np.int8)))
+    firsts = edges[::2] + 1 if not touching[0] else edges[1::2] + 1
+    lasts = edges[1::2] if not touching[0] else edges[2::2]
+    firsts = firsts[:lasts.size]
+
+    def line(a: int, b: int) -> np.ndarray | None:  # the free flight over samples a..b: (velocity, offset)
+        return np.polyfit(t[a:b + 1], q_abs[a:b + 1], 1) if b - a >= 1 else None
+
+    fits = [line(lasts[k - 1] + 1 if k else 0, firsts[k] - 1) for k in range(firsts.size)]
+    fits.append(line(lasts[-1] + 1, t.size - 1) if lasts.size else None)
+    rows = []
+    for k, (first, last) in enumerate(zip(firsts, lasts)):
+        before, after = fits[k], fits[k + 1]
+        if before is None or after is None or last + 1 >= t.size:
+            continue
+        left = signal["f_left"][first:last + 1].max() > 0.0
+        q_wall = signal["q_wall_left" if left else "q_wall_right"] + a_base * np.cos(Omega * t)
+        sign = 1.0 if left else -1.0
+
+        def closing(i: int, fit: np.ndarray) -> float:  # the indentation of the line at sample i (m)
+            return sign * (q_wall[i] - np.polyval(fit, t[i])) - clearance
+
+        c0, c1 = closing(first - 1, before), closing(first, before)
+        t_on = t[first - 1] + (t[first] - t[first - 1]) * c0 / (c0 - c1)
+        c0, c1 = closing(last, after), closing(last + 1, after)
+        t_off = t[last] + (t[last + 1] - t[last]) * c0 / (c0 - c1)
+        period = int(t_on * excitation_hz)
+        rows.append((0.0 if left else 1.0, period, t_on - period / excitation_hz, t_off - t_on,
+                     m_a * abs(after[0] - before[0]), np.nan,
+                     before[0] + a_base * Omega * np.sin(Omega * t_on), after[0] + a_base * Omega * np.sin(Omega * t_off),
+                     np.nan, np.nan, np.nan, np.nan))
+    records = np.array(rows, dtype=IMPACT_DTYPE) if rows else np.zeros(0, dtype=IMPACT_DTYPE)
+    records = records[records["period"] < n_periods]
+    if records.size == 0:
+        return float("nan"), 0
+    chosen = records[significant_impacts(records)]
+    chosen = chosen[chosen["period"] >= n_periods - RESTITUTION_PERIODS]
+    phase = np.exp(-1j * Omega * t[:n_periods * M]).reshape(n_periods, M)
+
+    def fundamental(column: str) -> np.ndarray:
+        return 2.0 / M * np.sum(signal[column][:n_periods * M].reshape(n_periods, M) * phase, axis=1)
+
+    if wall == "tip":
+        r = modal_restitution(chosen, fundamental("q_tip"), Omega)
+    else:
+        r = np.where(chosen["wall"] == 0, modal_restitution(chosen, fundamental("q_wall_left"), Omega),
+                     modal_restitution(chosen, fundamental("q_wall_right"), Omega))
+    return (float(np.median(r)), int(r.size)) if r.size else (float("nan"), 0)
