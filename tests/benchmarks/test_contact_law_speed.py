@@ -9,15 +9,12 @@ CPU times (medians), at the strongly modulated and the almost periodic point of 
 
 Run: pytest -m benchmark tests/benchmarks/test_contact_law_speed.py -s
 """
-import io
 import os
-import subprocess
-import sys
-import tarfile
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _ab import pairs, worker
 
 pytestmark = pytest.mark.benchmark
 ROOT = Path(__file__).resolve().parents[2]
@@ -28,42 +25,15 @@ POINTS = [(0.99, None, "strongly modulated"), (0.978, 0.99, "almost periodic")]
 
 
 @pytest.fixture(scope="module")
-def baseline_tree(tmp_path_factory):
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", BASELINE_REV], check=True, capture_output=True).stdout
-    target = tmp_path_factory.mktemp("baseline")
-    with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
-        tar.extractall(target)
-    return target
-
-
-def _worker(tree: Path, eta: float, prepare: float | None, integrator: str, r_cont: float = 1.0) -> subprocess.Popen:
-    proc = subprocess.Popen([sys.executable, str(Path(__file__).with_name("_point_worker.py")), str(tree), str(eta),
-                             "-" if prepare is None else str(prepare), integrator, str(r_cont)],
-                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-    assert proc.stdout.readline().strip() == "ready"
-    return proc
-
-
-def _pairs(workers: dict) -> dict[str, list[float]]:
-    times = {name: [] for name in workers}
-    try:
-        for _ in range(REPEATS):
-            for name, proc in workers.items():
-                proc.stdin.write("run\n")
-                proc.stdin.flush()
-                times[name].append(float(proc.stdout.readline()))
-    finally:
-        for proc in workers.values():
-            proc.stdin.close()
-            proc.wait()
-    return times
+def baseline_tree(tree_at):
+    return tree_at(BASELINE_REV)
 
 
 @pytest.mark.parametrize("integrator", ["exact", "ode3"])
 @pytest.mark.parametrize("eta, prepare, label", POINTS)
 def test_elastic_law_costs_what_it_did(baseline_tree, integrator, eta, prepare, label):
-    times = _pairs({"before": _worker(baseline_tree, eta, prepare, integrator),
-                    "after": _worker(ROOT, eta, prepare, integrator)})
+    times = pairs({"before": worker(baseline_tree, eta, prepare, integrator),
+                   "after": worker(ROOT, eta, prepare, integrator)}, REPEATS)
     ratio = float(np.median(np.array(times["after"]) / np.array(times["before"])))
     print(f"\n{integrator}, {label} (7.4, eta {eta}), r_cont 1: before {np.median(times['before']) * 1e3:.1f} ms, "
           f"after {np.median(times['after']) * 1e3:.1f} ms CPU per point; median ratio of the pairs {ratio:.3f}")
@@ -73,8 +43,8 @@ def test_elastic_law_costs_what_it_did(baseline_tree, integrator, eta, prepare, 
 @pytest.mark.parametrize("integrator", ["exact", "ode3"])
 @pytest.mark.parametrize("eta, prepare, label", POINTS)
 def test_cost_of_the_damped_law(integrator, eta, prepare, label):
-    times = _pairs({"elastic": _worker(ROOT, eta, prepare, integrator),
-                    "damped": _worker(ROOT, eta, prepare, integrator, 0.99)})
+    times = pairs({"elastic": worker(ROOT, eta, prepare, integrator),
+                   "damped": worker(ROOT, eta, prepare, integrator, "0.99")}, REPEATS)
     ratio = float(np.median(np.array(times["damped"]) / np.array(times["elastic"])))
     print(f"\n{integrator}, {label} (7.4, eta {eta}): elastic {np.median(times['elastic']) * 1e3:.1f} ms, damped "
           f"(r_cont 0.99) {np.median(times['damped']) * 1e3:.1f} ms CPU per point; median ratio {ratio:.2f}")

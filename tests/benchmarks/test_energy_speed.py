@@ -6,14 +6,11 @@ test_exact_speed.py (7.4 / eta 0.99 from rest, 0.978 after a down-sweep). The ba
 Run: pytest -m benchmark tests/benchmarks/test_energy_speed.py -s
 """
 import os
-import subprocess
-import sys
-import tarfile
-import io
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _ab import pairs, worker
 
 pytestmark = pytest.mark.benchmark
 ROOT = Path(__file__).resolve().parents[2]
@@ -23,40 +20,13 @@ REPEATS = 11
 
 
 @pytest.fixture(scope="module")
-def baseline_tree(tmp_path_factory):
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", BASELINE_REV], check=True, capture_output=True).stdout
-    target = tmp_path_factory.mktemp("baseline")
-    with tarfile.open(fileobj=io.BytesIO(archive)) as tar:
-        tar.extractall(target)
-    return target
-
-
-def _worker(tree: Path, eta: float, prepare: float | None) -> subprocess.Popen:
-    proc = subprocess.Popen([sys.executable, str(Path(__file__).with_name("_point_worker.py")), str(tree), str(eta),
-                             "-" if prepare is None else str(prepare)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                            text=True)
-    assert proc.stdout.readline().strip() == "ready"
-    return proc
-
-
-def _time(proc: subprocess.Popen) -> float:
-    proc.stdin.write("run\n")
-    proc.stdin.flush()
-    return float(proc.stdout.readline())
+def baseline_tree(tree_at):
+    return tree_at(BASELINE_REV)
 
 
 @pytest.mark.parametrize("eta, prepare, label", [(0.99, None, "strongly modulated"), (0.978, 0.99, "almost periodic")])
 def test_bookkeeping_costs_at_most_15_percent(baseline_tree, eta, prepare, label):
-    workers = {"before": _worker(baseline_tree, eta, prepare), "after": _worker(ROOT, eta, prepare)}
-    times = {name: [] for name in workers}
-    try:
-        for _ in range(REPEATS):
-            for name, proc in workers.items():
-                times[name].append(_time(proc))
-    finally:
-        for proc in workers.values():
-            proc.stdin.close()
-            proc.wait()
+    times = pairs({"before": worker(baseline_tree, eta, prepare), "after": worker(ROOT, eta, prepare)}, REPEATS)
     before, after = (float(np.median(times[name])) for name in ("before", "after"))
     ratio = float(np.median(np.array(times["after"]) / np.array(times["before"])))  # pairs measured back to back
     print(f"\n{label} (7.4, eta {eta}): before {before * 1e3:.1f} ms, after {after * 1e3:.1f} ms CPU per point "

@@ -1,0 +1,34 @@
+"""Same-run A/B timings of one stepped-sine point: worker processes (`_point_worker.py`) on two source trees,
+asked in turn, so that every pair of CPU times is measured back to back on the same machine load."""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+WORKER = Path(__file__).with_name("_point_worker.py")
+
+
+def worker(tree: Path, eta: float, prepare: float | None, *options: str) -> subprocess.Popen:
+    """A worker on `tree` at eta (prepared by a down-sweep from `prepare`, or None), ready to answer "run";
+    options: INTEGRATOR [R_CONT] of `_point_worker.py`."""
+    proc = subprocess.Popen([sys.executable, str(WORKER), str(tree), str(eta), "-" if prepare is None else str(prepare),
+                             *options], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "ready"
+    return proc
+
+
+def pairs(workers: dict[str, subprocess.Popen], repeats: int) -> dict[str, list[float]]:
+    """CPU seconds per point of each worker, `repeats` rounds of one point each, in turn; the workers are closed."""
+    times: dict[str, list[float]] = {name: [] for name in workers}
+    try:
+        for _ in range(repeats):
+            for name, proc in workers.items():
+                proc.stdin.write("run\n")
+                proc.stdin.flush()
+                times[name].append(float(proc.stdout.readline()))
+    finally:
+        for proc in workers.values():
+            proc.stdin.close()
+            proc.wait()
+    return times
