@@ -3,8 +3,9 @@ test_contact_law_speed.py): imports `sim` from the tree given on the command lin
 answers every line "run" on stdin with the CPU seconds of one point (3 s wait + 5 s hold at a_base/a_base* = 7.4),
 with the energy bookkeeping and impact measures where the tree has them (`sim.energy.Ledger`).
 
-Arguments: TREE ETA PREPARE [INTEGRATOR [R_CONT]]: PREPARE "-" starts from the base velocity, else a down-sweep
-from that eta; INTEGRATOR exact (default) or ode3; R_CONT < 1: the damped contact law of Eq. 10."""
+Arguments: TREE ETA PREPARE [INTEGRATOR [R_CONT [MU]]]: PREPARE "-" starts from the base velocity, else a down-sweep
+from that eta; INTEGRATOR exact (default) or ode3; R_CONT < 1: the damped contact law of Eq. 10; MU > 0: dry friction
+at the floor (Appendix C, ode3)."""
 import sys
 import time
 
@@ -12,6 +13,7 @@ sys.path.insert(0, sys.argv[1])
 ETA, PREPARE = float(sys.argv[2]), (float(sys.argv[3]) if sys.argv[3] != "-" else None)
 INTEGRATOR = sys.argv[4] if len(sys.argv) > 4 else "exact"
 R_CONT = float(sys.argv[5]) if len(sys.argv) > 5 else 1.0
+MU = float(sys.argv[6]) if len(sys.argv) > 6 else 0.0
 
 import numpy as np  # noqa: E402
 
@@ -30,10 +32,11 @@ except ImportError:
 
 LEVEL = 7.4
 model = seed_rig_model(n_modes=9)
-if R_CONT < 1.0:
+if R_CONT < 1.0 or MU > 0.0:
     from sim.contact_law import ContactLaw
 
-    sys_ = system_arrays(model, Impactor(contact_law=ContactLaw("hertz-damped", R_CONT)))
+    law = ContactLaw("hertz-damped", R_CONT) if R_CONT < 1.0 else ContactLaw()
+    sys_ = system_arrays(model, Impactor(contact_law=law, friction=MU))
 else:
     sys_ = system_arrays(model, Impactor())
 integrator = {"exact": exact, "ode3": ode3}[INTEGRATOR]

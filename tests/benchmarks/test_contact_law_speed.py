@@ -5,7 +5,8 @@ CPU times (medians), at the strongly modulated and the almost periodic point of 
 * the elastic law (r_cont = 1) against the tree before Eq. 10 entered the integrators (git revision BASELINE_REV,
   env IES_BASELINE_REV to change it): the bar is 5 %;
 * the damped law at r_cont,diss = 0.99 against the elastic law of this tree: reported (every contact of the
-  exact integrator then takes the Dormand-Prince pair instead of collocation).
+  exact integrator then takes the Dormand-Prince pair instead of collocation);
+* dry friction (mu = 0.07, Appendix C; ode3 only) against the elastic law without friction: reported.
 
 Run: pytest -m benchmark tests/benchmarks/test_contact_law_speed.py -s
 """
@@ -48,4 +49,14 @@ def test_cost_of_the_damped_law(integrator, eta, prepare, label):
     ratio = float(np.median(np.array(times["damped"]) / np.array(times["elastic"])))
     print(f"\n{integrator}, {label} (7.4, eta {eta}): elastic {np.median(times['elastic']) * 1e3:.1f} ms, damped "
           f"(r_cont 0.99) {np.median(times['damped']) * 1e3:.1f} ms CPU per point; median ratio {ratio:.2f}")
+    assert np.isfinite(ratio)
+
+
+@pytest.mark.parametrize("eta, prepare, label", POINTS)
+def test_cost_of_friction(eta, prepare, label):
+    times = pairs({"frictionless": worker(ROOT, eta, prepare, "ode3"),
+                   "friction": worker(ROOT, eta, prepare, "ode3", "1", "0.07")}, REPEATS)
+    ratio = float(np.median(np.array(times["friction"]) / np.array(times["frictionless"])))
+    print(f"\node3, {label} (7.4, eta {eta}): without friction {np.median(times['frictionless']) * 1e3:.1f} ms, with "
+          f"(mu 0.07) {np.median(times['friction']) * 1e3:.1f} ms CPU per point; median ratio {ratio:.2f}")
     assert np.isfinite(ratio)
