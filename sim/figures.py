@@ -263,7 +263,8 @@ def plot_trace(data: Mapping[str, Any], t: Sequence[float], q_tip: Sequence[floa
         draw_tip_velocity(bottom, t, v_tip, data)
         top.set_title(trace_title(data), fontsize=9)
         top.legend(fontsize=7, loc="upper right", ncols=4)
-        bottom.legend(fontsize=7, loc="upper right", ncols=2)
+        if bottom.get_legend_handles_labels()[0]:  # no impacts (e.g. a sphere at rest under friction): no legend
+            bottom.legend(fontsize=7, loc="upper right", ncols=2)
         save_figure(fig, path)
     finally:
         plt.close(fig)
