@@ -306,7 +306,7 @@ def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list
     out = args.out
     calibrated = False
     for figure, study in zip(figures, studies):
-        if study.kind == "interval" and "k_H" in study.space.names:  # calibrated once, before the first such study
+        if study.kind == "interval" and "k_H" in [p.name for p in study.space.varied]:  # calibrated once, first
             if not calibrated and calibration is None and not args.no_calibration:
                 calibration = run_calibration(calibrate, out)
             if calibration is not None:

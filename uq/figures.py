@@ -30,7 +30,8 @@ from sim.redraw import KINDS, PlotOptions, kind_of, register, selected
 from uq.results import nominal_regimes
 
 _YLABEL = {"mean": "mean resonant level  a / a_noabs*", "max": "max resonant level  a / a_noabs*",
-           "value": "response"}
+           "value": "response", "restitution": "modal coefficient of restitution r (tip)",
+           "restitution_wall": "modal coefficient of restitution r (wall)"}
 _LEVEL = "excitation level  a_base / a_base*"
 _NOISE_NOTE = "error bars: standard error of the repetition mean ({n} runs per point)"
 
@@ -135,6 +136,12 @@ def _marks(ax: Any, band: dict, prefix: str = "") -> None:
                 label=f"{prefix}monotonicity not tested (no noise estimate)")
 
 
+#: the joint band's figure per banded output: file stem and title (Fig. 8 for the response level, Fig. D.3 for r)
+_BOX_FIGURES = {"mean": ("fig8", "Joint variation (cf. Fig. 8)"),
+                "restitution": ("figD3", "Modal coefficient of restitution from the tip, joint variation (cf. Fig. D.3)"),
+                "restitution_wall": ("figD3", "Modal coefficient of restitution from the wall, joint variation (cf. Fig. D.3)")}
+
+
 def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
     """Draw Figs. 7 and 8 (as far as the study has the designs) and the nominal levels from folder/*.csv."""
     folder = Path(folder)
@@ -187,14 +194,17 @@ def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> 
             _band_with_noise(ax, band, color, alpha, f"{label} (+- SE of its edges)")
             _marks(ax, band, prefix=f"{d}: ")
         _errorbar(ax, *nominal, "k.--", label=nominal_text)
+        stem, title = _BOX_FIGURES.get(output, _BOX_FIGURES["mean"])
+        if stem == "figD3":
+            ax.axhline(0.8, color="k", lw=1, ls="-.", alpha=0.6, label="paper: r ~ 0.8 (Fig. D.3)")
         ax.set_xlabel(_LEVEL)
         ax.set_ylabel(_YLABEL.get(output, output))
-        ax.set_title("Joint variation (cf. Fig. 8)", fontsize=10)
+        ax.set_title(title, fontsize=10)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=6)
         fig.text(0.5, 0.005, note, ha="center", fontsize=7)
         fig.tight_layout(rect=(0, 0.03, 1, 1))
-        paths += _save(fig, folder, "fig8", options)
+        paths += _save(fig, folder, stem, options)
         plt.close(fig)
 
     if {"mean", "max"} <= set(meta["outputs"]):
