@@ -117,9 +117,9 @@ NODE_DATA = gauss_nodes()
 
 
 #: The blocks of a table, in their order: P, Q (n x (s+1), mode by mode), W (s x (s+1), column by column), BX,
-#: BV (s x n), BZ, BZD (s), TR (4 x n), TAU (s+1), WQ (s), and the contact work's VC, VD (n x s, mode by mode)
-#: and VS (n x s (s + 1) / 2, mode by mode, the node pairs k <= i). The layouts put the inner loops of the kernels along contiguous
-#: memory.
+#: BV (s x n), BZ, BZD (s), TR (4 x n), TAU (s+1), WQ (s), and the contact work's VC, VD (s x n, node by node)
+#: and VS (s (s + 1) / 2 x n, the node pairs k <= i, pair by pair). The layouts put the inner loops of the kernels
+#: along contiguous memory (for the contact work: along the modes, so that all modes advance together).
 TABLE_BLOCKS = ("P", "Q", "W", "BX", "BV", "BZ", "BZD", "TR", "TAU", "WQ", "VC", "VD", "VS")
 
 
@@ -258,15 +258,15 @@ def _build(tab, nodes, off, kind, h, wall, cst):
         for j in range(n):
             wphi = tab[off.WQ + i] * sgn * _phi(md, j, wall)
             _, _, c, d = transition(tab[off.TAU + i], md, j)
-            tab[off.VC + j * s + i] = wphi * c
-            tab[off.VD + j * s + i] = wphi * d
+            tab[off.VC + i * n + j] = wphi * c
+            tab[off.VD + i * n + j] = wphi * d
     for i in range(s):
         for k in range(i + 1):
             for j in range(n):
                 pair = tab[off.WQ + i] * sgn * _phi(md, j, wall) * vel[i, k, j]
                 if k < i:
                     pair += tab[off.WQ + k] * sgn * _phi(md, j, wall) * vel[k, i, j]
-                tab[off.VS + j * (s * (s + 1) // 2) + (i * (i + 1)) // 2 + k] = pair
+                tab[off.VS + ((i * (i + 1)) // 2 + k) * n + j] = pair
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -276,7 +276,8 @@ class WorkRows(NamedTuple):
     """Rows of the workspace (`Workspace.rows`) of `contact`: at the nodes and the end (s + 1 entries) the free
     closing function `chom`, its rate `dchom` and the right-hand side `rhs`; at the nodes the indentations
     `delta`, forces `F` and dF/d delta `D`; the states `Ynew` (a step's end) and `Ys` (a release step's
-    start); the backward series `Fs` of the force; the products F_i F_k (k <= i) of the nodal forces `pairs`."""
+    start); the backward series `Fs` of the force; the products F_i F_k (k <= i) of the nodal forces `pairs`;
+    the modes' contact work of a step `work`."""
 
     chom: int
     dchom: int
@@ -288,6 +289,7 @@ class WorkRows(NamedTuple):
     Ys: int
     Fs: int
     pairs: int
+    work: int
 
 
 ROW = WorkRows(*range(len(WorkRows._fields)))
@@ -468,40 +470,35 @@ def _newton(step, ws, kH):
 
 
 @kernel(fastmath=True)
-def _contact_work(tab, off, Y, Yout, F, FF):
+def _contact_work(tab, off, Y, Yout, F, FF, G):
     """Yout[G + j] += the contact work of mode j's deviation over the step of the table `tab` (layout `off`),
     int sgn phi_w,j F x_j' dt (Gauss quadrature at the nodes of the exact modal velocities there: blocks VC, VD,
-    VS), with FF the scratch for the s (s + 1) / 2 products F_i F_k. Bookkeeping only, so the sums may be
-    reordered (fastmath: vectorised dot products)."""
+    VS), with FF the scratch for the s (s + 1) / 2 products F_i F_k and G for the n sums. The modes are the inner
+    loops (contiguous in the table): they advance together in vector registers. Bookkeeping only, so the sums
+    may be reordered (fastmath)."""
     lay = state_layout(off.n)
+    n = lay.n
     s = off.s
-    pairs = s * (s + 1) // 2
     m = 0
     for i in range(s):
         for k in range(i + 1):
             FF[m] = F[i] * F[k]
             m += 1
-    for j in range(lay.n):
-        vc = off.VC + j * s
-        vd = off.VD + j * s
-        hc = 0.0
-        hd = 0.0
-        for i in range(s):
-            hc += tab[vc + i] * F[i]
-            hd += tab[vd + i] * F[i]
-        row = off.VS + j * pairs
-        q0 = q1 = q2 = q3 = 0.0  # four independent sums: the additions need not wait for each other
-        m = 0
-        while m + 4 <= pairs:
-            q0 += tab[row + m] * FF[m]
-            q1 += tab[row + m + 1] * FF[m + 1]
-            q2 += tab[row + m + 2] * FF[m + 2]
-            q3 += tab[row + m + 3] * FF[m + 3]
-            m += 4
-        while m < pairs:
-            q0 += tab[row + m] * FF[m]
-            m += 1
-        Yout[lay.G + j] += hc * Y[lay.x + j] + hd * Y[lay.v + j] + (q0 + q1) + (q2 + q3)
+    for j in range(n):
+        G[j] = 0.0
+    for i in range(s):
+        f = F[i]
+        vc = off.VC + i * n
+        vd = off.VD + i * n
+        for j in range(n):
+            G[j] += f * (tab[vc + j] * Y[lay.x + j] + tab[vd + j] * Y[lay.v + j])
+    for q in range(m):
+        ff = FF[q]
+        row = off.VS + q * n
+        for j in range(n):
+            G[j] += tab[row + j] * ff
+    for j in range(n):
+        Yout[lay.G + j] += G[j]
 
 
 @kernel
@@ -939,7 +936,7 @@ def contact(Y, t, t_stop, wall, ctx, cst):
                 return FALLBACK, t, steps
             continue
         if book:  # the accepted step's contact work (F still holds its nodal forces)
-            _contact_work(step.tab, step.off, Y, Ynew, F, rows[ROW.pairs])
+            _contact_work(step.tab, step.off, Y, Ynew, F, rows[ROW.pairs], rows[ROW.work])
         Y[:] = Ynew
         t += h
         norm = 1.5 - 0.5 * (c1 * c1 + s1 * s1)  # keeps cos^2 + sin^2 = 1 to rounding
@@ -979,7 +976,7 @@ def contact(Y, t, t_stop, wall, ctx, cst):
                     _overlap_work(S, Fs, d, wall, cst, Ynew, Ys)
                 _end_state(step, Ynew, Y, F, cs, ss, wall)
                 if book:
-                    _contact_work(step.tab, step.off, Ynew, Y, F, rows[ROW.pairs])
+                    _contact_work(step.tab, step.off, Ynew, Y, F, rows[ROW.pairs], rows[ROW.work])
                 return RELEASED, t - d + h_k, steps + 1
             # the contact lasts longer than predicted, or its end is not resolved: a regular step first
         k = _ladder(min(R / 1.6, _MAX_STEP_PERIODS * h_ref), h_ref, False)

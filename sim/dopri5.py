@@ -49,19 +49,27 @@ DOPRI5 = ButcherTableau(
 class Work(NamedTuple):
     """Scratch of the Dormand-Prince contact: K (7 x size) the stage derivatives, `stage` the state of a
     stage, `end` the state at a step's end, `memo` the two step-length laws of `contact`, `counters` (int64,
-    indexed by `sim.flight.COUNT`)."""
+    indexed by `sim.flight.COUNT`); `damped`: () for the elastic law (Eq. 4), (True,) with Eq. 10's damping;
+    `book`: (True,) when the energy bookkeeping's integrals (G_j, Dc) are carried, () when not (no ledger).
+
+    `damped` and `book` are types, not values: the kernels are compiled once per combination, and a contact
+    carries no trace of what it does not compute (a branch on par.c_damp inside the stages made elastic runs 4 %
+    slower, measured)."""
 
     K: np.ndarray
     stage: np.ndarray
     end: np.ndarray
     memo: np.ndarray
     counters: np.ndarray
+    damped: tuple
+    book: tuple
 
 
-def work(size: int, counters: np.ndarray) -> Work:
-    """A fresh `Work` for deviation states of length `size`, counting into `counters`."""
+def work(size: int, counters: np.ndarray, damped: bool = False, book: bool = True) -> Work:
+    """A fresh `Work` for deviation states of length `size`, counting into `counters`; damped: the contact law
+    has Eq. 10's damping (par.c_damp > 0); book: carry the energy bookkeeping's integrals."""
     return Work(K=np.zeros((7, size)), stage=np.zeros(size), end=np.zeros(size), memo=np.zeros(2),
-                counters=counters)
+                counters=counters, damped=(True,) if damped else (), book=(True,) if book else ())
 
 
 # No fastmath: reassociation lets each compiled specialisation round differently, and the chaotic response
@@ -84,10 +92,10 @@ def _wall_rate(ct, st, Y, left, cst):
 
 
 @kernel(inline="always", fastmath=_FAST)
-def rhs(ct, st, Y, out, cst):
+def rhs(ct, st, Y, out, cst, book):
     """Eqs. 3-7 with the elastic law (Eq. 4) in the deviation coordinates at cos, sin(Omega t) = ct, st, plus the
-    integrands of F_l, F_r, of each mode's contact work G_j and of the contact's dissipation Dc (0 here; `_damping`
-    adds Eq. 10's) (`sim.flight.StateLayout`)."""
+    integrands of F_l, F_r and, when booking (`Work.book`), of each mode's contact work G_j
+    (`sim.flight.StateLayout`); the contact's dissipation Dc is `_damping`'s (Eq. 10): here it stays 0."""
     md, par = cst.modes, cst.par
     lay = flight.state_layout(md.size)
     g = par.g
@@ -101,12 +109,12 @@ def rhs(ct, st, Y, out, cst):
     kH = par.k_H
     fl = kH * dl * math.sqrt(dl) if dl > 0.0 else 0.0
     fr = -kH * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
-    out[lay.Dc] = 0.0
     for j in range(lay.n):
         v = Y[lay.v + j]
         out[lay.x + j] = v
         out[lay.v + j] = -2.0 * md[j].sig * v - md[j].w2 * Y[lay.x + j] - md[j].phi_l * fl - md[j].phi_r * fr
-        out[lay.G + j] = (md[j].phi_l * fl + md[j].phi_r * fr) * v
+        if len(book) > 0:
+            out[lay.G + j] = (md[j].phi_l * fl + md[j].phi_r * fr) * v
     out[lay.z] = Y[lay.zd]
     out[lay.zd] = (fl + fr) * par.inv_m_a
     out[lay.F_l] = fl * ct
@@ -151,10 +159,11 @@ def _damping(ct, st, Y, out, cst):
 
 
 @kernel(inline="always", fastmath=_FAST)
-def forces(ct, st, Y, out, cst):
-    """The right-hand side of the contact (`rhs`) with the damping of Eq. 10 when the law has it."""
-    rhs(ct, st, Y, out, cst)
-    if cst.par.c_damp > 0.0:
+def forces(ct, st, Y, out, cst, damped, book):
+    """The right-hand side of the contact (`rhs`) with the damping of Eq. 10 when the law has it (damped, book:
+    `Work.damped`, `Work.book`; for () their branches are removed at compile time)."""
+    rhs(ct, st, Y, out, cst, book)
+    if len(damped) > 0:
         _damping(ct, st, Y, out, cst)
 
 
@@ -178,11 +187,11 @@ def _combine(Y, K, d, row, out, m):
 
 
 @kernel(inline="always", fastmath=_FAST)
-def _stage(Y, K, tmp, d, row, k, phase, cst):
+def _stage(Y, K, tmp, d, row, k, phase, cst, damped, book):
     """Stage k: its state Y + sum_j row[j] d[j] K[j] in tmp, and K[k] = F there, at cos, sin(Omega t) = phase.
     Only the mechanical state: the right-hand side does not depend on the carried integrals."""
     _combine(Y, K, d, row, tmp, flight.state_layout(cst.modes.size).acc)
-    forces(phase[0], phase[1], tmp, K[k], cst)
+    forces(phase[0], phase[1], tmp, K[k], cst, damped, book)
 
 
 @kernel(inline="always", fastmath=_FAST)
@@ -217,14 +226,15 @@ def step(Y, ct0, st0, s, kind, work, cst):
     p5, d5 = _warp(kind, c[4], s)
     _, d6 = _warp(kind, c[5], s)
     d = (d1, d2, d3, d4, d5, d6, d6)
-    _stage(Y, K, tmp, d, a[1], 1, flight.rotate(ct0, st0, Om * p2), cst)
-    _stage(Y, K, tmp, d, a[2], 2, flight.rotate(ct0, st0, Om * p3), cst)
-    _stage(Y, K, tmp, d, a[3], 3, flight.rotate(ct0, st0, Om * p4), cst)
-    _stage(Y, K, tmp, d, a[4], 4, flight.rotate(ct0, st0, Om * p5), cst)
+    _stage(Y, K, tmp, d, a[1], 1, flight.rotate(ct0, st0, Om * p2), cst, work.damped, work.book)
+    _stage(Y, K, tmp, d, a[2], 2, flight.rotate(ct0, st0, Om * p3), cst, work.damped, work.book)
+    _stage(Y, K, tmp, d, a[3], 3, flight.rotate(ct0, st0, Om * p4), cst, work.damped, work.book)
+    _stage(Y, K, tmp, d, a[4], 4, flight.rotate(ct0, st0, Om * p5), cst, work.damped, work.book)
     ct, st = flight.rotate(ct0, st0, Om * s)
-    _stage(Y, K, tmp, d, a[5], 5, (ct, st), cst)
-    _combine(Y, K, d, DOPRI5.b, Ynew, Y.size)
-    forces(ct, st, Ynew, K[6], cst)
+    _stage(Y, K, tmp, d, a[5], 5, (ct, st), cst, work.damped, work.book)
+    # the carried integrals up to G always (Fourier), G and Dc only when booking (else they stay 0)
+    _combine(Y, K, d, DOPRI5.b, Ynew, Y.size if len(work.book) > 0 else lay.G)
+    forces(ct, st, Ynew, K[6], cst, work.damped, work.book)
     err = 0.0
     for j in range(lay.n):
         err = max(err, abs(_error(K, d, lay.x + j)) * md[j].err_x)
@@ -333,7 +343,7 @@ def contact(Y, t, t_stop, h, at_onset, work, cst):
     Om = par.Omega
     ct = math.cos(Om * t)  # the phase at t, carried along by rotations
     st = math.sin(Om * t)
-    forces(ct, st, Y, K[0], cst)
+    forces(ct, st, Y, K[0], cst, work.damped, work.book)
     cl, cld, cr, crd = flight.closing_at(Y, ct, st, cst)
     wall_left = cl > cr  # the wall in contact (or about to be)
     open_l = cl <= 0.0

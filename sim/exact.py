@@ -502,13 +502,12 @@ def _close_period(Y, X0, T, cst, row):
 
 
 @kernel(inline="always")
-def _modal_energies(Y, t, cst):
-    """(E_1, sum_{j >= 2} E_j) in J, E_j = (s_j'^2 + omega_j^2 s_j^2)/2, at phase time t from the deviation state Y."""
+def _modal_energies(Y, ct, st, cst):
+    """(E_1, sum_{j >= 2} E_j) in J, E_j = (s_j'^2 + omega_j^2 s_j^2)/2, from the deviation state Y at the phase
+    with cos, sin(Omega t) = ct, st."""
     md, par = cst.modes, cst.par
     lay = state_layout(md.size)
     Om = par.Omega
-    ct = math.cos(Om * t)
-    st = math.sin(Om * t)
     first = 0.0
     higher = 0.0
     for j in range(lay.n):
@@ -530,16 +529,18 @@ def _log_onset(Y, t, p, wall, cst, log, count):
     count[0] += 1
     if i >= log.shape[0]:
         return -1
-    cl, cld, cr, crd = flight.closing(Y, t, cst)
-    lay = state_layout(cst.modes.size)
     par = cst.par
-    e1, eh = _modal_energies(Y, t, cst)
+    ct = math.cos(par.Omega * t)
+    st = math.sin(par.Omega * t)
+    cl, cld, cr, crd = flight.closing_at(Y, ct, st, cst)
+    lay = state_layout(cst.modes.size)
+    e1, eh = _modal_energies(Y, ct, st, cst)
     row = log[i]
     row[IMPACT.wall] = wall
     row[IMPACT.period] = p
     row[IMPACT.t_onset] = t
     row[IMPACT.approach_speed] = cld if wall == 0 else crd
-    row[IMPACT.sphere_before] = Y[lay.zd] + par.a_base * par.Omega * math.sin(par.Omega * t)
+    row[IMPACT.sphere_before] = Y[lay.zd] + par.a_base * par.Omega * st
     row[IMPACT.fundamental_onset] = e1
     row[IMPACT.higher_onset] = eh
     row[IMPACT.duration] = math.nan
@@ -558,8 +559,10 @@ def _log_release(Y, t, p, T, cst, log, i):
     lay = state_layout(cst.modes.size)
     par = cst.par
     row = log[i]
-    e1, eh = _modal_energies(Y, t, cst)
-    after = Y[lay.zd] + par.a_base * par.Omega * math.sin(par.Omega * t)
+    ct = math.cos(par.Omega * t)
+    st = math.sin(par.Omega * t)
+    e1, eh = _modal_energies(Y, ct, st, cst)
+    after = Y[lay.zd] + par.a_base * par.Omega * st
     row[IMPACT.duration] = (p - row[IMPACT.period]) * T + t - row[IMPACT.t_onset]
     row[IMPACT.impulse] = par.m_a * abs(after - row[IMPACT.sphere_before])
     row[IMPACT.sphere_after] = after
@@ -766,10 +769,12 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     stored_start = stored_energy(y, sys) if ledger is not None else math.nan
     # collocation solves the elastic law (Eq. 4); the damped law (Eq. 10) takes the Dormand-Prince contact
     use_collocation = contacts == "collocation" and fixed_contact_step <= 0.0 and sys.c_damp == 0.0
+    damped = sys.c_damp > 0.0
     recorder = Recorder(Y=np.zeros(work.Y.size), Ynew=np.zeros(work.Y.size),
-                        dp=dopri5.work(work.Y.size, np.zeros_like(work.counters)))
-    run = Run(cst, grid, out, work, dopri5.work(work.Y.size, work.counters), collocation.context(cst), use_collocation,
-              recorder)
+                        dp=dopri5.work(work.Y.size, np.zeros_like(work.counters), damped, ledger is not None))
+    run = Run(cst, grid, out, work, dopri5.work(work.Y.size, work.counters, damped, ledger is not None),
+              collocation.context(cst),
+              use_collocation, recorder)
     status, period = _advance(y, run)
     if stats is not None:
         for name, value in zip(COUNT._fields, work.counters):

@@ -170,7 +170,7 @@ def test_release_is_located_when_the_first_guess_ends_short():
     Y[2 * n] = -sys.g - 1e-7  # 0.1 um into the left wall ...
     Y[2 * n + 1] = 0.2  # ... opening at 0.2 m/s: the release is ~0.5 us ahead
     work = dopri5.work(Y.size, np.zeros(len(flight.COUNT), dtype=np.int64))
-    dopri5.rhs(1.0, 0.0, Y, work.K[0], cst)
+    dopri5.rhs(1.0, 0.0, Y, work.K[0], cst, work.book)
     guess = 0.3e-6  # ends short of the release
     for first_guess in (guess, 3 * guess):
         Ynew = work.end
