@@ -1,7 +1,10 @@
 """Same-run A/B timings of one stepped-sine point: worker processes (`_point_worker.py`) on two source trees,
-asked in turn, so that every pair of CPU times is measured back to back on the same machine load."""
+asked in turn, so that every pair of CPU times is measured back to back on the same machine load, and on the same
+core: unpinned, a worker that the scheduler keeps on a busier core (a sibling thread shared with another tenant) was
+seen 5-30 % slower for a whole run, a bias that the pairing cannot remove."""
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -14,6 +17,8 @@ def worker(tree: Path, eta: float, prepare: float | None, *options: str) -> subp
     options: INTEGRATOR [R_CONT] of `_point_worker.py`."""
     proc = subprocess.Popen([sys.executable, str(WORKER), str(tree), str(eta), "-" if prepare is None else str(prepare),
                              *options], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    if hasattr(os, "sched_setaffinity"):  # every worker on the same core (Linux)
+        os.sched_setaffinity(proc.pid, {min(os.sched_getaffinity(0))})
     assert proc.stdout.readline().strip() == "ready"
     return proc
 
