@@ -587,7 +587,7 @@ def _series_at(S, sigma, Y, m):
             Y[i] = Y[i] * sigma + S[q, i]
 
 
-#: 1 / k for k = 1, 2, ... (the integrals of the powers in `_overlap_fourier`)
+#: 1 / k for k = 1, 2, ... (the integrals of the powers in `_overlap_fourier` and `_overlap_work`: k <= 2 SERIES_ORDER)
 _INV = 1.0 / np.arange(1.0, 40.0)
 #: Terms of the exponential's series in `_overlap_fourier` ((Omega sigma)^5 / 5! < 1e-12 for Omega sigma < 0.01).
 _OVERLAP_TERMS = 5
@@ -617,33 +617,26 @@ def _overlap_fourier(Fs, sigma, ct_e, st_e, Om):
     return ct_e * jr + st_e * ji, ct_e * ji - st_e * jr
 
 
-#: Gauss-Legendre points and weights on [0, 1] of `_overlap_work` (exact for the product of the force's and a
-#: velocity's series up to degree 15; the overlap is at most a quarter of a step, omega_max sigma < 1.6)
-_OVERLAP_X, _OVERLAP_W = (0.5 * (np.polynomial.legendre.leggauss(8)[0] + 1.0), 0.5 * np.polynomial.legendre.leggauss(8)[1])
-
-
 @kernel
-def _overlap_work(S, Fs, sigma, wall, cst, Y, scratch):
-    """Y[G + j] -= int over [t_e - sigma, t_e] of sgn phi_w,j F x_j' dt: the contact work of the overlap, by
-    Gauss-Legendre quadrature of the series of the force (Fs) and of the modal velocities (S, evaluated into
-    `scratch`), both in the backward time (`_series`)."""
+def _overlap_work(S, Fs, sigma, wall, cst, Y):
+    """Y[G + j] -= int over [t_e - sigma, t_e] of sgn phi_w,j F x_j' dt: the contact work of the overlap, the
+    exact integral of the product of the series of the force (Fs) and of the modal velocities (S), both in the
+    backward time (`_series`): sum_b S_b,j K_b with K_b = sum_a Fs_a sigma^(a + b + 1) / (a + b + 1), one K_b
+    for all modes."""
     md = cst.modes
     lay = state_layout(md.size)
     sgn = 1.0 if wall == 0 else -1.0
     p = S.shape[0]
-    for q in range(_OVERLAP_X.size):
-        u = sigma * _OVERLAP_X[q]
-        for j in range(lay.n):  # the modal velocities only (Horner, all modes at once)
-            scratch[j] = S[p - 1, lay.v + j]
-        for k in range(p - 2, -1, -1):
-            for j in range(lay.n):
-                scratch[j] = scratch[j] * u + S[k, lay.v + j]
-        f = Fs[Fs.size - 1]
-        for k in range(Fs.size - 2, -1, -1):
-            f = f * u + Fs[k]
-        weight = sgn * sigma * _OVERLAP_W[q] * f
+    lead = sgn * sigma  # sgn sigma^(b + 1)
+    for b in range(p):
+        K = 0.0
+        term = lead  # sgn Fs_a sigma^(a + b + 1) / Fs_a
+        for a in range(Fs.size):
+            K += Fs[a] * term * _INV[a + b]
+            term *= sigma
         for j in range(lay.n):
-            Y[lay.G + j] -= weight * _phi(md, j, wall) * scratch[j]
+            Y[lay.G + j] -= K * _phi(md, j, wall) * S[b, lay.v + j]
+        lead *= sigma
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -973,7 +966,7 @@ def contact(Y, t, t_stop, wall, ctx, cst):
                 Ynew[frow] -= sgn * ore
                 Ynew[frow + 1] -= sgn * oim
                 if book:
-                    _overlap_work(S, Fs, d, wall, cst, Ynew, Ys)
+                    _overlap_work(S, Fs, d, wall, cst, Ynew)
                 _end_state(step, Ynew, Y, F, cs, ss, wall)
                 if book:
                     _contact_work(step.tab, step.off, Ynew, Y, F, rows[ROW.pairs], rows[ROW.work])

@@ -655,7 +655,8 @@ def _advance(y, run):
             open_impact = _log_onset(Y, t, p, wall, cst, log, log_count)
             h_contact = _initial_contact_step(Y, t, cst)
         amplitudes[p] = _fundamental(Y, X0, grid.T, cst)
-        _close_period(Y, X0, grid.T, cst, ledger[p])
+        if cst.par.book > 0.0:  # the ledger's row (without a ledger nobody reads it)
+            _close_period(Y, X0, grid.T, cst, ledger[p])
         impacts[p] = onsets
         for i in range(Y.size):
             if not math.isfinite(Y[i]):

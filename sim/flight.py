@@ -278,7 +278,7 @@ def _fly_sphere(Y, Ynew, tau, lay):
     Ynew[lay.zd] = Y[lay.zd]
 
 
-@kernel
+@kernel(inline="always")  # called per grid step: a call costs more than its body
 def grid_flight(Y, Ynew, h, md):
     """Ynew[:acc] = free flight of Y over one grid step h (s) with the transitions of the records (grid_a ... grid_d)."""
     lay = state_layout(md.size)
@@ -287,7 +287,7 @@ def grid_flight(Y, Ynew, h, md):
     _fly_sphere(Y, Ynew, h, lay)
 
 
-@kernel
+@kernel(inline="always")  # called per grid step: a call costs more than its body
 def free_flight(Y, Ynew, tau, md):
     """Ynew[:acc] = free flight of Y over tau s (Eq. 9)."""
     lay = state_layout(md.size)
