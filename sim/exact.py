@@ -672,7 +672,7 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
              h_fixed: float = 0.0, samples: int = 1, book: bool = True) -> tuple[Constants, Grid]:
     """Constants and grid of the kernels for one excitation (see the module docstring for the symbols); the
     state is recorded at `samples` equally spaced instants per period; `book`: keep the contact work of the
-    energy bookkeeping and the impact log (else the ledger's dissipation is not valid)."""
+    energy bookkeeping, the impact log and the ledger's rows (else the ledger is not written)."""
     omega = np.asarray(sys.omega, dtype=np.float64)
     D = np.asarray(sys.D, dtype=np.float64)
     n = omega.size

@@ -287,7 +287,7 @@ def grid_flight(Y, Ynew, h, md):
     _fly_sphere(Y, Ynew, h, lay)
 
 
-@kernel(inline="always")  # called per grid step: a call costs more than its body
+@kernel(inline="always")  # called after every release and per recorded sample: like grid_flight, cheaper inline
 def free_flight(Y, Ynew, tau, md):
     """Ynew[:acc] = free flight of Y over tau s (Eq. 9)."""
     lay = state_layout(md.size)
