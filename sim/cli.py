@@ -571,12 +571,13 @@ def trace_command(args: argparse.Namespace) -> int:
     from sim.files import dumps, report_written
     from sim.integrators import warm_up
     from sim.protocol import check_level
-    from sim.trace import record_trace, write_trace
+    from sim.trace import check_trace_settings, record_trace, write_trace
 
     started = time.perf_counter()
     level = check_level(args.level)
     protocol = build_protocol(args)
     model, impactor = build_system(args)
+    check_trace_settings(model, protocol, args.periods, args.fs)  # before the kernels compile
     if args.plot and not Path(args.plot).resolve().parent.is_dir():
         raise SimulationInputError(f"--plot {args.plot}: folder {Path(args.plot).parent} does not exist")
     with output_folder(args.out) as folder:

@@ -89,8 +89,8 @@ def make_signal(t: np.ndarray, columns: Mapping[str, np.ndarray], source: str = 
     step = np.diff(t)
     if np.any(step <= 0):
         i = int(np.flatnonzero(step <= 0)[0])
-        raise SimulationInputError(f"{source}: t must increase, but t = {t[i + 1]!r} s at data row {i + 2} follows "
-                                   f"t = {t[i]!r} s; sort the samples and remove repeated ones")
+        raise SimulationInputError(f"{source}: t must increase, but t = {float(t[i + 1])!r} s at data row {i + 2} follows "
+                                   f"t = {float(t[i])!r} s; sort the samples and remove repeated ones")
     mean = (t[-1] - t[0]) / (t.size - 1)
     off = np.abs(step - mean) > UNIFORM_STEP_TOLERANCE * mean
     if np.any(off):

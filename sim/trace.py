@@ -81,6 +81,16 @@ def samples_per_period(fs: float, Omega: float) -> int:
     return int(round(fs / f_exc))
 
 
+def check_trace_settings(model: ModalModel, protocol: SteppedSine, periods: int, fs: float) -> None:
+    """One-line SimulationInputError for a record length `periods` that is not a whole number >= 1 or a rate fs (Hz)
+    below two samples per period at the protocol's lowest excitation: checked before anything is simulated (or
+    compiled)."""
+    if int(periods) != periods or periods < 1:
+        raise SimulationInputError(f"--periods must be a whole number >= 1, got {periods!r}")
+    lowest = protocol.eta[0] * float(model.omega[0]) * (1.0 - protocol.perturbation)
+    samples_per_period(float(fs), lowest)
+
+
 def record_trace(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *,
                  periods: int = DEFAULT_PERIODS, fs: float = DEFAULT_FS, seed: int = 0, rep: int = 0,
                  nominal: Nominal = Nominal()) -> Trace:
@@ -92,12 +102,8 @@ def record_trace(model: ModalModel, impactor: Impactor | None, level: float, pro
     from sim.integrators import get_integrator
 
     level = check_level(level)
-    if int(periods) != periods or periods < 1:
-        raise SimulationInputError(f"--periods must be a whole number >= 1, got {periods!r}")
+    check_trace_settings(model, protocol, periods, fs)
     fs = float(fs)
-    omega_1 = float(model.omega[0])
-    lowest = protocol.eta[0] * omega_1 * (1.0 - protocol.perturbation)
-    samples_per_period(fs, lowest)  # refuse a too low rate before simulating
     run_step = get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
     sys = simulated_system(model, impactor)
     a_base = level * a_base_star(model, nominal)
