@@ -35,7 +35,8 @@ from typing import NamedTuple
 import numpy as np
 from numpy.polynomial import legendre, polynomial
 
-from sim.flight import ONSET, REGULAR, RELEASE, Constants, closing_at, rotate, state_layout, time_map, transition
+from sim.flight import (ONSET, REGULAR, RELEASE, Constants, closing_at, copy_into, rotate, state_layout, time_map,
+                        transition)
 from sim.jit import kernel
 
 #: Gauss nodes per collocation step.
@@ -183,7 +184,7 @@ def _phi(md, j, wall):
     return md[j].phi_l if wall == 0 else md[j].phi_r
 
 
-@kernel
+@kernel(refcounts=True)  # allocates its scratch; called from the integrator's kernels, which run without
 def _build(tab, nodes, off, kind, h, wall, cst):
     """Fill one table (layout `off`) for a step of length h with the time map `kind` at wall 0/1 (Eqs. 3-7).
 
@@ -930,7 +931,7 @@ def contact(Y, t, t_stop, wall, ctx, cst):
             continue
         if book:  # the accepted step's contact work (F still holds its nodal forces)
             _contact_work(step.tab, step.off, Y, Ynew, F, rows[ROW.pairs], rows[ROW.work])
-        Y[:] = Ynew
+        copy_into(Y, Ynew, 0, Y.size)
         t += h
         norm = 1.5 - 0.5 * (c1 * c1 + s1 * s1)  # keeps cos^2 + sin^2 = 1 to rounding
         ct = c1 * norm
@@ -960,8 +961,8 @@ def contact(Y, t, t_stop, wall, ctx, cst):
                 _series_at(S, d, Ys, m)
                 cs, ss = rotate(ct, st, -Om * d)
                 ore, oim = _overlap_fourier(Fs, d, ct, st, Om)
-                Ynew[:m] = Ys[:m]
-                Ynew[m:] = Y[m:]
+                copy_into(Ynew, Ys, 0, m)
+                copy_into(Ynew, Y, m, Y.size)
                 frow = lay.F_l if wall == 0 else lay.F_r
                 Ynew[frow] -= sgn * ore
                 Ynew[frow + 1] -= sgn * oim

@@ -202,7 +202,7 @@ def _search(Y, t0, tau_end, cst, scratch, counters):
     tau = 0.0
     for _ in range(_MAX_SEARCH):
         if tau == 0.0:
-            scratch[:lay.acc] = Y[:lay.acc]
+            flight.copy_into(scratch, Y, 0, lay.acc)
             cl, cld, cr, crd = flight.closing(Y, t0, cst)
         else:
             for j in range(lay.n):
@@ -416,7 +416,7 @@ def _record_contact(p, t0, t1, at_onset, h, record, run):
             in_contact = not in_flight
         if t_rec > t:
             flight.free_flight(Y, rec.Ynew, t_rec - t, cst.modes)
-            Y[:] = rec.Ynew
+            flight.copy_into(Y, rec.Ynew, 0, Y.size)
             t = t_rec
         _to_state(Y, t_rec, record[p * grid.M + i], cst)
         i += 1
@@ -570,7 +570,7 @@ def _log_release(Y, t, p, T, cst, log, i):
     row[IMPACT.higher_release] = eh
 
 
-@kernel
+@kernel(refcounts=False)
 def _advance(y, run):
     """Advance y (phase 0) over the periods of run.out; returns (status, period of failure).
 
@@ -595,7 +595,7 @@ def _advance(y, run):
     h_contact = 0.0  # the Dormand-Prince contact's step, carried from contact to contact
     for p in range(amplitudes.size):
         Y[lay.acc:] = 0.0
-        X0[:] = Y[:lay.z]
+        flight.copy_into(X0, Y, 0, lay.z)
         onsets = 0
         t = 0.0
         released = False  # the free flight starts at a release (else at a grid point)
@@ -605,7 +605,7 @@ def _advance(y, run):
             if in_contact:
                 t_start, onset_start, h_start = t, at_onset, h_contact
                 if recording:
-                    run.recorder.Y[:] = Y
+                    flight.copy_into(run.recorder.Y, Y, 0, Y.size)
                 t_stop = grid.T
                 released = False
                 status = OK
@@ -646,7 +646,7 @@ def _advance(y, run):
             # a located onset at t + tau (its state in work.scratch): the contact starts
             if onsets > _MAX_ONSETS_PER_PERIOD:  # onsets that do not advance in time
                 return STALLED, p
-            Y[:lay.acc] = scratch[:lay.acc]
+            flight.copy_into(Y, scratch, 0, lay.acc)
             t = t + tau
             in_contact = True
             at_onset = True

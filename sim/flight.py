@@ -278,6 +278,14 @@ def _fly_sphere(Y, Ynew, tau, lay):
     Ynew[lay.zd] = Y[lay.zd]
 
 
+@kernel(inline="always")
+def copy_into(dst, src, start, stop):
+    """dst[start:stop] = src[start:stop], element by element (a slice copy needs the reference counts that the
+    exact integrator's kernels run without: `sim.jit.kernel`)."""
+    for i in range(start, stop):
+        dst[i] = src[i]
+
+
 @kernel(inline="always")  # called per grid step: a call costs more than its body
 def grid_flight(Y, Ynew, h, md):
     """Ynew[:acc] = free flight of Y over one grid step h (s) with the transitions of the records (grid_a ... grid_d)."""

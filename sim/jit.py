@@ -16,6 +16,18 @@ transitions and the closing functions are written once (`sim.flight`) and shared
 its two contact methods and, with the energy bookkeeping and the new contact laws to come, by more kernels.
 One fingerprint over a handful of files costs a fraction of a millisecond per process.
 
+Reference counts. numba counts the references to every array a kernel is handed or slices (an atomic
+increment and decrement per array, per call). In the exact integrator's period loop, where small kernels are
+called per contact step and per Newton iteration with a dozen arrays each, that was 80k atomic operations per
+100 periods and 12 % of a stepped-sine point (tests/benchmarks/test_energy_speed.py). `kernel(refcounts=False)`
+compiles a kernel without them (numba's `_nrt` option; the kernels it calls inherit it). That is safe when
+the kernel, and everything it calls without counts, allocates no array, copies no slices into arrays
+(`sim.flight.copy_into` instead) and returns no array to a counting caller: every array it touches is then
+owned by its Python caller for the whole call. numba refuses to compile an allocation without counts, so a
+breach of the first rule is an error, not a leak; a kernel that must allocate says `refcounts=True`. numba's cache
+keys a kernel on its signature alone, so a kernel that hands arrays back (`sim.collocation._step_table`) must only
+ever be called from kernels without counts.
+
 Where the cache folder cannot be written to (a read-only install: numba then uses its user cache folder;
 NUMBA_CACHE_DIR if set), nothing is deleted and numba itself decides (an install brings new files with new
 modification times, which numba's own key already catches). A process that was started before an edit and
@@ -75,13 +87,21 @@ def discard_stale_kernels(cache_folder: str | os.PathLike) -> bool:
     return True
 
 
-def kernel(function: Callable | None = None, **options) -> Callable:
+def kernel(function: Callable | None = None, *, refcounts: bool | None = None, **options) -> Callable:
     """``numba.njit(cache=True, **options)`` whose cache is discarded when any kernel source changed.
 
     Use as ``@kernel`` or ``@kernel(inline="always", fastmath=...)``. The check runs once per process and
     cache folder, before the first kernel of that folder is compiled or loaded (numba loads lazily, at the
     first call, so checking at decoration time is early enough).
+
+    refcounts: False compiles the kernel, and every kernel it calls that does not say otherwise, without
+    numba's reference counts (see the module docstring: such kernels may not allocate, copy slices or hand
+    arrays back); True keeps them for a kernel that allocates and may be called from one without; None
+    (default): numba's default, inherited from the calling kernel.
     """
+    if refcounts is not None:
+        options["_nrt"] = refcounts
+
     def decorate(py_function: Callable) -> Callable:
         dispatcher = numba.njit(cache=True, **options)(py_function)
         folder = dispatcher.stats.cache_path
