@@ -20,13 +20,14 @@ Reference counts. numba counts the references to every array a kernel is handed 
 increment and decrement per array, per call). In the exact integrator's period loop, where small kernels are
 called per contact step and per Newton iteration with a dozen arrays each, that was 80k atomic operations per
 100 periods and 12 % of a stepped-sine point (tests/benchmarks/test_energy_speed.py). `kernel(refcounts=False)`
-compiles a kernel without them (numba's `_nrt` option; the kernels it calls inherit it). That is safe when
-the kernel, and everything it calls without counts, allocates no array, copies no slices into arrays
-(`sim.flight.copy_into` instead) and returns no array to a counting caller: every array it touches is then
-owned by its Python caller for the whole call. numba refuses to compile an allocation without counts, so a
-breach of the first rule is an error, not a leak; a kernel that must allocate says `refcounts=True`. numba's cache
-keys a kernel on its signature alone, so a kernel that hands arrays back (`sim.collocation._step_table`) must only
-ever be called from kernels without counts.
+compiles a kernel without them (numba's `_nrt` option; the kernels it calls inherit it). That is safe when the
+kernel, and everything it calls without counts, allocates no array, copies no slices into arrays
+(`sim.flight.copy_into` instead) and returns no array to a counting caller: every array it touches is then owned
+by its Python caller for the whole call (numba unboxes the arrays of a kernel without counts with no runtime record
+at all, so even a counting kernel further down counts nothing on them). numba refuses to compile an allocation
+without counts, so a breach of the first rule is an error, not a leak; a kernel that must allocate says
+`refcounts=True`. numba's cache keys a kernel on its signature alone, so a kernel that hands arrays back
+(`sim.collocation._step_table`) must only ever be called from kernels without counts.
 
 Where the cache folder cannot be written to (a read-only install: numba then uses its user cache folder;
 NUMBA_CACHE_DIR if set), nothing is deleted and numba itself decides (an install brings new files with new
