@@ -501,17 +501,18 @@ class RigModes:
 
 
 def rig_mesh(params: RigParameters = UPDATED_PARAMETERS, geometry: RigGeometry = RigGeometry(),
-             element_size: float = ELEMENT_SIZE) -> BeamMesh:
+             element_size: float = ELEMENT_SIZE, nu: float = NU_STEEL, rho: float = RHO_STEEL) -> BeamMesh:
     """Assembled beam model of the rig (root at the block's top face, rigid or on the joint springs), steel of
-    Table 1 with modulus E."""
-    return assemble_beam(geometry.segments(params), params.E, NU_STEEL, RHO_STEEL, element_size,
-                         params.root_stiffness)
+    Table 1 (nu, rho in kg/m^3) with modulus E."""
+    return assemble_beam(geometry.segments(params), params.E, nu, rho, element_size, params.root_stiffness)
 
 
 def rig_modes(params: RigParameters = UPDATED_PARAMETERS, geometry: RigGeometry = RigGeometry(),
-              n_modes: int = 9, element_size: float = ELEMENT_SIZE) -> RigModes:
-    """Lowest n_modes x-bending modes of the rig (Sect. 3.1, Eq. 7 inputs), signs per sim/system.py."""
-    mesh = rig_mesh(params, geometry, element_size)
+              n_modes: int = 9, element_size: float = ELEMENT_SIZE, nu: float = NU_STEEL,
+              rho: float = RHO_STEEL) -> RigModes:
+    """Lowest n_modes x-bending modes of the rig (Sect. 3.1, Eq. 7 inputs), signs per sim/system.py; nu (-) and
+    rho (kg/m^3) default to Table 1's steel."""
+    mesh = rig_mesh(params, geometry, element_size, nu, rho)
     omega, phi = mass_normalised_modes(mesh, n_modes)
     phi = phi * np.sign(phi[mesh.w_dof(geometry.contact_height)])  # x-value at the contact positive
     segments = geometry.segments(params)
@@ -521,7 +522,7 @@ def rig_modes(params: RigParameters = UPDATED_PARAMETERS, geometry: RigGeometry 
         phi_tip=phi[mesh.w_dof(geometry.measurement_height)],
         participation=phi.T @ mesh.base_load,
         phi_floor=phi[mesh.w_dof(geometry.floor_height)],
-        beam_mass=RHO_STEEL * sum(s.section.area * s.length for s in segments),
+        beam_mass=rho * sum(s.section.area * s.length for s in segments),
         moving_mass=mesh.moving_mass,
         params=params,
         geometry=geometry,
