@@ -49,9 +49,13 @@ def add_modes_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--variant", default=None, metavar="NAME",
                         help="updating variant of the built-in rig: joint-spring (default) or effective-modulus; "
                              "with --solid a variant of the solid model (sim.variants.SOLID_VARIANTS: beam-neck, "
-                             "updated, updated-400, updated-contact+2mm, updated-contact+4mm)")
+                             "updated, updated-400, updated-contact+2mm, updated-contact+4mm, updated-hertz-patch, "
+                             "updated-patch-3mm)")
     parser.add_argument("--n-modes", dest="n_modes", type=int, default=9, metavar="N",
                         help="x-bending modes to keep (default 9, as the paper; built-in rig, --solid, --from-calculix)")
+    parser.add_argument("--joint-stiffness", dest="joint_stiffness", type=float, default=None, metavar="N_PER_M",
+                        help="built-in rig, variant joint-spring: fix the beam-block joint's translational stiffness "
+                             "(N/m; inf = rigid) and re-update E and the neck to f1..f4 and f9 (10-60 s)")
     solid = parser.add_argument_group("3D solid model (--solid) and CalculiX (--from-calculix)")
     solid.add_argument("--mesh", metavar="LEVEL|JOB.inp",
                        help="--solid: mesh level coarse (default, ~1 min), medium or fine; --from-calculix: the job's .inp")
@@ -204,6 +208,34 @@ def _external_model(args: argparse.Namespace) -> tuple[Any, dict | None, list[st
     return result.model, result.provenance, result.report
 
 
+def _fixed_joint_model(stiffness: float, variant: str, n_modes: int) -> tuple[Any, Any, dict, list[str]]:
+    """`ies modes --joint-stiffness K`: the built-in rig re-updated (sim.rig.update_rig) with the joint's
+    translational stiffness fixed at K (N/m; sim.rig.update_rig_fixed_joint): (model, updated RigParameters,
+    provenance, report lines)."""
+    import math
+
+    from sim.files import to_jsonable
+    from sim.rig import rig_modal_model, update_rig_fixed_joint
+
+    if not (stiffness > 0):  # also refuses NaN
+        raise SimulationInputError(f"--joint-stiffness must be positive in N/m (inf = rigid), got {stiffness!r}")
+    fit = update_rig_fixed_joint(stiffness, variant=variant)
+    label = "rigid" if math.isinf(stiffness) else f"{stiffness:.4g} N/m"
+    model = rig_modal_model(fit.params, n_modes, f"built-in seed rig (sim.rig, Timoshenko beam, variant {variant} "
+                                                  f"re-updated with the joint stiffness fixed at {label})")
+    errors = [100 * e for e in fit.frequency_errors]
+    plain = {"model": "built-in Timoshenko beam (sim.rig), re-updated (sim.rig.update_rig_fixed_joint)",
+             "variant": variant,
+             "joint_translational_stiffness_N_per_m": stiffness if math.isfinite(stiffness) else "rigid",
+             "updated_parameters": fit.params.as_dict(), "f1_f4_error_percent": errors,
+             "f9_hz": fit.f9_hz, "cost": fit.cost, "on_bounds": list(fit.on_bounds)}
+    report = [f"joint stiffness fixed at {label}; re-updated: E = {fit.params.E / 1e9:.2f} GPa, neck "
+              f"{1e3 * fit.params.neck_length:.2f} mm x {1e3 * fit.params.neck_width_y:.2f} mm (y); f1..f4 "
+              + ", ".join(f"{e:+.3f}" for e in errors) + f" %, f9 = {fit.f9_hz:.0f} Hz"
+              + (f"; on bounds: {', '.join(fit.on_bounds)}" if fit.on_bounds else "")]
+    return model, fit.params, to_jsonable(plain), report
+
+
 def modes_command(args: argparse.Namespace) -> int:
     """`ies modes`: show (and with --save write) the built-in rig's model, a modal-model file, the 3D solid
     model or the modes of a CalculiX job."""
@@ -214,6 +246,9 @@ def modes_command(args: argparse.Namespace) -> int:
     report: list[str] = []
     if not 1 <= args.n_modes <= 30:
         raise SimulationInputError(f"--n-modes must lie in 1..30, got {args.n_modes}")
+    if args.joint_stiffness is not None and (args.solid or args.from_calculix or args.model):
+        raise SimulationInputError("--joint-stiffness re-updates the built-in rig; drop --model, --solid and "
+                                   "--from-calculix")
     if args.solid or args.from_calculix:
         model, provenance, report = _external_model(args)
     elif args.mesh or args.geometry or args.wall_left or args.wall_right or args.tip or args.dat or args.floor \
@@ -228,8 +263,11 @@ def modes_command(args: argparse.Namespace) -> int:
         from sim.rig import DEFAULT_VARIANT, rig_modes, seed_rig_model, variant_parameters
 
         variant = args.variant or DEFAULT_VARIANT
-        model = seed_rig_model(n_modes=args.n_modes, variant=variant)
-        rig = rig_modes(variant_parameters(variant), n_modes=max(args.n_modes, 9))  # its updating summary needs f1..f9
+        if args.joint_stiffness is not None:
+            model, params, provenance, report = _fixed_joint_model(args.joint_stiffness, variant, args.n_modes)
+        else:
+            model, params = seed_rig_model(n_modes=args.n_modes, variant=variant), variant_parameters(variant)
+        rig = rig_modes(params, n_modes=max(args.n_modes, 9))  # its updating summary needs f1..f9
     data = describe_modes(model, rig)
     if provenance is not None:
         data["provenance"] = provenance

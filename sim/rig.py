@@ -501,17 +501,18 @@ class RigModes:
 
 
 def rig_mesh(params: RigParameters = UPDATED_PARAMETERS, geometry: RigGeometry = RigGeometry(),
-             element_size: float = ELEMENT_SIZE) -> BeamMesh:
+             element_size: float = ELEMENT_SIZE, nu: float = NU_STEEL, rho: float = RHO_STEEL) -> BeamMesh:
     """Assembled beam model of the rig (root at the block's top face, rigid or on the joint springs), steel of
-    Table 1 with modulus E."""
-    return assemble_beam(geometry.segments(params), params.E, NU_STEEL, RHO_STEEL, element_size,
-                         params.root_stiffness)
+    Table 1 (nu, rho in kg/m^3) with modulus E."""
+    return assemble_beam(geometry.segments(params), params.E, nu, rho, element_size, params.root_stiffness)
 
 
 def rig_modes(params: RigParameters = UPDATED_PARAMETERS, geometry: RigGeometry = RigGeometry(),
-              n_modes: int = 9, element_size: float = ELEMENT_SIZE) -> RigModes:
-    """Lowest n_modes x-bending modes of the rig (Sect. 3.1, Eq. 7 inputs), signs per sim/system.py."""
-    mesh = rig_mesh(params, geometry, element_size)
+              n_modes: int = 9, element_size: float = ELEMENT_SIZE, nu: float = NU_STEEL,
+              rho: float = RHO_STEEL) -> RigModes:
+    """Lowest n_modes x-bending modes of the rig (Sect. 3.1, Eq. 7 inputs), signs per sim/system.py; nu (-) and
+    rho (kg/m^3) default to Table 1's steel."""
+    mesh = rig_mesh(params, geometry, element_size, nu, rho)
     omega, phi = mass_normalised_modes(mesh, n_modes)
     phi = phi * np.sign(phi[mesh.w_dof(geometry.contact_height)])  # x-value at the contact positive
     segments = geometry.segments(params)
@@ -521,7 +522,7 @@ def rig_modes(params: RigParameters = UPDATED_PARAMETERS, geometry: RigGeometry 
         phi_tip=phi[mesh.w_dof(geometry.measurement_height)],
         participation=phi.T @ mesh.base_load,
         phi_floor=phi[mesh.w_dof(geometry.floor_height)],
-        beam_mass=RHO_STEEL * sum(s.section.area * s.length for s in segments),
+        beam_mass=rho * sum(s.section.area * s.length for s in segments),
         moving_mass=mesh.moving_mass,
         params=params,
         geometry=geometry,
@@ -591,15 +592,20 @@ def variant_parameters(variant: str = DEFAULT_VARIANT) -> RigParameters:
     return _variant(variant)[1]
 
 
-@lru_cache(maxsize=8)
-def _seed_rig_model(n_modes: int, variant: str) -> ModalModel:
-    modes = rig_modes(variant_parameters(variant), n_modes=n_modes)
+def rig_modal_model(params: RigParameters, n_modes: int = 9, source: str = "") -> ModalModel:
+    """Modal model (Eq. 7) of the beam model with these parameters: frequencies, damping (damping_ratios), the
+    contact values at both walls, tip, participation, beam mass and floor values (SI units)."""
+    modes = rig_modes(params, n_modes=n_modes)
     return ModalModel(
         frequencies_hz=modes.frequencies_hz, damping_ratios=damping_ratios(n_modes),
         phi_wall_left=modes.phi_contact, phi_wall_right=modes.phi_contact, phi_tip=modes.phi_tip,
-        participation=modes.participation, beam_mass=modes.beam_mass, phi_floor=modes.phi_floor,
-        source=f"built-in seed rig (sim.rig, Timoshenko beam, updated, variant {variant})",
-    )
+        participation=modes.participation, beam_mass=modes.beam_mass, phi_floor=modes.phi_floor, source=source)
+
+
+@lru_cache(maxsize=8)
+def _seed_rig_model(n_modes: int, variant: str) -> ModalModel:
+    return rig_modal_model(variant_parameters(variant), n_modes,
+                           f"built-in seed rig (sim.rig, Timoshenko beam, updated, variant {variant})")
 
 
 def seed_rig_model(n_modes: int = 9, variant: str = DEFAULT_VARIANT) -> ModalModel:
@@ -635,11 +641,25 @@ def updating_residuals(params: RigParameters, geometry: RigGeometry = RigGeometr
     return np.array(problem.weights) * (f / targets - 1.0)
 
 
+def _fixed_joint_problem(problem: UpdatingProblem, stiffness: float) -> UpdatingProblem:
+    """The updating problem with the joint's translational stiffness (N/m) fixed and removed from the free set."""
+    name = "joint_translational_stiffness"
+    if name not in problem.free:
+        raise SimulationInputError("a fixed joint stiffness needs an updating variant that frees it (joint-spring)")
+    if not (isinstance(stiffness, (int, float)) and stiffness > 0):
+        raise SimulationInputError(f"joint stiffness must be positive in N/m (inf = rigid), got {stiffness!r}")
+    keep = [i for i, n in enumerate(problem.free) if n != name]
+    pick = lambda values: tuple(values[i] for i in keep)  # noqa: E731
+    return replace(problem, free=pick(problem.free), lower=pick(problem.lower), upper=pick(problem.upper),
+                   log=pick(problem.log), start=replace(problem.start, **{name: float(stiffness)}))
+
+
 def update_rig(start: RigParameters | None = None, geometry: RigGeometry = RigGeometry(),
-               variant: str = DEFAULT_VARIANT) -> RigUpdate:
+               variant: str = DEFAULT_VARIANT, joint_stiffness: float | None = None) -> RigUpdate:
     """Model updating like Appendix A: bounded weighted least squares (scipy trust-region reflective) of the
     relative frequency errors over the variant's free parameters (RIG_VARIANTS), from `start` (default: the
-    variant's start). Takes 10-60 s.
+    variant's start). joint_stiffness (N/m, inf = rigid): fix the joint's translational stiffness there and update
+    the variant's other free parameters (only where the variant frees it, "joint-spring"). Takes 10-60 s.
 
     Findings (report of the updating; tests/sim/test_rig.py):
     * "effective-modulus" (E, neck length and widths; rigid joint; f1..f4): f1..f4 to < 1e-8, unique from several
@@ -667,6 +687,8 @@ def update_rig(start: RigParameters | None = None, geometry: RigGeometry = RigGe
     from scipy.optimize import least_squares
 
     problem = _variant(variant)[0]
+    if joint_stiffness is not None:
+        problem = _fixed_joint_problem(problem, joint_stiffness)
     lower, upper = problem.bounds
     x0 = np.clip(problem.to_vector(problem.start if start is None else start), lower, upper)
 
@@ -696,3 +718,64 @@ def update_rig(start: RigParameters | None = None, geometry: RigGeometry = RigGe
     cost = 0.5 * float(np.sum(updating_residuals(params, geometry, variant) ** 2))
     on_bounds = tuple(name for name, on in zip(problem.free, active) if on)
     return RigUpdate(params, modes.frequency_errors, float(modes.frequencies_hz[8]), cost, on_bounds)
+
+
+def update_rig_fixed_joint(stiffness: float, geometry: RigGeometry = RigGeometry(),
+                           variant: str = DEFAULT_VARIANT) -> RigUpdate:
+    """update_rig with the joint's translational stiffness fixed at `stiffness` (N/m, inf = rigid), from the
+    variant's start and from its stored optimum; the lower cost wins. Two starts because the fixed-joint problem
+    has two optima for stiff joints (from 1e10 N/m on, the default start ends on a shorter neck with about 1.6 times
+    the cost). About 1-3 s."""
+    fits = [update_rig(start, geometry, variant, joint_stiffness=stiffness)
+            for start in (None, variant_parameters(variant))]
+    return min(fits, key=lambda fit: fit.cost)
+
+
+def worst_target_error(fit: RigUpdate) -> float:
+    """The largest relative error (-) of an updating's targets: f1..f4 against Table A.1 and f9 against 19.8 kHz."""
+    return float(max(np.max(np.abs(fit.frequency_errors)), abs(fit.f9_hz / F9_PAPER_HZ - 1.0)))
+
+
+@dataclass(frozen=True)
+class JointRange:
+    """Joint stiffnesses (N/m) the updating allows: those whose re-updated fit (update_rig_fixed_joint) keeps its
+    worst target error (worst_target_error) within `threshold` (-; factor times the free fit's). lower, upper:
+    the range's ends (upper inf when the rigid joint still fits); stiffnesses and worst_errors: the scan."""
+
+    threshold: float
+    lower: float
+    upper: float
+    stiffnesses: np.ndarray
+    worst_errors: np.ndarray
+
+
+def joint_stiffness_range(factor: float = 2.0, geometry: RigGeometry = RigGeometry(),
+                          grid: np.ndarray | None = None, variant: str = DEFAULT_VARIANT) -> JointRange:
+    """The range of the beam-block joint's translational stiffness (N/m) over which the updated beam model still
+    fits Table A.1 (f1..f4) and the paper's f9 (Appendix A): the joint fixed at each value of `grid` (default
+    1e8..1e11 N/m, 4 per decade, and rigid), E and the neck re-updated (update_rig_fixed_joint), kept while the
+    worst relative target error stays within factor (> 1) times that of the free fit (variant "joint-spring":
+    1.05 %, f2). The ends are bisected in log k to 1 %. About 1-2 min."""
+    if not (isinstance(factor, (int, float)) and factor > 1):
+        raise SimulationInputError(f"joint_stiffness_range: factor must exceed 1, got {factor!r}")
+    threshold = factor * worst_target_error(update_rig(geometry=geometry, variant=variant))
+    k = np.r_[np.logspace(8, 11, 13), math.inf] if grid is None else np.sort(np.asarray(grid, float))
+    worst = np.array([worst_target_error(update_rig_fixed_joint(float(v), geometry, variant)) for v in k])
+    ok = worst <= threshold
+    if not ok.any():
+        raise SimulationInputError("joint_stiffness_range: no joint stiffness of the grid fits within the threshold")
+
+    def bisect(good: float, bad: float) -> float:  # in log k; `good` fits, `bad` does not
+        while abs(math.log(bad / good)) > 0.01:
+            mid = math.sqrt(good * bad)
+            good, bad = (mid, bad) if worst_target_error(update_rig_fixed_joint(mid, geometry, variant)) <= threshold \
+                else (good, mid)
+        return good
+
+    first, last = int(np.argmax(ok)), int(len(ok) - 1 - np.argmax(ok[::-1]))
+    lower = float(k[first]) if first == 0 else bisect(float(k[first]), float(k[first - 1]))
+    if math.isinf(k[last]) or last == len(k) - 1 or math.isinf(k[last + 1]):
+        upper = float(k[last])
+    else:
+        upper = bisect(float(k[last]), float(k[last + 1]))
+    return JointRange(threshold, lower, upper, k, worst)

@@ -778,6 +778,56 @@ def solid_rig_model(mesh: str | float = "coarse", geometry: SolidGeometry = Soli
 
 
 # ---------------------------------------------------------------------------------------------------------
+# The same rig as a Timoshenko beam (sim.rig), like for like
+
+
+def timoshenko_counterpart(geometry: SolidGeometry, material: SolidMaterial = SolidMaterial(),
+                           n_modes: int = 9):
+    """The Timoshenko beam model (sim.rig, module docstring: Cowper shear coefficients, the cavity and groove as
+    tube sections, cubic elements) of the same rig as a solid model clamped at its root section (block_edge = 0):
+    the same free length, neck, section, cavity and groove (m), the same E (Pa), nu and rho (kg/m^3), a rigid
+    joint (the solid's clamped root face). The beam's contact and measurement points lie at the same heights, on
+    the axis (the solid reads the inner wall faces and, with measurement_on_face, the outer face). A solid
+    without a neck gets a neck of the full section (the same beam). Returns sim.rig.RigModes (frequencies Hz,
+    values 1/sqrt(kg), participation sqrt(kg))."""
+    from sim.rig import RigParameters, rig_modes
+
+    g = geometry
+    if g.block_edge != 0 or g.cavity_z == 0 or g.groove_depth == 0:
+        raise SimulationInputError("timoshenko_counterpart needs a solid clamped at its root section (block_edge = 0) "
+                                   "with a cavity and a groove, as the beam model has")
+    neck = (g.neck_length, g.neck_width_x, g.neck_width_y) if g.neck_length > 0 else (1e-3, g.section_x, g.section_y)
+    params = RigParameters(E=material.E, neck_length=neck[0], neck_width_x=neck[1], neck_width_y=neck[2])
+    rig = RigGeometry(free_length=g.free_length, section_x=g.section_x, section_y=g.section_y, cavity_x=g.cavity_x,
+                      cavity_y=g.cavity_y, cavity_z=g.cavity_z, groove_depth=g.groove_depth,
+                      groove_width=g.groove_width, sphere_radius=g.sphere_radius,
+                      measurement_below_contact=g.measurement_below_contact, block_edge=0.0)
+    return rig_modes(params, rig, n_modes=n_modes, nu=material.nu, rho=material.rho)
+
+
+def compare_with_timoshenko(geometry: SolidGeometry, material: SolidMaterial = SolidMaterial(),
+                            mesh: str | float = "coarse", n_modes: int = 9) -> dict:
+    """The solid model (quarter symmetry) of a rig clamped at its root section against its Timoshenko counterpart
+    (timoshenko_counterpart): per mode the frequencies (Hz), the values at the contact point (solid: mean of the two
+    wall-face centres at the sphere-centre height; beam: the axis at that height), at the measurement point and the
+    participation (1/sqrt(kg), sqrt(kg)) of both, and the ratios solid / beam (frequency ratios minus 1).
+    Plain data (lists per mode)."""
+    size = MESH_LEVELS[mesh] if isinstance(mesh, str) and mesh in MESH_LEVELS else mesh
+    if isinstance(size, str):
+        raise SimulationInputError(f"unknown mesh level {mesh!r}; choose one of {', '.join(MESH_LEVELS)}")
+    beam = timoshenko_counterpart(geometry, material, n_modes)
+    model = solid_modal_model(solve_solid_modes(solid_mesh(geometry, material, size, symmetry="quarter"), n_modes))
+    solid = {"frequencies_hz": model.frequencies_hz, "phi_c": 0.5 * (model.phi_wall_left + model.phi_wall_right),
+             "phi_tip": model.phi_tip, "participation": model.participation}
+    timo = {"frequencies_hz": beam.frequencies_hz, "phi_c": beam.phi_contact, "phi_tip": beam.phi_tip,
+            "participation": beam.participation}
+    out = {"element_size_m": float(size), "solid": solid, "beam": timo,
+           "f_rel_diff": solid["frequencies_hz"] / timo["frequencies_hz"] - 1.0}
+    out.update({f"{key}_ratio": solid[key] / timo[key] for key in ("phi_c", "phi_tip", "participation")})
+    return to_jsonable(out)
+
+
+# ---------------------------------------------------------------------------------------------------------
 # Model updating of the unpublished geometry (Appendix A)
 
 # Bounds (m) of the dimensions the updating may move: the neck (not published) and the free length ("about 400 mm")

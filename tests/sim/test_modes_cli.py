@@ -163,6 +163,10 @@ def test_solid_variant_through_the_cli(tmp_path, capsys):
     (["--solid", "--variant", "updated", "--patch-radius", "0.001"], "--variant fixes the solid model's geometry"),
     ([*JOB, "--variant", "updated"], "the job defines the model; drop --variant"),
     (["--n-modes", "0"], "--n-modes must lie in 1..30"),
+    (["--joint-stiffness", "-1"], "--joint-stiffness must be positive in N/m"),
+    (["--joint-stiffness", "nan"], "--joint-stiffness must be positive in N/m"),
+    (["--joint-stiffness", "1e9", "--solid"], "--joint-stiffness re-updates the built-in rig"),
+    (["--joint-stiffness", "1e9", "--variant", "effective-modulus"], "needs an updating variant that frees it"),
 ])
 def test_bad_solid_and_calculix_input_one_line_exit_2_nothing_written(tmp_path, capsys, args, message):
     assert main(["modes", *args, "--save", str(tmp_path / "out.toml")]) == 2

@@ -322,3 +322,28 @@ def test_stored_updated_geometry_reproduces_its_fit():
     assert modes.frequencies_hz[8] == pytest.approx(20410, abs=1)
     assert RHO * g.beam_volume == pytest.approx(1.545, abs=5e-4)
     assert SPHERE_MASS * np.mean(modes.wall_values(), axis=0)[0] ** 2 == pytest.approx(0.0357, abs=1e-4)
+
+
+def test_solid_and_its_timoshenko_counterpart_like_for_like():
+    """The same rig (the updated solid geometry without the block, clamped at its root section, E = 207 GPa) as a
+    solid (medium mesh, quarter) and as the Timoshenko beam of sim.rig. Bands: the issue's claims where the beam
+    theory's assumptions hold (f1..f9 within 0.4 %, the contact values of modes 1-5 within 2 %; mesh-converged at
+    1.8 mm: 0.36 % and 1.2 %). Above them the physics of the open cavity: its walls are plates, more compliant than
+    the tube's plane sections, so the solid's contact values of modes 6-9 exceed the beam's, and more so at
+    higher frequency: the excess of modes 8-9 is at least twice the larger of modes 6-7 (a wall compliance felt
+    as f^2 gives (f8/f6)^2 = 2.6; converged 6.5-7.4 % against 2.2-2.4 %). Without the neck the 3D clamped root face (it also fixes the
+    section's warping and contraction) makes every solid frequency higher than the beam's."""
+    from dataclasses import replace
+
+    from sim.solid import UPDATED_SOLID_GEOMETRY, compare_with_timoshenko
+
+    rig = replace(UPDATED_SOLID_GEOMETRY, block_edge=0.0, measurement_on_face=False)
+    c = compare_with_timoshenko(rig, SolidMaterial(E, NU, RHO), "medium")
+    assert np.max(np.abs(c["f_rel_diff"])) < 0.004
+    ratio = np.array(c["phi_c_ratio"])
+    assert np.max(np.abs(ratio[:5] - 1)) < 0.02
+    assert np.all(ratio[5:] > 1) and min(ratio[7:]) - 1 > 2 * (max(ratio[5:7]) - 1)
+    no_neck = compare_with_timoshenko(replace(rig, neck_length=0.0), SolidMaterial(E, NU, RHO), "medium")
+    assert np.all(np.array(no_neck["f_rel_diff"]) > 0)
+    with pytest.raises(SimulationInputError, match="block_edge = 0"):
+        compare_with_timoshenko(UPDATED_SOLID_GEOMETRY)
