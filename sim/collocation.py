@@ -299,7 +299,8 @@ ROW = WorkRows(*range(len(WorkRows._fields)))
 class Workspace(NamedTuple):
     """Scratch of `contact`: the vectors named by `ROW` (rows of one array, as long as the longest), the Newton
     matrix A ((s + 1) x (s + 1), by columns) and the backward series S of the mechanical state (order x acc).
-    One array for the vectors: every array handed to a kernel costs a reference count."""
+    One array for the vectors, handed around as a whole (from before the kernels ran without reference counts,
+    `sim.jit`; still fewer arguments per call)."""
 
     rows: np.ndarray
     A: np.ndarray

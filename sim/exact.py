@@ -576,8 +576,9 @@ def _advance(y, run):
 
     Each period from phase 0: free flight (`_fly`), contacts (`collocation.contact` from an onset if
     run.use_collocation, `dopri5.contact` wherever that falls back), then the period's |c_1| and onset count
-    (`_fundamental`). A contact may go on into the next period. (One kernel for all periods: a kernel call
-    per period would count references to every array it is handed.)"""
+    (`_fundamental`). A contact may go on into the next period. One kernel for all periods (a call from Python
+    per period would unbox every array of `run` again), compiled without reference counts (`sim.jit`): the
+    kernels it calls inherit that, except `collocation._build`, which allocates."""
     cst, grid, colloc, dp, use_collocation = run.cst, run.grid, run.colloc, run.dp, run.use_collocation
     work = run.work
     Y, X0, scratch, counters = work.Y, work.X0, work.scratch, work.counters

@@ -5,8 +5,9 @@ output of a period loop, the kernels' counters and status codes, and the closed-
 
 Conventions of the kernels (each measured against the positional code they replace, same machine code speed):
 * Constants are numba records read by name (``md[j].sig``, ``par.Omega``): a structured array with a record
-  per mode and one record of scalars. A record costs no reference counting, whereas every array a kernel
-  keeps from its arguments across a call is counted up and down (two atomic operations) on every call.
+  per mode and one record of scalars. A record costs no reference counting, whereas every array a counting
+  kernel keeps from its arguments across a call is counted up and down (two atomic operations) on every call.
+  The exact integrator's kernels do not count (`sim.jit`, `kernel(refcounts=False)`); ode3's do.
 * Hence tuples of arrays (workspaces, contexts) are unpacked at a kernel's entry, and a kernel called per
   contact step or per grid step is handed few arrays.
 * A kernel takes the state layout from `state_layout(n)`, not from an argument: inlined, its offsets are
