@@ -174,3 +174,29 @@ def test_reproduce_with_a_bad_modal_model_writes_nothing(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "modal_model" in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
     assert not out.exists()
+
+
+SHIPPED = Path(__file__).resolve().parents[2] / "uq" / "studies"
+SHIPPED_FILES = sorted(SHIPPED.rglob("*.toml"))
+
+
+@pytest.mark.parametrize("path", [p for p in SHIPPED_FILES if "ies-modal-model" not in p.read_text()],
+                         ids=lambda p: str(p.relative_to(SHIPPED)))
+def test_every_shipped_study_loads_and_builds_its_model(path):
+    study = load_study(path)
+    model = study.make_model()
+    assert study.levels and model is not None
+    if study.modal_model is not None:
+        assert study.modal_model.is_file()
+
+
+def test_the_wheel_ships_every_study_and_modal_file():
+    import tomllib
+    from pathlib import PurePosixPath
+
+    globs = tomllib.loads((SHIPPED.parents[1] / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]["uq"]
+    # setuptools globs do not cross folders: the pattern must match every part of the path
+    shipped = [PurePosixPath(p.relative_to(SHIPPED.parent).as_posix()) for p in SHIPPED_FILES]
+    missing = [str(p) for p in shipped if not any(len(p.parts) == len(PurePosixPath(g).parts) and p.match(g)
+                                                  for g in globs)]
+    assert len(SHIPPED_FILES) > 40 and not missing
