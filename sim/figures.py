@@ -89,21 +89,27 @@ def draw_overview(ax: Any, data: Mapping[str, Any], title: str, *, paper_optimum
                label=f"optimum of this model ({levels[best]:g}: mean /{1 / data['resonant_mean'][best]:.0f}, "
                      f"max /{1 / data['resonant_max'][best]:.0f})")
     if paper_optimum:
-        from matplotlib.patches import Rectangle
-
-        ax.axvline(PAPER_OPTIMUM_LEVEL, color="k", lw=1, ls="-.", alpha=0.6,
-                   label=f"paper's optimum ({PAPER_OPTIMUM_LEVEL:g}: mean /{PAPER_REDUCTION_MEAN:g}, "
-                         f"max /{PAPER_REDUCTION_MAX:g}, stars)")
-        ax.plot([PAPER_OPTIMUM_LEVEL] * 2, [1 / PAPER_REDUCTION_MEAN, 1 / PAPER_REDUCTION_MAX], "k*", ms=8)
-        ax.add_patch(Rectangle((7.2, PAPER_APR_LEVEL[0]), 0.4, PAPER_APR_LEVEL[1] - PAPER_APR_LEVEL[0],
-                                facecolor="0.6", alpha=0.5,
-                                label=f"paper's almost periodic level at 7.4 ({PAPER_APR_LEVEL[0]:g}-"
-                                      f"{PAPER_APR_LEVEL[1]:g}, App. B)"))
+        draw_paper_landmarks(ax)
     ax.set_xlabel(r"$a_{base} / a^*_{base}$")
     ax.set_ylabel(r"resonant level $a / a^{noabs*}$")
     ax.set_ylim(bottom=0)
     ax.set_title(title, pad=28, fontsize=9)
     ax.grid(alpha=0.3)
+
+
+def draw_paper_landmarks(ax: Any) -> None:
+    """The paper's Fig. 6 landmarks on `ax`: its optimum (a_base/a_base* ~ 6.7, a vertical line, with its mean and
+    max levels as stars, Sect. 5.3) and its almost periodic level at 7.4 (a grey box, Appendix B)."""
+    from matplotlib.patches import Rectangle
+
+    ax.axvline(PAPER_OPTIMUM_LEVEL, color="k", lw=1, ls="-.", alpha=0.6,
+               label=f"paper's optimum ({PAPER_OPTIMUM_LEVEL:g}: mean /{PAPER_REDUCTION_MEAN:g}, "
+                     f"max /{PAPER_REDUCTION_MAX:g}, stars)")
+    ax.plot([PAPER_OPTIMUM_LEVEL] * 2, [1 / PAPER_REDUCTION_MEAN, 1 / PAPER_REDUCTION_MAX], "k*", ms=8)
+    ax.add_patch(Rectangle((7.2, PAPER_APR_LEVEL[0]), 0.4, PAPER_APR_LEVEL[1] - PAPER_APR_LEVEL[0],
+                           facecolor="0.6", alpha=0.5,
+                           label=f"paper's almost periodic level at 7.4 ({PAPER_APR_LEVEL[0]:g}-"
+                                 f"{PAPER_APR_LEVEL[1]:g}, App. B)"))
 
 
 def plot_overview(data: Mapping[str, Any], path: str | os.PathLike, title: str, *, paper_optimum: bool = False) -> None:
@@ -114,25 +120,34 @@ def plot_overview(data: Mapping[str, Any], path: str | os.PathLike, title: str, 
 
 
 def plot_series(series: Sequence[tuple[str, Mapping[str, Any]]], path: str | os.PathLike, title: str,
-                paper_line: tuple[float, str] | None = None) -> None:
+                paper_line: tuple[float, str] | None = None, *, paper_landmarks: bool = False) -> None:
     """Figs. 11 and C.1a: the resonant mean level against the excitation level, one curve per value of a series
     (`series`: [(label, `sim.tables.overview_data` keys)]), each with the range of its runs as error bars;
-    paper_line: (level, what the paper says there) marked as a vertical line."""
+    paper_line: (level, what the paper says there) marked as a vertical line; paper_landmarks: the paper's Fig. 6
+    landmarks (draw_paper_landmarks; `ies compare`)."""
     import numpy as np
 
-    with plot_to(path, figsize=(6.5, 4.4)) as (fig, ax):
-        for label, data in series:
+    many = len(series) > 6  # legend beside the axes; markers and line styles tell apart curves of one colour
+    with plot_to(path, figsize=(9.5, 4.4) if many else (6.5, 4.4)) as (fig, ax):
+        for i, (label, data) in enumerate(series):
             levels = np.asarray(data["levels"], dtype=float)
             value = np.asarray(data["resonant_mean"], dtype=float)
             spread = [value - np.asarray(data["resonant_mean_lo"], dtype=float),
                       np.asarray(data["resonant_mean_hi"], dtype=float) - value]
-            ax.errorbar(levels, value, yerr=spread, fmt="o-", ms=3, capsize=2, lw=1.2, label=label)
+            fmt = "os^vD"[i // 10 % 5] + ("-", "--", ":")[i // 10 % 3]
+            ax.errorbar(levels, value, yerr=spread, fmt=fmt, ms=3, capsize=2, lw=1.2, label=label)
         if paper_line is not None:
             ax.axvline(paper_line[0], color="k", lw=1, ls="-.", alpha=0.6, label=paper_line[1])
+        if paper_landmarks:
+            draw_paper_landmarks(ax)
+            ax.set_ylim(bottom=0)
         ax.set_xlabel("excitation level a_base / a_base*")
         ax.set_ylabel("resonant mean a / a_noabs*")
         ax.set_title(title, fontsize=8)
-        ax.legend(fontsize=7, loc="upper left")
+        if many:
+            ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+        else:
+            ax.legend(fontsize=7, loc="upper left")
 
 
 def plot_scattering(overview: Mapping[str, Any], runs: Sequence[Mapping[str, Any]], path: str | os.PathLike,

@@ -1,5 +1,5 @@
 """The uncertainty stage's words of the `ies` command line: `interval`, `sobol`, `response`, `reproduce`
-(seed paper Sects. 5.2-5.4, Figs. 5-8) and `plot`.
+(seed paper Sects. 5.2-5.4, Figs. 5-8), `plot` and `compare`.
 
 * `ies interval STUDY.toml`: interval (vertex) bands of the resonant response, Figs. 7 and 8.
 * `ies sobol STUDY.toml [--n N]`: Sobol' indices (S1, ST) of the resonant response levels.
@@ -14,6 +14,8 @@
   Table 2's bounds are kept.
 * `ies plot DIR`: redraw the figures of a result folder from its data (`sim.redraw`), in other formats, another
   matplotlib style or for a subset of the levels, without recomputing.
+* `ies compare DIR DIR ... --out OUT`: the Fig. 6 landmarks of several response studies side by side with the
+  paper's (`uq.compare`; the README's fidelity table), a table and one figure.
 
 `add_commands(subparsers, calibrate=...)` registers them with the front door (`uq.cli`), which hands over
 the calibration as a callable: this stage never imports the contact stage itself. Heavy imports stay
@@ -41,6 +43,8 @@ RESPONSE_HELP = ("frequency responses and resonant levels of the nominal point o
 REPRODUCE_HELP = ("reproduce the paper's Figs. 5 and 6 (nominal response), 7 and 8 (uncertainty of D, g, k_H) and "
                   "D.2 and D.3 (impacts per period, restitution)")
 PLOT_HELP = "redraw a result folder's figures from its saved data (formats, style, levels) without recomputing"
+COMPARE_HELP = ("the Fig. 6 landmarks of several response studies side by side with the paper's: switch, optimum, "
+                "levels at 7.4 and 9, impacts, r and energy share at 7.4 (table and figure)")
 #: the paper's figures that `ies reproduce` runs, in the order of `all`
 FIGURES = ("fig5", "fig6", "fig7", "fig8", "figD2", "figD3")
 #: figures `ies reproduce` runs when named, not in `all` (five contact laws, friction: minutes even when quick)
@@ -50,14 +54,15 @@ TRACED = {"figC1": (1.26, 5.3)}
 
 
 def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
-    """Register `interval`, `sobol`, `response`, `reproduce` and `plot` on the front door's subparsers (argparse);
+    """Register `interval`, `sobol`, `response`, `reproduce`, `plot` and `compare` on the front door's subparsers (argparse);
     `calibrate` is the calibration `reproduce` runs unless told otherwise."""
     reproduce = functools.partial(reproduce_command, calibrate=calibrate)
     for name, help_text, add_arguments, run in (("interval", INTERVAL_HELP, add_interval_arguments, interval_command),
                                                 ("sobol", SOBOL_HELP, add_sobol_arguments, sobol_command),
                                                 ("response", RESPONSE_HELP, add_response_arguments, response_command),
                                                 ("reproduce", REPRODUCE_HELP, add_reproduce_arguments, reproduce),
-                                                ("plot", PLOT_HELP, add_plot_arguments, plot_command)):
+                                                ("plot", PLOT_HELP, add_plot_arguments, plot_command),
+                                                ("compare", COMPARE_HELP, add_compare_arguments, compare_command)):
         parser = subparsers.add_parser(name, help=help_text, description=help_text)
         add_arguments(parser)
         parser.set_defaults(_run=run)
@@ -369,4 +374,47 @@ def plot_command(args: argparse.Namespace) -> int:
         args.out.mkdir(parents=True, exist_ok=True)
     paths = redraw(args.folder, PlotOptions(args.formats, args.style, args.levels, args.out))
     report_written(paths)
+    return 0
+
+
+# ---- ies compare --------------------------------------------------------------------------------------------
+
+def add_compare_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies compare`."""
+    parser.add_argument("folders", type=Path, nargs="+", metavar="DIR",
+                        help="the --out folders of response studies (ies response, ies reproduce fig6)")
+    parser.add_argument("--out", type=Path, default=Path("ies-out/compare"), metavar="DIR",
+                        help="where compare.csv, compare.json and fig6-compare.* go (default ies-out/compare)")
+    parser.add_argument("--format", dest="formats", type=figure_formats, default=(".png", ".pdf"), metavar="F1,F2",
+                        help="figure formats, e.g. png,pdf,svg (default png,pdf)")
+    parser.add_argument("--style", metavar="NAME|FILE",
+                        help="a matplotlib style (e.g. seaborn-v0_8-paper, grayscale) or a .mplstyle file")
+    parser.add_argument("--json", action="store_true", help="print the rows as one JSON object instead of the table")
+
+
+def compare_command(args: argparse.Namespace) -> int:
+    """`ies compare`: every folder is read and checked before anything is written (`uq.compare`)."""
+    from sim.errors import SimulationInputError
+    from sim.figures import plot_series
+    from sim.files import dumps, report_written, write_csv, write_text
+    from sim.redraw import style
+    from uq.compare import COMPARE_COLUMNS, PAPER_ROW, compare_row, compare_series, compare_text
+
+    rows = [compare_row(folder) for folder in args.folders]
+    series = compare_series(args.folders)
+    context = style(args.style)
+    if args.out.exists() and not args.out.is_dir():
+        raise SimulationInputError(f"--out {args.out} exists and is not a folder; choose another path")
+    args.out.mkdir(parents=True, exist_ok=True)
+    written = [write_csv(args.out / "compare.csv", COMPARE_COLUMNS,
+                         [[row[key] for key in COMPARE_COLUMNS] for row in (*rows, PAPER_ROW)]),
+               write_text(args.out / "compare.json", dumps({"studies": rows, "paper": PAPER_ROW}) + "\n")]
+    with context:
+        for suffix in args.formats:
+            path = args.out / f"fig6-compare{suffix}"
+            plot_series(series, path, "Resonant mean vs excitation level (cf. Fig. 6) of each study, bars: range of "
+                                      "its runs; the paper's landmarks", paper_landmarks=True)
+            written.append(path)
+    print(dumps({"studies": rows, "paper": PAPER_ROW}) if args.json else compare_text(rows))
+    report_written(written, json_mode=args.json)
     return 0

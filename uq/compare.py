@@ -1,0 +1,134 @@
+"""`ies compare`: the Fig. 6 landmarks of several response studies side by side, next to the paper's (README,
+"Fidelity"): one row per study (the switch from SMR to APR, the optimum and its reductions, the resonant level
+with its repetition range and regime at 7.4 and 9, the impacts, significant impacts, restitution r (Eq. D.1)
+and share of modes 2..N after the impacts at 7.4), and one figure with every study's resonant mean against the
+excitation level and the paper's landmarks (Sect. 5.3, Appendices B and D).
+
+Only the data files of the folders are read (study.json, overview.csv), never the runs: the table of the README's
+fidelity study is `ies compare ies-out/fidelity/* --out ies-out/fidelity-compare`.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+from typing import Any, Sequence
+
+from sim.measures import PAPER_APR_LEVEL, PAPER_IMPACTS_PER_PERIOD, PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, \
+    PAPER_REDUCTION_MEAN
+from uq.errors import StudyError
+
+#: the levels a_base/a_base* at which the table reports the resonant level (7.4: the paper's APR landmark)
+LANDMARK_LEVELS = (7.4, 9.0)
+#: measures of overview.csv reported at the first landmark level (the resonant eta there)
+SCATTERING_AT_7_4 = ("impacts_per_period", "significant_impacts_per_period", "restitution", "higher_mode_energy_share")
+#: compare.csv's columns, in order
+COMPARE_COLUMNS = ("study", "folder", "last_smr", "first_apr", "optimum_level", "reduction_mean", "reduction_max",
+                   *(f"{key}_{level:g}" for level in LANDMARK_LEVELS
+                     for key in ("resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "regime")),
+                   *(f"{key}_7.4" for key in SCATTERING_AT_7_4))
+#: the paper's row (Sect. 5.3, Fig. 6; Appendix B: the APR level at 7.4; Appendix D: two significant impacts per
+#: period, r ~ 0.8, 15 % of the energy in modes 2..9 after the impacts, simulated)
+PAPER_ROW = {"study": "paper", "folder": "", "last_smr": math.nan, "first_apr": PAPER_OPTIMUM_LEVEL,
+             "optimum_level": PAPER_OPTIMUM_LEVEL, "reduction_mean": PAPER_REDUCTION_MEAN,
+             "reduction_max": PAPER_REDUCTION_MAX, "resonant_mean_7.4": math.nan,
+             "resonant_mean_lo_7.4": PAPER_APR_LEVEL[0], "resonant_mean_hi_7.4": PAPER_APR_LEVEL[1], "regime_7.4": "APR",
+             "resonant_mean_9": math.nan, "resonant_mean_lo_9": math.nan, "resonant_mean_hi_9": math.nan,
+             "regime_9": "", "impacts_per_period_7.4": math.nan,
+             "significant_impacts_per_period_7.4": PAPER_IMPACTS_PER_PERIOD, "restitution_7.4": 0.8,
+             "higher_mode_energy_share_7.4": 0.15}
+
+
+def _overview(folder: Path) -> list[dict[str, str]]:
+    with open(folder / "overview.csv", newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def response_folder(folder: str | Path) -> tuple[dict, list[dict[str, str]]]:
+    """(study.json, overview.csv rows) of a response study's folder (`ies response`, `ies reproduce fig6`); a
+    StudyError naming the folder when it is not one."""
+    folder = Path(folder)
+    meta_path = folder / "study.json"
+    if not folder.is_dir():
+        raise StudyError(f"{folder} is not a folder; give the --out folders of response studies")
+    try:
+        meta = json.loads(meta_path.read_text())
+    except (OSError, json.JSONDecodeError):
+        raise StudyError(f"{folder} has no readable study.json; give the --out folder of an ies response study")
+    kind = meta.get("study", {}).get("kind")
+    if kind != "response" or "series_folders" in meta:
+        what = "a series response study; compare its NAME=VALUE subfolders" if "series_folders" in meta else \
+            f"not a response study (kind {kind!r}); ies compare takes the folders of response studies"
+        raise StudyError(f"{folder} is {what}")
+    if "landmarks" not in meta or not (folder / "overview.csv").is_file():
+        raise StudyError(f"{folder} has no landmarks or overview.csv (unfinished?); finish it with ies response "
+                         f"STUDY.toml --out {folder} --resume")
+    return meta, _overview(folder)
+
+
+def compare_row(folder: str | Path) -> dict[str, Any]:
+    """The landmarks of one response study's folder as a row of COMPARE_COLUMNS (NaN or "" where a level is not
+    among the study's)."""
+    meta, overview = response_folder(folder)
+    landmarks = meta["landmarks"]
+    nan = math.nan
+    row: dict[str, Any] = {"study": meta["study"].get("name", Path(folder).name), "folder": str(folder)}
+    for key in ("last_smr", "first_apr", "optimum_level", "reduction_mean", "reduction_max"):
+        row[key] = nan if landmarks.get(key) is None else float(landmarks[key])
+    by_level = {float(r["level"]): r for r in overview}
+    for level in LANDMARK_LEVELS:
+        at = next((r for lv, r in by_level.items() if math.isclose(lv, level, rel_tol=1e-9)), None)
+        for key in ("resonant_mean", "resonant_mean_lo", "resonant_mean_hi"):
+            row[f"{key}_{level:g}"] = nan if at is None else float(at[key])
+        row[f"regime_{level:g}"] = "" if at is None else at["regime"]
+        if level == LANDMARK_LEVELS[0]:
+            for key in SCATTERING_AT_7_4:
+                row[f"{key}_7.4"] = nan if at is None or key not in at else float(at[key])
+    return row
+
+
+def _number(value: float, fmt: str) -> str:
+    return "–" if value is None or (isinstance(value, float) and math.isnan(value)) else format(value, fmt)
+
+
+def switch_text(row: dict[str, Any]) -> str:
+    """The switch SMR->APR of a row as the README writes it ("5.3->5.5", "none (SMR to 9)", "APR from 4.5")."""
+    last, first = row["last_smr"], row["first_apr"]
+    if math.isnan(first):
+        return "none"
+    return f"APR from {first:g}" if math.isnan(last) else f"{last:g}->{first:g}"
+
+
+def compare_text(rows: Sequence[dict[str, Any]]) -> str:
+    """The rows as a text table (the README's fidelity table), the paper's row last."""
+    head = (f"{'study':<34} {'switch':>10} {'optimum':>14} {'level at 7.4 [range]':>28} {'level at 9 [range]':>28} "
+            f"{'imp/T':>6} {'sig/T':>6} {'r':>5} {'E2..N':>6}")
+    lines = [head]
+    for row in (*rows, PAPER_ROW):
+        optimum = f"{row['optimum_level']:g}: {row['reduction_mean']:.0f}x/{row['reduction_max']:.0f}x"
+        levels = []
+        for level in LANDMARK_LEVELS:
+            mean, lo, hi = (row[f"{key}_{level:g}"] for key in ("resonant_mean", "resonant_mean_lo", "resonant_mean_hi"))
+            text = "" if math.isnan(mean) else f"{mean:.3f} "
+            text += "" if math.isnan(lo) else f"[{lo:.3f}, {hi:.3f}] "
+            levels.append(f"{text}{row[f'regime_{level:g}']}" if text else "–")
+        switch = switch_text(row) if row is not PAPER_ROW else f"~{PAPER_OPTIMUM_LEVEL:g}"
+        lines.append(f"{row['study']:<34} {switch:>10} {optimum:>14} {levels[0]:>28} {levels[1]:>28} "
+                     f"{_number(row['impacts_per_period_7.4'], '.2f'):>6} "
+                     f"{_number(row['significant_impacts_per_period_7.4'], '.2f'):>6} "
+                     f"{_number(row['restitution_7.4'], '.2f'):>5} "
+                     f"{_number(100 * row['higher_mode_energy_share_7.4'], '.1f'):>5}%")
+    return "\n".join(lines)
+
+
+def compare_series(folders: Sequence[str | Path]) -> list[tuple[str, dict[str, list]]]:
+    """[(study name, overview as `sim.tables.overview_data` keys)] of response folders, for `sim.figures.plot_series`."""
+    series = []
+    for folder in folders:
+        meta, overview = response_folder(folder)
+        data = {"levels": [float(r["level"]) for r in overview]}
+        for key in ("resonant_mean", "resonant_mean_lo", "resonant_mean_hi"):
+            data[key] = [float(r[key]) for r in overview]
+        series.append((meta["study"].get("name", Path(folder).name), data))
+    return series
