@@ -88,8 +88,8 @@ def compare_row(folder: str | Path) -> dict[str, Any]:
     return row
 
 
-def _number(value: float, fmt: str) -> str:
-    return "–" if value is None or (isinstance(value, float) and math.isnan(value)) else format(value, fmt)
+def _number(value: float, fmt: str, unit: str = "") -> str:
+    return "–" if value is None or (isinstance(value, float) and math.isnan(value)) else format(value, fmt) + unit
 
 
 def switch_text(row: dict[str, Any]) -> str:
@@ -118,7 +118,7 @@ def compare_text(rows: Sequence[dict[str, Any]]) -> str:
                      f"{_number(row['impacts_per_period_7.4'], '.2f'):>6} "
                      f"{_number(row['significant_impacts_per_period_7.4'], '.2f'):>6} "
                      f"{_number(row['restitution_7.4'], '.2f'):>5} "
-                     f"{_number(100 * row['higher_mode_energy_share_7.4'], '.1f'):>5}%")
+                     f"{_number(100 * row['higher_mode_energy_share_7.4'], '.1f', '%'):>6}")
     return "\n".join(lines)
 
 
