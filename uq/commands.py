@@ -398,10 +398,10 @@ def compare_command(args: argparse.Namespace) -> int:
     from sim.figures import plot_series
     from sim.files import dumps, report_written, write_csv, write_text
     from sim.redraw import style
-    from uq.compare import COMPARE_COLUMNS, PAPER_ROW, compare_row, compare_series, compare_text
+    from uq.compare import COMPARE_COLUMNS, PAPER_ROW, compare_row, compare_text, read_response_folder
 
-    rows = [compare_row(folder) for folder in args.folders]
-    series = compare_series(args.folders)
+    studies = [read_response_folder(folder) for folder in args.folders]
+    rows = [compare_row(study) for study in studies]
     context = style(args.style)
     if args.out.exists() and not args.out.is_dir():
         raise SimulationInputError(f"--out {args.out} exists and is not a folder; choose another path")
@@ -412,7 +412,7 @@ def compare_command(args: argparse.Namespace) -> int:
     with context:
         for suffix in args.formats:
             path = args.out / f"fig6-compare{suffix}"
-            plot_series(series, path, "Resonant mean vs excitation level (cf. Fig. 6) of each study, bars: range of "
+            plot_series([(study.name, study.overview) for study in studies], path, "Resonant mean vs excitation level (cf. Fig. 6) of each study, bars: range of "
                                       "its runs; the paper's landmarks", paper_landmarks=True)
             written.append(path)
     print(dumps({"studies": rows, "paper": PAPER_ROW}) if args.json else compare_text(rows))

@@ -9,9 +9,9 @@ fidelity study is `ies compare ies-out/fidelity/* --out ies-out/fidelity-compare
 """
 from __future__ import annotations
 
-import csv
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -40,20 +40,26 @@ PAPER_ROW = {"study": "paper", "folder": "", "last_smr": math.nan, "first_apr": 
              "higher_mode_energy_share_7.4": 0.15}
 
 
-def _overview(folder: Path) -> list[dict[str, str]]:
-    with open(folder / "overview.csv", newline="") as fh:
-        return list(csv.DictReader(fh))
+@dataclass(frozen=True)
+class ResponseFolder:
+    """A finished response study's folder: its name, path, study.json `landmarks` and overview.csv (as
+    `sim.tables.overview_data` keys)."""
+
+    name: str
+    folder: Path
+    landmarks: dict
+    overview: dict[str, list]
 
 
-def response_folder(folder: str | Path) -> tuple[dict, list[dict[str, str]]]:
-    """(study.json, overview.csv rows) of a response study's folder (`ies response`, `ies reproduce fig6`); a
-    StudyError naming the folder when it is not one."""
+def read_response_folder(folder: str | Path) -> ResponseFolder:
+    """A response study's folder (`ies response`, `ies reproduce fig6`); a StudyError naming it when it is not one."""
+    from uq.figures import read_overview
+
     folder = Path(folder)
-    meta_path = folder / "study.json"
     if not folder.is_dir():
         raise StudyError(f"{folder} is not a folder; give the --out folders of response studies")
     try:
-        meta = json.loads(meta_path.read_text())
+        meta = json.loads((folder / "study.json").read_text())
     except (OSError, json.JSONDecodeError):
         raise StudyError(f"{folder} has no readable study.json; give the --out folder of an ies response study")
     kind = meta.get("study", {}).get("kind")
@@ -64,27 +70,24 @@ def response_folder(folder: str | Path) -> tuple[dict, list[dict[str, str]]]:
     if "landmarks" not in meta or not (folder / "overview.csv").is_file():
         raise StudyError(f"{folder} has no landmarks or overview.csv (unfinished?); finish it with ies response "
                          f"STUDY.toml --out {folder} --resume")
-    return meta, _overview(folder)
+    return ResponseFolder(meta["study"].get("name", folder.name), folder, meta["landmarks"], read_overview(folder))
 
 
-def compare_row(folder: str | Path) -> dict[str, Any]:
-    """The landmarks of one response study's folder as a row of COMPARE_COLUMNS (NaN or "" where a level is not
-    among the study's)."""
-    meta, overview = response_folder(folder)
-    landmarks = meta["landmarks"]
-    nan = math.nan
-    row: dict[str, Any] = {"study": meta["study"].get("name", Path(folder).name), "folder": str(folder)}
+def compare_row(study: ResponseFolder) -> dict[str, Any]:
+    """The landmarks of one response study as a row of COMPARE_COLUMNS (NaN or "" where a level is not among the
+    study's)."""
+    row: dict[str, Any] = {"study": study.name, "folder": str(study.folder)}
     for key in ("last_smr", "first_apr", "optimum_level", "reduction_mean", "reduction_max"):
-        row[key] = nan if landmarks.get(key) is None else float(landmarks[key])
-    by_level = {float(r["level"]): r for r in overview}
+        value = study.landmarks.get(key)
+        row[key] = math.nan if value is None else float(value)
+    levels = study.overview["levels"]
     for level in LANDMARK_LEVELS:
-        at = next((r for lv, r in by_level.items() if math.isclose(lv, level, rel_tol=1e-9)), None)
-        for key in ("resonant_mean", "resonant_mean_lo", "resonant_mean_hi"):
-            row[f"{key}_{level:g}"] = nan if at is None else float(at[key])
-        row[f"regime_{level:g}"] = "" if at is None else at["regime"]
-        if level == LANDMARK_LEVELS[0]:
-            for key in SCATTERING_AT_7_4:
-                row[f"{key}_7.4"] = nan if at is None or key not in at else float(at[key])
+        at = next((i for i, lv in enumerate(levels) if math.isclose(lv, level, rel_tol=1e-9)), None)
+        keys = ("resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "regime") + \
+            (SCATTERING_AT_7_4 if level == LANDMARK_LEVELS[0] else ())
+        for key in keys:
+            missing = "" if key == "regime" else math.nan
+            row[f"{key}_{level:g}"] = missing if at is None or key not in study.overview else study.overview[key][at]
     return row
 
 
@@ -93,7 +96,7 @@ def _number(value: float, fmt: str, unit: str = "") -> str:
 
 
 def switch_text(row: dict[str, Any]) -> str:
-    """The switch SMR->APR of a row as the README writes it ("5.3->5.5", "none (SMR to 9)", "APR from 4.5")."""
+    """The switch SMR->APR of a row ("5.3->5.5"; "none" without APR at the highest level; "APR from 4.5")."""
     last, first = row["last_smr"], row["first_apr"]
     if math.isnan(first):
         return "none"
@@ -120,15 +123,3 @@ def compare_text(rows: Sequence[dict[str, Any]]) -> str:
                      f"{_number(row['restitution_7.4'], '.2f'):>5} "
                      f"{_number(100 * row['higher_mode_energy_share_7.4'], '.1f', '%'):>6}")
     return "\n".join(lines)
-
-
-def compare_series(folders: Sequence[str | Path]) -> list[tuple[str, dict[str, list]]]:
-    """[(study name, overview as `sim.tables.overview_data` keys)] of response folders, for `sim.figures.plot_series`."""
-    series = []
-    for folder in folders:
-        meta, overview = response_folder(folder)
-        data = {"levels": [float(r["level"]) for r in overview]}
-        for key in ("resonant_mean", "resonant_mean_lo", "resonant_mean_hi"):
-            data[key] = [float(r[key]) for r in overview]
-        series.append((meta["study"].get("name", Path(folder).name), data))
-    return series

@@ -271,10 +271,11 @@ def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list
     return paths
 
 
-def _overview_of(rows: list[dict]) -> dict[str, list]:
-    """overview.csv as `sim.tables.overview_data` keys (numbers as floats, the regime as text)."""
+def read_overview(folder: Path, options: PlotOptions | None = None) -> dict[str, list]:
+    """A folder's overview.csv as `sim.tables.overview_data` keys (numbers as floats, the regime as text); with
+    `options`, only the chosen levels."""
     data: dict[str, list] = defaultdict(list)
-    for r in rows:
+    for r in _rows(folder / "overview.csv", options):
         for key, value in r.items():
             data["levels" if key == "level" else key].append(value if key == "regime" else float(value))
     return dict(data)
@@ -291,7 +292,7 @@ def response_figures(folder: str | Path, options: PlotOptions | None = None) -> 
     meta = _study(folder)
     if "series_folders" in meta:
         return _series_figure(folder, meta, options)
-    overview = _overview_of(_rows(folder / "overview.csv", options))
+    overview = read_overview(folder, options)
     selected([float(r["level"]) for r in _rows(folder / "overview.csv")], options, folder)
     protocol = meta["study"]["protocol_resolved"]
     runs = f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold"
@@ -328,7 +329,7 @@ def response_figures(folder: str | Path, options: PlotOptions | None = None) -> 
 def series_overviews(folder: Path, options: PlotOptions | None = None) -> list[tuple[str, dict[str, list]]]:
     """[(NAME=VALUE, overview)] of a series response study (Fig. 11), from each value's overview.csv."""
     meta = _study(folder)
-    return [(sub, _overview_of(_rows(folder / sub / "overview.csv", options))) for sub in meta["series_folders"]]
+    return [(sub, read_overview(folder / sub, options)) for sub in meta["series_folders"]]
 
 
 def _series_figure(folder: Path, meta: dict, options: PlotOptions) -> list[Path]:
