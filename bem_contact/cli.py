@@ -28,7 +28,7 @@ import sys
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from sim.options import figure_file
+from sim.common.options import figure_file
 
 HELP = "calibrate the Hertzian spring constant k_H by BEM contact on a scanned crater or the flat wall (Sect. 4.1, Eq. 8, Fig. 3)"
 
@@ -327,7 +327,7 @@ def plot(data: dict[str, Any], label: str, path: str) -> None:
     """Force-indentation curve, the fit and Eq. 8 (Fig. 3c style), written atomically."""
     import numpy as np
 
-    from sim.files import plot_to
+    from sim.common.files import plot_to
 
     d = np.asarray(data["deltas"])
     fine = np.linspace(0.0, d[-1], 200)
@@ -345,7 +345,7 @@ def plot(data: dict[str, Any], label: str, path: str) -> None:
 def scan_plot(data: dict[str, Any], source: GapSource, path: str) -> None:
     """Levelled crater map beside the force-indentation curve, its fit and Eq. 8 (Fig. 3b, 3c), atomically."""
     from scans.figures import calibration_figure
-    from sim.files import save_figure
+    from sim.common.files import save_figure
 
     fig = calibration_figure(source.facts["_contact"], source.facts["_metrics"], data["deltas"], data["forces"],
                              data["k_H"], data["k_H_star"])
@@ -397,7 +397,7 @@ def _tangential_text(data: dict[str, Any]) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """`ies calibrate`: calibrate, plot on request, print the summary (text or JSON)."""
-    from sim.files import dumps, report_written
+    from sim.common.files import dumps, report_written
 
     if args.normal_force is not None and not args.tangential:
         from bem_contact.errors import ContactInputError
@@ -421,7 +421,7 @@ def run(args: argparse.Namespace) -> int:
 def calibrate_default() -> dict[str, Any]:
     """`ies calibrate --json` with every default (the shipped paper-like crater, Sect. 4.1), in process: the
     JSON object as plain data (SI units; k_H in N/m^1.5). Raises the stages' errors as `ies calibrate` does."""
-    from sim.files import to_jsonable
+    from sim.common.files import to_jsonable
 
     parser = argparse.ArgumentParser()
     add_arguments(parser)

@@ -1,6 +1,6 @@
 """Pictures of a scan calibration: the levelled crater and the force-indentation curve (Fig. 3b, 3c).
 
-Built on `matplotlib.figure.Figure` (no pyplot, no GUI back end); save with `sim.files.save_figure`.
+Built on `matplotlib.figure.Figure` (no pyplot, no GUI back end); save with `sim.common.files.save_figure`.
 """
 from __future__ import annotations
 

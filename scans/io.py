@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from scans.errors import ScanError
-from sim.files import write_bytes
+from sim.common.files import write_bytes
 
 #: length units a scan file may be written in, as metres per unit
 UNITS: dict[str, float] = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": 0.0254}

@@ -1,14 +1,14 @@
 """The simulation stage: the modal model of a beam with an Impact Energy Scatterer, its time integrators and
 the stepped-sine protocol with its measures (seed paper Sects. 3 and 5).
 
-Pipeline: rig geometry / modal file -> sim.rig / sim.modal_file -> modal model -> **sim** (stepped sine,
-per-period amplitudes) -> uq. sim stands alone: it imports no other stage, which is why `sim.files`, the
+Pipeline: rig geometry / modal file -> sim.hosts.rig / sim.hosts.modal_file -> modal model -> **sim** (stepped sine,
+per-period amplitudes) -> uq. sim stands alone: it imports no other stage, which is why `sim.common.files`, the
 one way every stage writes a file, lives here, with what every stage's command line shares: option types
-(`sim.options`, quantities with units from `sim.units`) and the redrawing of result folders (`sim.redraw`). Its
+(`sim.common.options`, quantities with units from `sim.common.units`) and the redrawing of result folders (`sim.plots.redraw`). Its
 commands `ies modes`, `ies sweep`, `ies overview` live in `sim.cli`; independent references for tests in
-`sim.references`.
+`sim.integration.references`.
 
-Public names, each imported from its module on first use, so that `import sim.errors` (done by the `ies`
+Public names, each imported from its module on first use, so that `import sim.common.errors` (done by the `ies`
 front door) stays light (importing all of them takes 0.6-0.8 s more):
   system:     ModalModel, Impactor, Nominal, a_base_star, a_noabs_star (Eqs. 3-7, Sect. 5)
   rig:        seed_rig_model (the built-in Timoshenko beam model of the rig, Appendix A)
@@ -26,19 +26,19 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-from sim.errors import SimulationDiverged, SimulationInputError
+from sim.common.errors import SimulationDiverged, SimulationInputError
 
 _MODULE_OF = {
-    "ModalModel": "system", "Impactor": "system", "Nominal": "system", "a_base_star": "system",
-    "a_noabs_star": "system",
-    "seed_rig_model": "rig",
-    "load_modal_model": "modal_file", "save_modal_model": "modal_file",
-    "ContactLaw": "contact_law", "JenkinsElement": "friction",
-    "SteppedSine": "protocol", "SweepResult": "protocol", "run_sweep": "protocol", "sweep": "protocol",
-    "Signal": "signals", "read_signal": "signals", "simulated_signal": "signals",
-    "detect_impacts": "impacts", "ImpactDetection": "impacts",
-    "fit_modes": "modal_fit", "ModalFit": "modal_fit", "plot_modal_fit": "modal_fit",
-    "overview_data": "tables",
+    "ModalModel": "model.system", "Impactor": "model.system", "Nominal": "model.system", "a_base_star": "model.system",
+    "a_noabs_star": "model.system",
+    "seed_rig_model": "hosts.rig",
+    "load_modal_model": "hosts.modal_file", "save_modal_model": "hosts.modal_file",
+    "ContactLaw": "model.contact_law", "JenkinsElement": "model.friction",
+    "SteppedSine": "stepped_sine.protocol", "SweepResult": "stepped_sine.protocol", "run_sweep": "stepped_sine.protocol", "sweep": "stepped_sine.protocol",
+    "Signal": "analysis.signals", "read_signal": "analysis.signals", "simulated_signal": "analysis.signals",
+    "detect_impacts": "analysis.impacts", "ImpactDetection": "analysis.impacts",
+    "fit_modes": "analysis.modal_fit", "ModalFit": "analysis.modal_fit", "plot_modal_fit": "analysis.modal_fit",
+    "overview_data": "stepped_sine.tables",
 }
 __all__ = ["SimulationDiverged", "SimulationInputError", *_MODULE_OF]
 

@@ -1,11 +1,11 @@
 """The simulation stage's words of the `ies` command line: `modes`, `sweep`, `overview`, `trace`.
 
 * `ies modes`: the modal model of the host structure (seed paper Sect. 3.1, Eq. 7, Appendix A), the built-in
-  model of the seed rig (`sim.rig`) or a modal-model file (`sim.modal_file`); --save writes it as a file.
+  model of the seed rig (`sim.hosts.rig`) or a modal-model file (`sim.hosts.modal_file`); --save writes it as a file.
 * `ies sweep`: a stepped-sine frequency response like Fig. 5 (Sects. 5.1, 5.2).
 * `ies overview`: the resonant response level against the excitation level, like Fig. 6 (Sect. 5.3).
-* `ies trace`: time histories of one stepped-sine point, like Figs. 4 and 9a (Sects. 5.1, 5.5; `sim.trace`).
-* `ies impacts`, `ies modal-fit`: the analyses of measured or simulated signals (`sim.signal_cli`).
+* `ies trace`: time histories of one stepped-sine point, like Figs. 4 and 9a (Sects. 5.1, 5.5; `sim.analysis.trace`).
+* `ies impacts`, `ies modal-fit`: the analyses of measured or simulated signals (`sim.analysis.cli`).
 
 `add_commands(subparsers)` (at the end) registers them with the front door (`uq.cli`), which only dispatches. Heavy
 imports (numpy, numba) stay inside the functions, so that `ies --help` stays fast. Every bad value ends in
@@ -20,9 +20,9 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
-from sim import signal_cli
-from sim.errors import SimulationInputError
-from sim.options import clearance, figure_file, friction_coefficient, hertz_constant, positive_int, tangential_stiffness
+from sim.analysis import cli as signal_cli
+from sim.common.errors import SimulationInputError
+from sim.common.options import clearance, figure_file, friction_coefficient, hertz_constant, positive_int, tangential_stiffness
 
 MODES_HELP = "modal model of the host structure: frequencies, damping, mode values, participation (built-in rig or file)"
 SWEEP_HELP = "stepped-sine frequency response (mean and max amplitude per eta, spread over repetitions; Fig. 5)"
@@ -42,13 +42,13 @@ def add_modes_arguments(parser: argparse.ArgumentParser) -> None:
     source = parser.add_mutually_exclusive_group()
     source.add_argument("--model", metavar="FILE", help="read a modal-model file instead of the built-in seed rig")
     source.add_argument("--solid", action="store_true",
-                        help="the rig as a 3D solid finite-element model (sim.solid; needs pip install '.[solid]')")
+                        help="the rig as a 3D solid finite-element model (sim.hosts.solid; needs pip install '.[solid]')")
     source.add_argument("--from-calculix", dest="from_calculix", metavar="JOB.frd",
                         help="mode shapes of a CalculiX *FREQUENCY job (ASCII .frd; with --mesh JOB.inp and the node "
                              "sets --wall-left, --wall-right, --tip; participation from JOB.dat)")
     parser.add_argument("--variant", default=None, metavar="NAME",
                         help="updating variant of the built-in rig: joint-spring (default) or effective-modulus; "
-                             "with --solid a variant of the solid model (sim.variants.SOLID_VARIANTS: beam-neck, "
+                             "with --solid a variant of the solid model (sim.hosts.variants.SOLID_VARIANTS: beam-neck, "
                              "updated, updated-400, updated-contact+2mm, updated-contact+4mm, updated-hertz-patch, "
                              "updated-patch-3mm)")
     parser.add_argument("--n-modes", dest="n_modes", type=int, default=9, metavar="N",
@@ -60,7 +60,7 @@ def add_modes_arguments(parser: argparse.ArgumentParser) -> None:
     solid.add_argument("--mesh", metavar="LEVEL|JOB.inp",
                        help="--solid: mesh level coarse (default, ~1 min), medium or fine; --from-calculix: the job's .inp")
     solid.add_argument("--geometry", metavar="FILE",
-                       help="--solid: TOML file with [geometry] (sim.solid.SolidGeometry fields, m) and [material] "
+                       help="--solid: TOML file with [geometry] (sim.hosts.solid.SolidGeometry fields, m) and [material] "
                             "(E in Pa, nu, rho in kg/m^3) tables; missing keys keep the rig's defaults")
     solid.add_argument("--patch-radius", dest="patch_radius", type=float, default=0.0, metavar="M",
                        help="--solid: average the wall values over a circle of this radius (m) on each wall face")
@@ -79,10 +79,10 @@ def add_modes_arguments(parser: argparse.ArgumentParser) -> None:
 def describe_modes(model: Any, rig: Any = None) -> dict:
     """The JSON object of `ies modes --json` (Sect. 3.1, Eq. 7; Sect. 5 for a_base*; SI units): the model's
     arrays, the modal mass ratio, a_base*, the paper's ode3 step dt = 2 pi/(15 omega_n), and with the
-    built-in rig (`sim.rig.RigModes`) its updating summary (Appendix A)."""
+    built-in rig (`sim.hosts.rig.RigModes`) its updating summary (Appendix A)."""
     import numpy as np
 
-    from sim.system import SPHERE_MASS, a_base_star
+    from sim.model.system import SPHERE_MASS, a_base_star
 
     phi_c = model.phi_contact
     data = {
@@ -144,7 +144,7 @@ def _solid_geometry(path: str | None) -> tuple[Any, Any]:
     import dataclasses
     import tomllib
 
-    from sim.solid import SolidGeometry, SolidMaterial
+    from sim.hosts.solid import SolidGeometry, SolidMaterial
 
     if path is None:
         return SolidGeometry(), SolidMaterial()
@@ -174,8 +174,8 @@ def _external_model(args: argparse.Namespace) -> tuple[Any, dict | None, list[st
     if args.variant is not None and not args.solid:
         raise SimulationInputError("--variant with --from-calculix: the job defines the model; drop --variant")
     if args.solid:
-        from sim.solid import MESH_LEVELS, solid_rig_model
-        from sim.variants import SOLID_VARIANTS, solid_variant_model
+        from sim.hosts.solid import MESH_LEVELS, solid_rig_model
+        from sim.hosts.variants import SOLID_VARIANTS, solid_variant_model
 
         level = args.mesh or "coarse"
         if level not in MESH_LEVELS:
@@ -196,7 +196,7 @@ def _external_model(args: argparse.Namespace) -> tuple[Any, dict | None, list[st
         else:
             result = solid_rig_model(level, geometry, material, n_modes=args.n_modes, patch_radius=args.patch_radius)
         return result.model, result.provenance, result.report
-    from sim.calculix import calculix_modal_model
+    from sim.hosts.calculix import calculix_modal_model
 
     missing = [o for o, v in (("--mesh JOB.inp", args.mesh), ("--wall-left", args.wall_left),
                               ("--wall-right", args.wall_right), ("--tip", args.tip)) if not v]
@@ -209,22 +209,22 @@ def _external_model(args: argparse.Namespace) -> tuple[Any, dict | None, list[st
 
 
 def _fixed_joint_model(stiffness: float, variant: str, n_modes: int) -> tuple[Any, Any, dict, list[str]]:
-    """`ies modes --joint-stiffness K`: the built-in rig re-updated (sim.rig.update_rig) with the joint's
-    translational stiffness fixed at K (N/m; sim.rig.update_rig_fixed_joint): (model, updated RigParameters,
+    """`ies modes --joint-stiffness K`: the built-in rig re-updated (sim.hosts.rig.update_rig) with the joint's
+    translational stiffness fixed at K (N/m; sim.hosts.rig.update_rig_fixed_joint): (model, updated RigParameters,
     provenance, report lines)."""
     import math
 
-    from sim.files import to_jsonable
-    from sim.rig import rig_modal_model, update_rig_fixed_joint
+    from sim.common.files import to_jsonable
+    from sim.hosts.rig import rig_modal_model, update_rig_fixed_joint
 
     if not (stiffness > 0):  # also refuses NaN
         raise SimulationInputError(f"--joint-stiffness must be positive in N/m (inf = rigid), got {stiffness!r}")
     fit = update_rig_fixed_joint(stiffness, variant=variant)
     label = "rigid" if math.isinf(stiffness) else f"{stiffness:.4g} N/m"
-    model = rig_modal_model(fit.params, n_modes, f"built-in seed rig (sim.rig, Timoshenko beam, variant {variant} "
+    model = rig_modal_model(fit.params, n_modes, f"built-in seed rig (sim.hosts.rig, Timoshenko beam, variant {variant} "
                                                   f"re-updated with the joint stiffness fixed at {label})")
     errors = [100 * e for e in fit.frequency_errors]
-    plain = {"model": "built-in Timoshenko beam (sim.rig), re-updated (sim.rig.update_rig_fixed_joint)",
+    plain = {"model": "built-in Timoshenko beam (sim.hosts.rig), re-updated (sim.hosts.rig.update_rig_fixed_joint)",
              "variant": variant,
              "joint_translational_stiffness_N_per_m": stiffness if math.isfinite(stiffness) else "rigid",
              "updated_parameters": fit.params.as_dict(), "f1_f4_error_percent": errors,
@@ -239,8 +239,8 @@ def _fixed_joint_model(stiffness: float, variant: str, n_modes: int) -> tuple[An
 def modes_command(args: argparse.Namespace) -> int:
     """`ies modes`: show (and with --save write) the built-in rig's model, a modal-model file, the 3D solid
     model or the modes of a CalculiX job."""
-    from sim.files import dumps, report_written
-    from sim.modal_file import save_modal_model
+    from sim.common.files import dumps, report_written
+    from sim.hosts.modal_file import save_modal_model
 
     rig = provenance = None
     report: list[str] = []
@@ -260,7 +260,7 @@ def modes_command(args: argparse.Namespace) -> int:
             raise SimulationInputError("--variant selects a built-in rig model; it cannot be used with --model")
         model = model_file(args.model)
     else:
-        from sim.rig import DEFAULT_VARIANT, rig_modes, seed_rig_model, variant_parameters
+        from sim.hosts.rig import DEFAULT_VARIANT, rig_modes, seed_rig_model, variant_parameters
 
         variant = args.variant or DEFAULT_VARIANT
         if args.joint_stiffness is not None:
@@ -290,7 +290,7 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
                         help="Hertz constant k_H in N/m^1.5, or with a unit: 282e3N/mm^1.5 (default 282e3 N/mm^1.5 = "
                              "8.918e9 N/m^1.5)")
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
-    parser.add_argument("--contact-law", dest="contact_law", choices=("hertz", "hertz-damped"), default=None,  # sim.contact_law.CONTACT_LAWS
+    parser.add_argument("--contact-law", dest="contact_law", choices=("hertz", "hertz-damped"), default=None,  # sim.model.contact_law.CONTACT_LAWS
                         help="normal contact law at both walls: hertz (Eq. 4, elastic, default) or hertz-damped (Eq. 10; "
                              "needs the model's beam mass; the exact integrator then takes every contact by "
                              "Dormand-Prince)")
@@ -369,7 +369,7 @@ def parse_levels(text: str) -> list[float]:
     """Excitation levels a_base/a_base* (Sect. 5.3) from '1.26,5.3' or 'START:STOP:N'; each must be positive."""
     import numpy as np
 
-    from sim.protocol import check_level
+    from sim.stepped_sine.protocol import check_level
 
     if ":" in text:
         start, stop, n = parse_grid(text, "--levels")
@@ -388,11 +388,11 @@ def parse_levels(text: str) -> list[float]:
 
 
 def model_file(path: str) -> Any:
-    """The modal model of a file (`sim.modal_file`), its source naming the file first: ``file PATH (what the file
+    """The modal model of a file (`sim.hosts.modal_file`), its source naming the file first: ``file PATH (what the file
     says it holds)``, so that a saved built-in model is reported as the file it now is."""
     import dataclasses
 
-    from sim.modal_file import load_modal_model
+    from sim.hosts.modal_file import load_modal_model
 
     model = load_modal_model(path)
     return dataclasses.replace(model, source=f"file {path} ({model.source})")
@@ -400,8 +400,8 @@ def model_file(path: str) -> Any:
 
 def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     """(modal model, impactor or None) of the system and impactor options (Eqs. 3-7, Table 2)."""
-    from sim.rig import seed_rig_model
-    from sim.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor, system_arrays
+    from sim.hosts.rig import seed_rig_model
+    from sim.model.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor, system_arrays
 
     model = model_file(args.model) if args.model else seed_rig_model(n_modes=9)
     if args.D is not None:
@@ -418,8 +418,8 @@ def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
 
 
 def contact_law(args: argparse.Namespace) -> Any:
-    """The `sim.contact_law.ContactLaw` of --contact-law and --r-cont (--r-cont alone implies the damped law)."""
-    from sim.contact_law import DEFAULT_R_CONT, ContactLaw
+    """The `sim.model.contact_law.ContactLaw` of --contact-law and --r-cont (--r-cont alone implies the damped law)."""
+    from sim.model.contact_law import DEFAULT_R_CONT, ContactLaw
 
     name = args.contact_law or ("hertz-damped" if args.r_cont is not None else "hertz")
     r_cont = args.r_cont if args.r_cont is not None else (DEFAULT_R_CONT if name == "hertz-damped" else 1.0)
@@ -439,8 +439,8 @@ def system_data(model: Any, impactor: Any) -> dict:
 
 
 def build_protocol(args: argparse.Namespace) -> Any:
-    """The `sim.protocol.SteppedSine` of the protocol options (Sect. 5.1; 15 s wait without impactor)."""
-    from sim.protocol import SteppedSine
+    """The `sim.stepped_sine.protocol.SteppedSine` of the protocol options (Sect. 5.1; 15 s wait without impactor)."""
+    from sim.stepped_sine.protocol import SteppedSine
 
     start, stop, n = parse_grid(args.eta, "--eta")
     wait = args.wait if args.wait is not None else (15.0 if args.no_impactor else 3.0)
@@ -476,7 +476,7 @@ LONG_SWEEP_S = 60.0
 
 @contextmanager
 def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str) -> Iterator[tuple]:
-    """(--out folder or None, protocol, model, impactor, one `sim.protocol.sweep` result per level) of the
+    """(--out folder or None, protocol, model, impactor, one `sim.stepped_sine.protocol.sweep` result per level) of the
     options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder.
     The integrator's kernels are warmed up (compiled on the first run) before one progress bar, `label`, counts
     the stepped-sine points of every level and repetition (on a terminal; for one level only when it is long)."""
@@ -484,8 +484,8 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
 
     from tqdm import tqdm
 
-    from sim.integrators import warm_up
-    from sim.protocol import sweep
+    from sim.integration.integrators import warm_up
+    from sim.stepped_sine.protocol import sweep
 
     protocol = build_protocol(args)
     model, impactor = build_system(args)
@@ -502,7 +502,7 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
 
 def write_results(folder: Path | None, stem: str, header: Sequence[str], rows: Any, data: dict) -> list[Path]:
     """With --out: the table as STEM.csv (data) and `data` as STEM.json (data + metadata); the paths written."""
-    from sim.files import dumps, write_csv, write_text
+    from sim.common.files import dumps, write_csv, write_text
 
     if folder is None:
         return []
@@ -512,7 +512,7 @@ def write_results(folder: Path | None, stem: str, header: Sequence[str], rows: A
 def report(args: argparse.Namespace, data: dict, written: list, plot: Any, text: str) -> int:
     """End of `ies sweep`/`ies overview`: draw `--plot` with plot(path), then print the JSON object (`--json`)
     or the text table, and a `wrote PATH` line per file written; exit code 0."""
-    from sim.files import dumps, report_written
+    from sim.common.files import dumps, report_written
 
     if args.plot:
         plot(args.plot)
@@ -533,9 +533,9 @@ def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
 
 def sweep_command(args: argparse.Namespace) -> int:
     """`ies sweep`: one stepped-sine frequency response (Sects. 5.1, 5.2; Fig. 5)."""
-    from sim.figures import plot_sweep, sweep_title
-    from sim.protocol import check_level
-    from sim.tables import SWEEP_COLUMNS, sweep_rows
+    from sim.plots.figures import plot_sweep, sweep_title
+    from sim.stepped_sine.protocol import check_level
+    from sim.stepped_sine.tables import SWEEP_COLUMNS, sweep_rows
 
     started = time.perf_counter()
     level = check_level(args.level)
@@ -565,8 +565,8 @@ def add_overview_arguments(parser: argparse.ArgumentParser) -> None:
 
 def overview_command(args: argparse.Namespace) -> int:
     """`ies overview`: the resonant level at each excitation level (Sect. 5.3; Fig. 6)."""
-    from sim.figures import overview_title, plot_overview
-    from sim.tables import OVERVIEW_COLUMNS, dissipation_key, overview_data, overview_rows, overview_text
+    from sim.plots.figures import overview_title, plot_overview
+    from sim.stepped_sine.tables import OVERVIEW_COLUMNS, dissipation_key, overview_data, overview_rows, overview_text
 
     started = time.perf_counter()
     levels = parse_levels(args.levels)
@@ -583,7 +583,7 @@ def overview_command(args: argparse.Namespace) -> int:
 
 def add_trace_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies trace`."""
-    from sim.trace import DEFAULT_FS, DEFAULT_PERIODS
+    from sim.analysis.trace import DEFAULT_FS, DEFAULT_PERIODS
 
     parser.add_argument("--level", type=float, required=True, metavar="L", help="excitation level a_base/a_base* (-)")
     parser.add_argument("--eta", required=True, metavar="ETA|START:STOP:N",
@@ -606,10 +606,10 @@ def add_trace_arguments(parser: argparse.ArgumentParser) -> None:
 
 def trace_command(args: argparse.Namespace) -> int:
     """`ies trace`: time histories of one stepped-sine point (Sects. 5.1, 5.5; Figs. 4, 9a)."""
-    from sim.files import dumps, report_written
-    from sim.integrators import warm_up
-    from sim.protocol import check_level
-    from sim.trace import check_trace_settings, record_trace, write_trace
+    from sim.common.files import dumps, report_written
+    from sim.integration.integrators import warm_up
+    from sim.stepped_sine.protocol import check_level
+    from sim.analysis.trace import check_trace_settings, record_trace, write_trace
 
     started = time.perf_counter()
     level = check_level(args.level)

@@ -131,13 +131,64 @@ def test_no_import_cycles_at_module_level(modules):
 
 def test_the_walk_sees_every_kind_of_import():
     """The checks above can fail: imports in functions, relative and aliased imports are all seen."""
-    source = ("import uq.cli as front\nfrom . import files\nfrom ..scans import io\n"
+    source = ("import uq.cli as front\nfrom .common import files\nfrom ..scans import io\n"
               "def later():\n    from bem_contact.solvers import solve_contact\n")
     every = imported_names(source, "sim.cli", False, top_level_only=False)
-    assert {"uq.cli", "sim.files", "scans.io", "bem_contact.solvers"} <= every
+    assert {"uq.cli", "sim.common.files", "scans.io", "bem_contact.solvers"} <= every
     top = imported_names(source, "sim.cli", False, top_level_only=True)
     assert "bem_contact.solvers" not in top and "uq.cli" in top
-    modules = {"uq": ROOT, "uq.cli": ROOT, "sim": ROOT, "sim.files": ROOT}
-    assert resolve({"uq.cli", "sim.files.write_text", "numpy"}, modules) == {"uq", "uq.cli", "sim", "sim.files"}
+    modules = {"uq": ROOT, "uq.cli": ROOT, "sim": ROOT, "sim.common.files": ROOT}
+    assert resolve({"uq.cli", "sim.common.files.write_text", "numpy"}, modules) == {"uq", "uq.cli", "sim", "sim.common.files"}
     assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == ["a", "b", "c", "a"]
     assert find_cycle({"a": {"b"}, "b": set()}) is None
+
+
+#: Inside `sim`: sub-package -> the sub-packages it may import (besides itself). The simulator's parts in pipeline
+#: order: the shared layer; the coupled system; the integrators; the stepped-sine protocol and its measures; the host
+#: models (their fidelity variants read the measures' landmarks); signal analysis; the reduced (slow-flow) model;
+#: figures. `sim` itself (its lazy public names) and `sim.cli` (the commands) may import every part.
+SIM_LAYERS: dict[str, set[str]] = {
+    "common": set(),
+    "model": {"common"},
+    "integration": {"common", "model"},
+    "stepped_sine": {"common", "model", "integration"},
+    "hosts": {"common", "model", "stepped_sine"},
+    "analysis": {"common", "model", "integration", "stepped_sine", "hosts"},
+    "reduced": {"common", "model", "integration", "stepped_sine", "hosts"},
+    "plots": {"common", "model", "stepped_sine", "analysis"},
+}
+#: The written-down exceptions: (importing module, the part it may also import) with the reason.
+SIM_EXCEPTIONS = {
+    # `ies trace` writes its figure with its data, all or nothing (inside the function that writes both)
+    ("sim.analysis.trace", "plots"),
+}
+
+
+def sim_part(module: str) -> str | None:
+    """The sub-package of `sim` a module belongs to (None for `sim` itself and `sim.cli`)."""
+    parts = module.split(".")
+    return parts[1] if parts[0] == "sim" and len(parts) > 1 and parts[1] != "cli" else None
+
+
+def test_sim_parts_import_each_other_only_as_written_down(modules):
+    assert {sim_part(m) for m in modules if sim_part(m)} <= set(SIM_LAYERS), "a new part of sim: add it to SIM_LAYERS"
+    wrong = []
+    for name, targets in import_graph(modules, top_level_only=False).items():
+        part = sim_part(name)
+        if part is None:
+            continue
+        for target in sorted(targets):
+            other = sim_part(target)
+            if target.startswith("sim") and (other is None and target != "sim" or other and other != part
+                                             and other not in SIM_LAYERS[part]) and (name, other) not in SIM_EXCEPTIONS:
+                wrong.append(f"{name} imports {target}")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_no_import_cycles_between_modules_even_inside_functions(modules):
+    """Also the imports made inside functions: a cycle there is a tangle even when it cannot fail at import time."""
+    graph = import_graph(modules, top_level_only=False)
+    for name, part in SIM_EXCEPTIONS:
+        graph[name] = {t for t in graph[name] if sim_part(t) != part}
+    graph = {name: {t for t in targets if t not in ("sim", "uq")} for name, targets in graph.items()}
+    assert find_cycle(graph) is None

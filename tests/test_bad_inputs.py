@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sim.modal_file import save_modal_model
-from sim.system import ModalModel
+from sim.hosts.modal_file import save_modal_model
+from sim.model.system import ModalModel
 from uq.cli import main
 
 FAST = ["--eta", "0.98:1.0:3", "--wait", "0.02", "--hold", "0.03", "--reps", "1"]

@@ -1,4 +1,4 @@
-"""Every file the workbench writes is an ordinary file: mode 0644 under the usual umask 022 (sim.files), on
+"""Every file the workbench writes is an ordinary file: mode 0644 under the usual umask 022 (sim.common.files), on
 every writing path of every stage, with no temporary file left behind."""
 import os
 import stat
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from scans import write_scan
-from sim.files import write_text
+from sim.common.files import write_text
 from uq.cli import main
 from uq.commands import run_calibration
 

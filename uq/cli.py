@@ -22,7 +22,7 @@ import sim.cli
 import uq.commands
 from bem_contact.errors import ContactInputError, ConvergenceError
 from scans.errors import ScanError
-from sim.errors import SimulationDiverged, SimulationInputError
+from sim.common.errors import SimulationDiverged, SimulationInputError
 from uq.errors import StudyError
 
 USER_ERRORS = (ContactInputError, ScanError, SimulationInputError, StudyError)

@@ -12,7 +12,7 @@
   its BEM result 1.52 k_H* (Sect. 4.1); the best estimate stays 1.25 k_H* unless the calibration falls below
   it (then the midpoint of k_H* and the calibrated value). A failed calibration is one warning line, and
   Table 2's bounds are kept.
-* `ies plot DIR`: redraw the figures of a result folder from its data (`sim.redraw`), in other formats, another
+* `ies plot DIR`: redraw the figures of a result folder from its data (`sim.plots.redraw`), in other formats, another
   matplotlib style or for a subset of the levels, without recomputing.
 * `ies compare DIR DIR ... --out OUT`: the Fig. 6 landmarks of several response studies side by side with the
   paper's (`uq.compare`; the README's fidelity table), a table and one figure.
@@ -31,7 +31,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, Callable
 
-from sim.options import figure_formats, level_list, positive_int
+from sim.common.options import figure_formats, level_list, positive_int
 
 #: the calibration `ies reproduce` runs: no arguments, returns the JSON object of `ies calibrate --json`
 Calibrate = Callable[[], dict]
@@ -184,14 +184,14 @@ def print_response_result(folder: Path, name: str) -> None:
     scattering measures at the resonant eta."""
     import json
 
-    from sim.tables import optimum_line, overview_text, scattering_text
+    from sim.stepped_sine.tables import optimum_line, overview_text, scattering_text
 
-    from sim.variants import switch_line
+    from sim.hosts.variants import switch_line
 
     data = json.loads((folder / "study.json").read_text())
     if "series_folders" in data:
         from uq.figures import series_overviews
-        from sim.tables import series_text
+        from sim.stepped_sine.tables import series_text
 
         print(f"{name}: resonant mean (a / a_noabs*) and the input's dissipation shares at the resonant eta "
               f"(contact / friction / mode 1 / modes 2..N) for each value:")
@@ -250,7 +250,7 @@ def run_calibration(calibrate: Calibrate, out: Path) -> dict | None:
     Returns None after one warning line when it fails: the calibration is optional, and whatever stops it
     (a bad scan, a solver that does not converge, ...) leaves the studies on Table 2's k_H bounds.
     """
-    from sim.files import dumps, write_text
+    from sim.common.files import dumps, write_text
 
     try:
         data = calibrate()
@@ -359,12 +359,12 @@ def add_plot_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def plot_command(args: argparse.Namespace) -> int:
-    """`ies plot`: redraw the figures of a result folder from its data files (`sim.redraw`)."""
-    import sim.figures  # noqa: F401 - registers ies sweep's, overview's and trace's folders
+    """`ies plot`: redraw the figures of a result folder from its data files (`sim.plots.redraw`)."""
+    import sim.plots.figures  # noqa: F401 - registers ies sweep's, overview's and trace's folders
     import uq.figures  # noqa: F401 - registers the study folders
-    from sim.errors import SimulationInputError
-    from sim.files import report_written
-    from sim.redraw import PlotOptions, kind_of, redraw, style
+    from sim.common.errors import SimulationInputError
+    from sim.common.files import report_written
+    from sim.plots.redraw import PlotOptions, kind_of, redraw, style
 
     kind_of(args.folder)  # what it is and whether the style exists, before any folder is made
     style(args.style)
@@ -394,10 +394,10 @@ def add_compare_arguments(parser: argparse.ArgumentParser) -> None:
 
 def compare_command(args: argparse.Namespace) -> int:
     """`ies compare`: every folder is read and checked before anything is written (`uq.compare`)."""
-    from sim.errors import SimulationInputError
-    from sim.figures import plot_series
-    from sim.files import dumps, report_written, write_csv, write_text
-    from sim.redraw import style
+    from sim.common.errors import SimulationInputError
+    from sim.plots.figures import plot_series
+    from sim.common.files import dumps, report_written, write_csv, write_text
+    from sim.plots.redraw import style
     from uq.compare import COMPARE_COLUMNS, PAPER_ROW, compare_row, compare_text, read_response_folder
 
     studies = [read_response_folder(folder) for folder in args.folders]

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Sequence
 
-from sim.measures import PAPER_APR_LEVEL, PAPER_IMPACTS_PER_PERIOD, PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, \
+from sim.stepped_sine.measures import PAPER_APR_LEVEL, PAPER_IMPACTS_PER_PERIOD, PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, \
     PAPER_REDUCTION_MEAN
 from uq.errors import StudyError
 
@@ -43,7 +43,7 @@ PAPER_ROW = {"study": "paper", "folder": "", "last_smr": math.nan, "first_apr": 
 @dataclass(frozen=True)
 class ResponseFolder:
     """A finished response study's folder: its name, path, study.json `landmarks` and overview.csv (as
-    `sim.tables.overview_data` keys)."""
+    `sim.stepped_sine.tables.overview_data` keys)."""
 
     name: str
     folder: Path

@@ -15,7 +15,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from sim.files import dumps, write_csv, write_text
+from sim.common.files import dumps, write_csv, write_text
 from uq.errors import StudyError
 from uq.interval import Band, Design, DesignPoint, axis_design, band, box_design
 from uq.runner import ResultStore, Task, dask_client, prepare_output, run_tasks
@@ -312,8 +312,8 @@ def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     """Response study (Figs. 5 and 6): the frequency response of the nominal point at every level (mean and max
     amplitude per eta with the spread of the runs, Sect. 5.2) and its resonant levels (Sect. 5.3), every
     stepped-sine run a task of the store (resumable, parallel, on a cluster)."""
-    from sim.tables import OVERVIEW_COLUMNS, SWEEP_COLUMNS, overview_data, overview_rows, sweep_rows
-    from sim.variants import landmarks
+    from sim.stepped_sine.tables import OVERVIEW_COLUMNS, SWEEP_COLUMNS, overview_data, overview_rows, sweep_rows
+    from sim.hosts.variants import landmarks
 
     if study.series:
         return _run_response_series(study, out=out, jobs=jobs, scheduler=scheduler, resume=resume, progress=progress,
@@ -373,15 +373,15 @@ def _run_response_series(study: Study, *, out: Path | None, jobs: int, scheduler
 
 
 def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: int = 20) -> list[Path]:
-    """Fig. C.1b: with the series' last value (e.g. friction on), the time history (`sim.trace`, 51.2 kHz) of the
+    """Fig. C.1b: with the series' last value (e.g. friction on), the time history (`sim.analysis.trace`, 51.2 kHz) of the
     point of the resonant mean at each of `levels`, reached as the study's runs reach it (its grid up to that eta,
     the first run's random offset), into folder/trace-LEVEL: trace.csv, trace.json, Figs. 4/9a (trace.png) and
     the walls and the sphere (motion.png)."""
     import csv
     import dataclasses
 
-    from sim.figures import plot_motion
-    from sim.trace import record_trace, write_trace
+    from sim.plots.figures import plot_motion
+    from sim.analysis.trace import record_trace, write_trace
 
     sub, one = study.series_studies()[-1]
     with open(folder / sub / "overview.csv", newline="") as fh:

@@ -8,10 +8,10 @@
 * nominal-levels: the nominal point's resonant mean and max against the excitation level with the regime of
   each level (an interval study's by-product; not the paper's Fig. 6, which a response study draws).
 * Fig. 5 (frequency responses, one panel per level) and Fig. 6 (resonant levels against the excitation level,
-  the paper's optimum marked), response studies, through `sim.figures`.
+  the paper's optimum marked), response studies, through `sim.plots.figures`.
 * Sobol': S1 and ST with their confidence intervals vs level, and the repetition-noise share.
 
-Only the data files are read, never the runs, so `ies plot` redraws any of them (`sim.redraw`: the study kinds
+Only the data files are read, never the runs, so `ies plot` redraws any of them (`sim.plots.redraw`: the study kinds
 are registered here). Every figure is written in the formats of the plot options (PNG and PDF by default).
 """
 from __future__ import annotations
@@ -24,9 +24,9 @@ from typing import Any
 
 import numpy as np
 
-from sim.errors import SimulationInputError
-from sim.files import pyplot, save_figure
-from sim.redraw import KINDS, PlotOptions, kind_of, register, selected
+from sim.common.errors import SimulationInputError
+from sim.common.files import pyplot, save_figure
+from sim.plots.redraw import KINDS, PlotOptions, kind_of, register, selected
 from uq.results import nominal_regimes
 
 _YLABEL = {"mean": "mean resonant level  a / a_noabs*", "max": "max resonant level  a / a_noabs*",
@@ -272,7 +272,7 @@ def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list
 
 
 def read_overview(folder: Path, options: PlotOptions | None = None) -> dict[str, list]:
-    """A folder's overview.csv as `sim.tables.overview_data` keys (numbers as floats, the regime as text); with
+    """A folder's overview.csv as `sim.stepped_sine.tables.overview_data` keys (numbers as floats, the regime as text); with
     `options`, only the chosen levels."""
     data: dict[str, list] = defaultdict(list)
     for r in _rows(folder / "overview.csv", options):
@@ -285,7 +285,7 @@ def response_figures(folder: str | Path, options: PlotOptions | None = None) -> 
     """Fig. 5 (the frequency response at every level, a panel each) and Fig. 6 (resonant levels against the
     excitation level, the paper's optimum marked), as the study's [response] figures ask, from sweeps.csv and
     overview.csv."""
-    from sim.figures import plot_overview, plot_sweeps
+    from sim.plots.figures import plot_overview, plot_sweeps
 
     folder = Path(folder)
     options = options or PlotOptions()
@@ -311,7 +311,7 @@ def response_figures(folder: str | Path, options: PlotOptions | None = None) -> 
                                       "range of the runs")
     for figure in ("figD2", "figD3"):
         if figure in meta["study"]["response"]["figures"]:
-            from sim.figures import plot_scattering
+            from sim.plots.figures import plot_scattering
 
             what = "impacts per period (cf. Fig. D.2)" if figure == "figD2" else "restitution, APR levels (cf. Fig. D.3)"
             runs_rows = _rows(folder / "runs.csv", options)
@@ -334,7 +334,7 @@ def series_overviews(folder: Path, options: PlotOptions | None = None) -> list[t
 
 def _series_figure(folder: Path, meta: dict, options: PlotOptions) -> list[Path]:
     """Fig. 11: the resonant mean against the excitation level for each value of the series."""
-    from sim.figures import plot_series
+    from sim.plots.figures import plot_series
 
     protocol = meta["study"]["protocol_resolved"]
     name = next(iter(meta["study"]["series"]))

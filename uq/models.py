@@ -2,7 +2,7 @@
 
 A model maps (parameter values, excitation level, repetition) to named scalar outputs:
 
-* ``"ies"``: one stepped-sine run of the simulator (`sim.protocol.run_sweep`, Sect. 5.1-5.3 of the
+* ``"ies"``: one stepped-sine run of the simulator (`sim.stepped_sine.protocol.run_sweep`, Sect. 5.1-5.3 of the
   seed paper) with D, g, k_H; outputs the run's resonant response levels ``mean`` and ``max``
   (largest per-frequency mean / max amplitude, normalised by the nominal a_noabs*, Sect. 5) and
   ``apr`` (1 where the resonant level is reached in the almost periodic regime, else 0).
@@ -28,7 +28,7 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from sim.measures import SCATTERING_MEASURES
+from sim.stepped_sine.measures import SCATTERING_MEASURES
 from uq.errors import StudyError
 from uq.space import Parameter, ParameterSpace, table2_space
 
@@ -56,9 +56,9 @@ def _source_version(*relative_dirs_or_files: str) -> str:
 class IESModel:
     """The simulator of the seed rig under a stepped-sine protocol (one task = one run at one level).
 
-    protocol: keyword arguments of `sim.protocol.SteppedSine` (eta grid, sequence, wait, hold, ...);
+    protocol: keyword arguments of `sim.stepped_sine.protocol.SteppedSine` (eta grid, sequence, wait, hold, ...);
     n_modes: modes of the built-in rig model (9 as in the paper);
-    modal_file: a modal-model file (`sim.modal_file`, e.g. from `ies modes --save`) used instead of the built-in
+    modal_file: a modal-model file (`sim.hosts.modal_file`, e.g. from `ies modes --save`) used instead of the built-in
     rig; its SHA-256 is part of every task's key;
     rig: the modal model itself, built once by the controlling process (`with_rig`) and shipped to the
     workers: the eigen-solution's last bits depend on the BLAS thread count, which differs between the
@@ -79,7 +79,7 @@ class IESModel:
     #: r_cont,diss of the damped contact law (Eq. 10; listing it implies contact_law = "hertz-damped"), and the
     #: friction coefficient mu and tangential stiffness k_t (N/m) of dry friction at the floor (Appendix C; ode3)
     optional_parameters = ("r_cont", "friction", "k_t")
-    #: the resonant levels, the regime (1 = APR) and the scattering measures of `sim.measures` at the resonant
+    #: the resonant levels, the regime (1 = APR) and the scattering measures of `sim.stepped_sine.measures` at the resonant
     #: mean's eta (Sect. 5.5, Appendix D)
     outputs = ("mean", "max", "apr", *SCATTERING_MEASURES)
 
@@ -88,8 +88,8 @@ class IESModel:
 
     def optional_parameter(self, name: str) -> Parameter:
         """The default of an optional parameter (`optional_parameters`), before the study's table fills it in."""
-        from sim.contact_law import DEFAULT_R_CONT
-        from sim.friction import K_T_PAPER, MU_PAPER
+        from sim.model.contact_law import DEFAULT_R_CONT
+        from sim.model.friction import K_T_PAPER, MU_PAPER
 
         nominal, unit, label = {"r_cont": (DEFAULT_R_CONT, "-", "r_cont,diss of the damped contact law (Eq. 10)"),
                                 "friction": (MU_PAPER, "-", "friction coefficient mu at the floor (App. C)"),
@@ -104,9 +104,9 @@ class IESModel:
         return _protocol_dict(self._stepped_sine())
 
     def _stepped_sine(self):
-        from sim.protocol import SteppedSine
+        from sim.stepped_sine.protocol import SteppedSine
 
-        from sim.errors import SimulationInputError
+        from sim.common.errors import SimulationInputError
 
         try:
             return SteppedSine(**dict(self.protocol))
@@ -116,8 +116,8 @@ class IESModel:
     def check(self) -> None:
         """Build the protocol, the integrator and the rig model once so that bad settings fail before any
         task runs (and before anything is written)."""
-        from sim.errors import SimulationInputError
-        from sim.integrators import get_integrator
+        from sim.common.errors import SimulationInputError
+        from sim.integration.integrators import get_integrator
 
         protocol = self._stepped_sine()
         try:
@@ -130,8 +130,8 @@ class IESModel:
     def check_physics(self, params: Mapping[str, float]) -> None:
         """The model and protocol can simulate a point with these optional parameters (`optional_parameters`): Eq. 10
         needs the model's beam mass, friction its phi_floor and the ode3 integrator; one line otherwise."""
-        from sim.errors import SimulationInputError
-        from sim.system import system_arrays
+        from sim.common.errors import SimulationInputError
+        from sim.model.system import system_arrays
 
         point = {"g": 1e-3, "k_H": 1e9, **params}
         if self.contact_law == "hertz" and point.get("friction", 0.0) == 0.0:
@@ -145,9 +145,9 @@ class IESModel:
                              "[excitation] integrator = \"ode3\"")
 
     def _rig(self):
-        from sim.errors import SimulationInputError
-        from sim.modal_file import load_modal_model
-        from sim.variants import with_higher_mode_damping
+        from sim.common.errors import SimulationInputError
+        from sim.hosts.modal_file import load_modal_model
+        from sim.hosts.variants import with_higher_mode_damping
 
         try:
             rig = _rig_model(self.n_modes) if self.modal_file is None else load_modal_model(self.modal_file)
@@ -163,9 +163,9 @@ class IESModel:
     def _impactor(self, params: Mapping[str, float]):
         """The sphere of Eqs. 3-6 with this run's g and k_H, its mass scaled by [variant] sphere_mass_factor, the
         study's contact law (Eq. 10 with this run's r_cont when damped) and this run's friction (Appendix C)."""
-        from sim.contact_law import DEFAULT_R_CONT, ContactLaw
-        from sim.friction import K_T_PAPER
-        from sim.system import SPHERE_MASS, Impactor
+        from sim.model.contact_law import DEFAULT_R_CONT, ContactLaw
+        from sim.model.friction import K_T_PAPER
+        from sim.model.system import SPHERE_MASS, Impactor
 
         mass = SPHERE_MASS * self.variant.get("sphere_mass_factor", 1.0)
         law = (ContactLaw(self.contact_law, params.get("r_cont", DEFAULT_R_CONT)) if self.contact_law != "hertz"
@@ -179,12 +179,12 @@ class IESModel:
         return rig.with_damping(params["D"]), self._impactor(params)
 
     def stepped_sine(self) -> Any:
-        """The study's stepped-sine protocol (`sim.protocol.SteppedSine`)."""
+        """The study's stepped-sine protocol (`sim.stepped_sine.protocol.SteppedSine`)."""
         return self._stepped_sine()
 
     def warm_up(self) -> None:
-        """Compile the integrator's kernels in this process (`sim.integrators.warm_up`; minutes on a first run)."""
-        from sim.integrators import warm_up
+        """Compile the integrator's kernels in this process (`sim.integration.integrators.warm_up`; minutes on a first run)."""
+        from sim.integration.integrators import warm_up
 
         warm_up(self._stepped_sine().integrator)
 
@@ -206,7 +206,7 @@ class IESModel:
 
     def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, Any]:
         """One run: its own resonant levels (outputs) and the per-point measures (trace) for aggregation."""
-        from sim.protocol import aggregate_runs, run_sweep
+        from sim.stepped_sine.protocol import aggregate_runs, run_sweep
 
         model, impactor = self.simulated_system(params)
         run = run_sweep(model, impactor, level, self._stepped_sine(), seed=seed, rep=rep)
@@ -219,11 +219,11 @@ class IESModel:
                 **{name: float(own.scattering[name][at][0]) for name in SCATTERING_MEASURES}, "trace": trace}
 
     def sweep_result(self, records: list[Mapping[str, Any]]) -> Any:
-        """The frequency response (`sim.protocol.SweepResult`, Fig. 5) of the runs of one (point, level), rebuilt
-        from their traces and aggregated exactly as `ies sweep` does (`sim.protocol.aggregate_runs`); None
+        """The frequency response (`sim.stepped_sine.protocol.SweepResult`, Fig. 5) of the runs of one (point, level), rebuilt
+        from their traces and aggregated exactly as `ies sweep` does (`sim.stepped_sine.protocol.aggregate_runs`); None
         without runs."""
         import numpy as np
-        from sim.protocol import SweepRun, aggregate_runs
+        from sim.stepped_sine.protocol import SweepRun, aggregate_runs
 
         protocol = self._stepped_sine()
         runs = []
@@ -236,7 +236,7 @@ class IESModel:
         return aggregate_runs(runs) if runs else None
 
     def aggregate(self, records: list[Mapping[str, Any]]) -> dict[str, Any]:
-        """Resonant levels over the repetitions of one (point, level), exactly as `sim.protocol.aggregate_runs`
+        """Resonant levels over the repetitions of one (point, level), exactly as `sim.stepped_sine.protocol.aggregate_runs`
         (largest repetition-averaged mean / max over eta, Sect. 5.2-5.3), with the standard error of the
         repetition samples at that eta (`SweepResult.resonant_spread`; NaN for a single sample: no noise
         estimate): {output: (value, standard error, number of samples)} and "regime": the regime there."""
@@ -285,7 +285,7 @@ def mean_over_repetitions(outputs: tuple[str, ...], records: list[Mapping[str, A
 
 @functools.lru_cache(maxsize=4)
 def _rig_model(n_modes: int):
-    from sim.rig import seed_rig_model
+    from sim.hosts.rig import seed_rig_model
 
     return seed_rig_model(n_modes=n_modes)
 

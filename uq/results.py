@@ -41,7 +41,7 @@ def _rows(path: Path) -> list[dict]:
 
 def nominal_regimes(points: list[dict], output: str = "mean") -> dict[float, str]:
     """{level: regime} of the nominal point in points.csv: the regime where its repetition-averaged resonant level
-    is reached, as the simulator classifies it (`sim.protocol.aggregate_runs`, `sim.measures.classify_regime`:
+    is reached, as the simulator classifies it (`sim.stepped_sine.protocol.aggregate_runs`, `sim.stepped_sine.measures.classify_regime`:
     APR, SMR or linear); the one source of every regime label of a study's tables and figures."""
     return {float(r["level"]): r.get("regime", "") for r in points
             if r["design"] == "nominal" and r["output"] == output}

@@ -6,7 +6,7 @@ result is reused only for exactly the same computation. Every result is written 
 (atomically) by the controlling process as soon as it arrives; an interrupted study therefore keeps
 every finished task, and `--resume` runs only the missing ones.
 
-Determinism: a task's random stream depends only on (seed, rep) (sim.protocol contract), results are
+Determinism: a task's random stream depends only on (seed, rep) (sim.stepped_sine.protocol contract), results are
 stored as JSON floats (exact round trip), and they are collected by key, never by arrival order: the
 same study gives identical numbers serially, with `--jobs N` and on Dask.
 """
@@ -24,7 +24,7 @@ from dataclasses import asdict, dataclass, is_dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
-from sim.files import write_text
+from sim.common.files import write_text
 from uq.errors import StudyError
 
 
@@ -135,7 +135,7 @@ def prepare_output(folder: str | Path, *, resume: bool, study: tuple[str, str] |
 
 def evaluate(model: Callable, task: Task, seed: int) -> dict:
     """Run one task; a diverged simulation or non-finite output is recorded as a failed run."""
-    from sim.errors import SimulationDiverged
+    from sim.common.errors import SimulationDiverged
 
     start = time.perf_counter()
     try:

@@ -19,12 +19,12 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
-from sim.errors import SimulationInputError
-from sim.system import CLEARANCE_NOMINAL, D1_NOMINAL, K_H_NOMINAL
-from sim.units import CLEARANCE, K_H, K_T, implausible, parse_quantity
+from sim.common.errors import SimulationInputError
+from sim.model.system import CLEARANCE_NOMINAL, D1_NOMINAL, K_H_NOMINAL
+from sim.common.units import CLEARANCE, K_H, K_T, implausible, parse_quantity
 from uq.errors import StudyError
 
-# Table 2 of the seed paper (SI units); the nominal values are the simulator's (sim.system).
+# Table 2 of the seed paper (SI units); the nominal values are the simulator's (sim.model.system).
 # k_H in N/m^1.5: 1 N/mm^1.5 = 1e3^1.5 N/m^1.5.
 N_PER_MM15 = 1e3**1.5
 K_H_STAR = K_H_NOMINAL  # Eq. 8, nominal sphere on a flat wall (282e3 N/mm^1.5)
@@ -224,7 +224,7 @@ def resolve_k_H(value: object, *, base_dir: Path | None = None) -> float:
 
 def resolve_value(name: str, value: object, *, base_dir: Path | None = None) -> object:
     """A parameter value of a study file in SI units: k_H through `resolve_k_H`, the clearance g as a number in m
-    or a string with its unit ("0.58 mm", `sim.units`); other parameters unchanged (checked by `Parameter`)."""
+    or a string with its unit ("0.58 mm", `sim.common.units`); other parameters unchanged (checked by `Parameter`)."""
     if name == "k_H":
         return resolve_k_H(value, base_dir=base_dir)
     if name in ("g", "k_t") and isinstance(value, str):
@@ -236,7 +236,7 @@ def resolve_value(name: str, value: object, *, base_dir: Path | None = None) -> 
 
 
 def plausibility_warning(name: str, value: float) -> str | None:
-    """`sim.units.implausible` for g and k_H (a clearance above 10 mm, a k_H below 1e6 N/m^1.5, ...)."""
+    """`sim.common.units.implausible` for g and k_H (a clearance above 10 mm, a k_H below 1e6 N/m^1.5, ...)."""
     quantity = {"g": CLEARANCE, "k_H": K_H}.get(name)
     return None if quantity is None else implausible(float(value), quantity)
 

@@ -13,7 +13,7 @@ Layout (every table and key is optional except where noted; SI units)::
     output = "results/fig7"      # default output folder (`--out` overrides), relative to the cwd
     outputs = ["mean", "max"]    # model "ies": the outputs the bands / indices are computed for (default
                                  # mean, max; also "restitution", "significant_impacts_per_period", ... of
-                                 # sim.measures.SCATTERING_MEASURES, at the resonant mean's eta)
+                                 # sim.stepped_sine.measures.SCATTERING_MEASURES, at the resonant mean's eta)
     contact_law = "hertz"        # model "ies": "hertz" (Eq. 4) or "hertz-damped" (Eq. 10, r_cont,diss from
                                  # [parameters.r_cont], default 0.99; a table there implies "hertz-damped")
 
@@ -33,12 +33,12 @@ Layout (every table and key is optional except where noted; SI units)::
     [parameters.friction]        # model "ies", optional: mu of dry friction at the floor (Appendix C; ode3 only),
     nominal = 0.07               # with [parameters.k_t] (N/m, or "22kN/mm") the tangential stiffness
 
-    [excitation]                 # passed to the stepped-sine protocol (sim.protocol.SteppedSine)
+    [excitation]                 # passed to the stepped-sine protocol (sim.stepped_sine.protocol.SteppedSine)
     levels = [5.3, 6.7, 7.4]     # a_base / a_base* (Sect. 5.3; nominal D*, g*)
     eta = { start = 0.95, stop = 1.01, n = 25 }   # Omega / omega_1*
-    repetition = "leg"           # "leg" or "run": what counts as one repetition sample (sim.protocol)
-    start = "base-velocity"      # initial conditions of each run: "rest" or "base-velocity" (sim.protocol)
-    perturbation = 5e-4          # half-width of the random relative frequency offset of each run (sim.protocol)
+    repetition = "leg"           # "leg" or "run": what counts as one repetition sample (sim.stepped_sine.protocol)
+    start = "base-velocity"      # initial conditions of each run: "rest" or "base-velocity" (sim.stepped_sine.protocol)
+    perturbation = 5e-4          # half-width of the random relative frequency offset of each run (sim.stepped_sine.protocol)
     perturb = "start"            # what it perturbs: "start" (each run's first wait) or "each-point"
     wait = 3.0                   # s
     hold = 5.0                   # s
@@ -309,8 +309,8 @@ def _parse_series(table: Any, kind: str, space: ParameterSpace) -> tuple[str, tu
 def _parse_contact_law(head: Mapping[str, Any], space: ParameterSpace) -> str:
     """[study] contact_law (Eq. 4 "hertz" or Eq. 10 "hertz-damped"); [parameters.r_cont] implies the damped law,
     and its values must lie in (0, 1]."""
-    from sim.contact_law import CONTACT_LAWS, ContactLaw
-    from sim.errors import SimulationInputError
+    from sim.model.contact_law import CONTACT_LAWS, ContactLaw
+    from sim.common.errors import SimulationInputError
 
     listed = "r_cont" in space.names
     law = head.get("contact_law", "hertz-damped" if listed else "hertz")

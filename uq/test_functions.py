@@ -8,7 +8,7 @@ failed-run reporting without the simulator.
   noise variance of an r-repetition mean is SIGMA^2 / r against Var(a + 2 b) = 5/12 of uniform a, b.
 * `pure_noise`: seeded Gaussian noise of standard deviation SIGMA whatever a and b: every index it gets
   describes noise (its noise share of the variance is about 1).
-* `failing`: a + b, except that it diverges (`sim.errors.SimulationDiverged`) for a > 0.9 in repetition 0 and
+* `failing`: a + b, except that it diverges (`sim.common.errors.SimulationDiverged`) for a > 0.9 in repetition 0 and
   returns NaN for b > 0.95: every run there is a failed run that a study must report, not hide.
 """
 from __future__ import annotations
@@ -18,7 +18,7 @@ from typing import Mapping
 
 import numpy as np
 
-from sim.errors import SimulationDiverged
+from sim.common.errors import SimulationDiverged
 
 SIGMA = 0.2
 

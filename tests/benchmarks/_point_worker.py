@@ -1,7 +1,7 @@
 """A worker process for same-run A/B timings of one stepped-sine point (tests/benchmarks/test_energy_speed.py,
 test_contact_law_speed.py): imports `sim` from the tree given on the command line, prepares the start state, then
 answers every line "run" on stdin with the CPU seconds of one point (3 s wait + 5 s hold at a_base/a_base* = 7.4),
-with the energy bookkeeping and impact measures where the tree has them (`sim.energy.Ledger`).
+with the energy bookkeeping and impact measures where the tree has them (`sim.integration.energy.Ledger`).
 
 Arguments: TREE ETA PREPARE [INTEGRATOR [R_CONT [MU]]]: PREPARE "-" starts from the base velocity, else a down-sweep
 from that eta; INTEGRATOR exact (default) or ode3; R_CONT < 1: the damped contact law of Eq. 10; MU > 0: dry friction
@@ -18,22 +18,22 @@ MU = float(sys.argv[6]) if len(sys.argv) > 6 else 0.0
 import numpy as np  # noqa: E402
 
 from sim import exact, ode3  # noqa: E402
-from sim.rig import seed_rig_model  # noqa: E402
-from sim.system import Impactor, a_base_star, a_noabs_star, system_arrays  # noqa: E402
+from sim.hosts.rig import seed_rig_model  # noqa: E402
+from sim.model.system import Impactor, a_base_star, a_noabs_star, system_arrays  # noqa: E402
 
 try:
-    from sim.energy import Ledger
+    from sim.integration.energy import Ledger
 except ImportError:  # the tree before the bookkeeping
     Ledger = None
 try:
-    from sim.measures import point_measures
+    from sim.stepped_sine.measures import point_measures
 except ImportError:
     point_measures = None
 
 LEVEL = 7.4
 model = seed_rig_model(n_modes=9)
 if R_CONT < 1.0 or MU > 0.0:
-    from sim.contact_law import ContactLaw
+    from sim.model.contact_law import ContactLaw
 
     law = ContactLaw("hertz-damped", R_CONT) if R_CONT < 1.0 else ContactLaw()
     sys_ = system_arrays(model, Impactor(contact_law=law, friction=MU))

@@ -7,8 +7,8 @@ Run: pytest -m benchmark tests/benchmarks/test_exact_accuracy.py -s
 """
 import pytest
 
-from sim import exact, ode3
-from sim.references import rebound_error
+from sim.integration import exact, ode3
+from sim.integration.references import rebound_error
 
 pytestmark = pytest.mark.benchmark
 

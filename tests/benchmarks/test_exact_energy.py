@@ -6,7 +6,7 @@ Run: pytest -m benchmark tests/benchmarks/test_exact_energy.py -s
 """
 import pytest
 
-from sim.references import ringing_energy_drift
+from sim.integration.references import ringing_energy_drift
 
 pytestmark = pytest.mark.benchmark
 

@@ -14,9 +14,9 @@ import time
 import numpy as np
 import pytest
 
-from sim import collocation, exact, ode3
-from sim.measures import hold_measures
-from sim.system import Impactor, a_base_star, a_noabs_star, system_arrays
+from sim.integration import collocation, exact, ode3
+from sim.stepped_sine.measures import hold_measures
+from sim.model.system import Impactor, a_base_star, a_noabs_star, system_arrays
 
 pytestmark = pytest.mark.benchmark
 LEVEL = 7.4
@@ -24,7 +24,7 @@ LEVEL = 7.4
 
 @pytest.fixture(scope="module")
 def rig():
-    from sim.rig import seed_rig_model
+    from sim.hosts.rig import seed_rig_model
 
     return seed_rig_model(n_modes=9)
 
@@ -41,7 +41,7 @@ def _start_state(rig, sys, eta, prepare_down_from):
 
 
 def _one_point(run_step, y0, rig, sys, eta):
-    """One stepped-sine point exactly as sim.protocol.run_sweep does it (wait, then hold)."""
+    """One stepped-sine point exactly as sim.stepped_sine.protocol.run_sweep does it (wait, then hold)."""
     Omega = eta * rig.omega[0]
     periods = Omega / (2 * np.pi)
     n_wait, n_hold = int(round(3.0 * periods)), int(round(5.0 * periods))

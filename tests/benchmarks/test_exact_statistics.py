@@ -10,8 +10,8 @@ Run: pytest -m benchmark tests/benchmarks/test_exact_statistics.py -s
 import numpy as np
 import pytest
 
-from sim.protocol import SteppedSine, run_sweep
-from sim.system import Impactor
+from sim.stepped_sine.protocol import SteppedSine, run_sweep
+from sim.model.system import Impactor
 
 pytestmark = pytest.mark.benchmark
 REPS = 8
@@ -19,7 +19,7 @@ REPS = 8
 
 @pytest.fixture(scope="module")
 def rig():
-    from sim.rig import seed_rig_model
+    from sim.hosts.rig import seed_rig_model
 
     return seed_rig_model(n_modes=9)
 

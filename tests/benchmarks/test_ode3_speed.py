@@ -9,16 +9,16 @@ import time
 import numpy as np
 import pytest
 
-from sim.ode3 import paper_time_step, run_step, steps_per_period
-from sim.protocol import SteppedSine, run_sweep
-from sim.system import Impactor, a_base_star, system_arrays
+from sim.integration.ode3 import paper_time_step, run_step, steps_per_period
+from sim.stepped_sine.protocol import SteppedSine, run_sweep
+from sim.model.system import Impactor, a_base_star, system_arrays
 
 pytestmark = pytest.mark.benchmark
 
 
 @pytest.fixture(scope="module")
 def rig():
-    from sim.rig import seed_rig_model
+    from sim.hosts.rig import seed_rig_model
 
     return seed_rig_model(n_modes=9)
 

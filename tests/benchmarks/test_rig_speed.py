@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from sim.rig import RigParameters, rig_mesh, rig_modes, update_rig
+from sim.hosts.rig import RigParameters, rig_mesh, rig_modes, update_rig
 
 
 def median_time(fn, repeat=7):
@@ -27,7 +27,7 @@ def test_rig_model_speed():
     rig_modes()  # warm-up (imports, first ARPACK call)
     t_mesh = median_time(rig_mesh)
     t_modes = median_time(rig_modes)
-    code = "import time; t = time.perf_counter(); from sim.rig import seed_rig_model; seed_rig_model(); print(time.perf_counter() - t)"
+    code = "import time; t = time.perf_counter(); from sim.hosts.rig import seed_rig_model; seed_rig_model(); print(time.perf_counter() - t)"
     t_cold = statistics.median(float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                                                     check=True).stdout) for _ in range(3))
     t_cli = median_time(lambda: subprocess.run([sys.executable, "-m", "uq", "modes", "--json"], capture_output=True,

@@ -12,8 +12,8 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from sim.impacts import detect_impacts, synthetic_impact_signal
-from sim.modal_fit import fit_modes
+from sim.analysis.impacts import detect_impacts, synthetic_impact_signal
+from sim.analysis.modal_fit import fit_modes
 from tests.sim._traces import rig_trace
 
 pytestmark = pytest.mark.benchmark

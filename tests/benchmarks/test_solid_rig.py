@@ -1,8 +1,8 @@
-"""The rig as a 3D solid model (sim/solid.py): cost, mesh convergence and comparison with the Timoshenko beam model.
+"""The rig as a 3D solid model (sim/hosts/solid.py): cost, mesh convergence and comparison with the Timoshenko beam model.
 
 Run with `pytest -m benchmark tests/benchmarks/test_solid_rig.py -s` (about 5 min on the shared 2-core machine).
 Targets: a coarse rig model solves in under 3 minutes and 4 GB; coarse and medium meshes agree within
-0.5 % in f1..f9 and the contact values. The comparison with sim.rig.seed_rig_model() (frequencies, wall values at
+0.5 % in f1..f9 and the contact values. The comparison with sim.hosts.rig.seed_rig_model() (frequencies, wall values at
 the contact height, 2 mm higher and at the wall's top edge, tip values, participation, masses) is printed.
 """
 import json
@@ -15,14 +15,14 @@ import pytest
 
 pytest.importorskip("skfem")
 
-from sim.rig import F_MEASURED_HZ, rig_modes, seed_rig_model, variant_parameters  # noqa: E402
-from sim.solid import MESH_LEVELS, SolidGeometry, solid_mesh, solid_modal_model, solve_solid_modes  # noqa: E402
-from sim.system import SPHERE_MASS  # noqa: E402
+from sim.hosts.rig import F_MEASURED_HZ, rig_modes, seed_rig_model, variant_parameters  # noqa: E402
+from sim.hosts.solid import MESH_LEVELS, SolidGeometry, solid_mesh, solid_modal_model, solve_solid_modes  # noqa: E402
+from sim.model.system import SPHERE_MASS  # noqa: E402
 
 CHILD = """
 import json, resource, time
 start = time.perf_counter()
-from sim.solid import solid_rig_model
+from sim.hosts.solid import solid_rig_model
 result = solid_rig_model("coarse", convergence=False)
 print(json.dumps({"seconds": time.perf_counter() - start, "peak_rss_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6,
                   "free_dofs": result.provenance["free_dofs"], "elements": result.provenance["elements"]}))
@@ -62,7 +62,7 @@ def test_rig_convergence_and_comparison_with_the_beam_model():
     rig = rig_modes(variant_parameters())
     beam_E = rig.params.E
     print(f"\nsolid model, medium mesh ({1e3 * MESH_LEVELS['medium']:g} mm, {modes.solid.n_free} free DOFs, {seconds:.0f} s), "
-          f"E = {E / 1e9:g} GPa, clamp {g.clamp}; beam model: sim.rig, E = {beam_E / 1e9:g} GPa, joint spring")
+          f"E = {E / 1e9:g} GPa, clamp {g.clamp}; beam model: sim.hosts.rig, E = {beam_E / 1e9:g} GPa, joint spring")
     print(row("mode", range(1, 10), "{:>9d}"))
     print(row("f solid (Hz)", model.frequencies_hz, "{:>9.1f}"))
     print(row("f solid at the beam's E (Hz)", model.frequencies_hz * np.sqrt(beam_E / E), "{:>9.1f}"))

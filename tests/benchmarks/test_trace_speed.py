@@ -14,10 +14,10 @@ import time
 import numpy as np
 import pytest
 
-from sim import exact
-from sim.integrators import warm_up
-from sim.rig import seed_rig_model
-from sim.system import Impactor, a_base_star, system_arrays
+from sim.integration import exact
+from sim.integration.integrators import warm_up
+from sim.hosts.rig import seed_rig_model
+from sim.model.system import Impactor, a_base_star, system_arrays
 
 pytestmark = pytest.mark.benchmark
 REPEATS = 5

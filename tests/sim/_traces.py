@@ -12,10 +12,10 @@ from functools import lru_cache
 
 import numpy as np
 
-from sim import exact
-from sim.rig import seed_rig_model
-from sim.signals import Signal, SimulatedContacts, simulated_contacts, simulated_signal
-from sim.system import Impactor, ModalModel, SystemArrays, a_base_star, system_arrays
+from sim.integration import exact
+from sim.hosts.rig import seed_rig_model
+from sim.analysis.signals import Signal, SimulatedContacts, simulated_contacts, simulated_signal
+from sim.model.system import Impactor, ModalModel, SystemArrays, a_base_star, system_arrays
 
 LEVEL = 7.4
 #: Samples per excitation period: fs = M Omega / (2 pi) = 51.2 kHz at eta = 0.976.

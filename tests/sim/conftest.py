@@ -6,7 +6,7 @@ values) so that step sizes, damping and contact time scales are realistic, but f
 import numpy as np
 import pytest
 
-from sim.system import ModalModel
+from sim.model.system import ModalModel
 
 
 @pytest.fixture

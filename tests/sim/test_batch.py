@@ -1,11 +1,11 @@
-"""sim.batch: many runs in one call, each identical to the single run with the same (seed, rep)."""
+"""sim.stepped_sine.batch: many runs in one call, each identical to the single run with the same (seed, rep)."""
 import numpy as np
 import pytest
 
-from sim.batch import BatchJob, aggregate_batch, batch_jobs, run_batch
-from sim.errors import SimulationInputError
-from sim.protocol import SteppedSine, aggregate_runs, run_sweep
-from sim.system import Impactor
+from sim.stepped_sine.batch import BatchJob, aggregate_batch, batch_jobs, run_batch
+from sim.common.errors import SimulationInputError
+from sim.stepped_sine.protocol import SteppedSine, aggregate_runs, run_sweep
+from sim.model.system import Impactor
 
 PROTOCOL = SteppedSine(eta_start=0.98, eta_stop=1.0, n_eta=2, wait=0.5, hold=0.05, integrator="exact")
 FIELDS = ("eta_actual", "mean", "max", "min", "std", "impacts_per_period")

@@ -1,7 +1,7 @@
-"""The CalculiX reader (sim/calculix.py) against the solid model (sim/solid.py) on the same mesh, and its input checks.
+"""The CalculiX reader (sim/hosts/calculix.py) against the solid model (sim/hosts/solid.py) on the same mesh, and its input checks.
 
 tests/sim/data/calculix/beam.* is a real ccx 2.20 job (45 mm cantilever, 10 x 8 mm, 12 C3D20 elements, 5 modes:
-y-bending, x-bending, torsion, y-bending, x-bending), written by sim.calculix.write_calculix_job from
+y-bending, x-bending, torsion, y-bending, x-bending), written by sim.hosts.calculix.write_calculix_job from
 solid_mesh(SHIPPED_GEOMETRY, element_size=0.015) with node sets WALL_LEFT, WALL_RIGHT, TIP at the solid model's
 wall and measurement points, and solved by `ccx beam`. When ccx is installed, a rig-like job (neck, cavity with
 groove, block) is written, solved and read back as well.
@@ -13,16 +13,16 @@ import subprocess
 import numpy as np
 import pytest
 
-from sim.calculix import calculix_modal_model, read_dat, read_frd, read_inp
-from sim.errors import SimulationInputError
-from sim.modal_file import load_modal_model, load_provenance, save_modal_model
+from sim.hosts.calculix import calculix_modal_model, read_dat, read_frd, read_inp
+from sim.common.errors import SimulationInputError
+from sim.hosts.modal_file import load_modal_model, load_provenance, save_modal_model
 
 DATA = __import__("pathlib").Path(__file__).parent / "data" / "calculix"
 SETS = dict(wall_left="WALL_LEFT", wall_right="WALL_RIGHT", tip="TIP")
 
 
 def shipped_geometry():
-    from sim.solid import SolidGeometry
+    from sim.hosts.solid import SolidGeometry
 
     return SolidGeometry(free_length=0.045, section_x=0.01, section_y=0.008, neck_length=0.0, cavity_z=0.0,
                          groove_depth=0.0, block_edge=0.0, measurement_below_contact=0.015, measurement_on_face=True)
@@ -35,7 +35,7 @@ def compare(calculix, solid, rtol=1e-3, keys=("participation",)):
 
 def test_shipped_job_reads_and_matches_the_solid_model():
     pytest.importorskip("skfem")
-    from sim.solid import solid_mesh, solid_modal_model, solve_solid_modes
+    from sim.hosts.solid import solid_mesh, solid_modal_model, solve_solid_modes
 
     result = calculix_modal_model(DATA / "beam.frd", DATA / "beam.inp", n_modes=2, **SETS)
     assert result.provenance["selected_modes"] == [2, 5]
@@ -148,8 +148,8 @@ def test_bad_calculix_input_is_one_line(tmp_path, case, message):
                            "of the solid model against ccx on a small rig-like mesh is skipped")
 def test_ccx_on_a_small_rig_like_model_gives_the_solid_models_modal_file(tmp_path):
     pytest.importorskip("skfem")
-    from sim.calculix import write_calculix_job
-    from sim.solid import SolidGeometry, solid_mesh, solid_modal_model, solve_solid_modes
+    from sim.hosts.calculix import write_calculix_job
+    from sim.hosts.solid import SolidGeometry, solid_mesh, solid_modal_model, solve_solid_modes
 
     geometry = SolidGeometry(free_length=0.1, neck_length=0.03, block_edge=0.06)  # the rig's section, cavity, groove
     solid = solid_mesh(geometry, element_size=0.012)

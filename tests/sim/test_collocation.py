@@ -1,4 +1,4 @@
-"""Contacts by exponential Gauss collocation (sim.collocation): the tables against a finer quadrature,
+"""Contacts by exponential Gauss collocation (sim.integration.collocation): the tables against a finer quadrature,
 the backward series against an independent forward step, the observed order of a step, and whole impacts
 against scipy's DOP853 (rtol 1e-12, restarted at the contact events)."""
 import math
@@ -6,13 +6,13 @@ import math
 import numpy as np
 import pytest
 
-from sim import collocation as C
-from sim import exact
-from sim.flight import state_layout
-from sim.errors import SimulationInputError
-from sim.system import Impactor, system_arrays
+from sim.integration import collocation as C
+from sim.integration import exact
+from sim.integration.flight import state_layout
+from sim.common.errors import SimulationInputError
+from sim.model.system import Impactor, system_arrays
 
-from sim.references import cantilever_like_model, reference_run
+from sim.integration.references import cantilever_like_model, reference_run
 
 N9 = 9
 OMEGA = 2 * math.pi * 1000.0
@@ -20,7 +20,7 @@ OMEGA = 2 * math.pi * 1000.0
 
 @pytest.fixture(scope="module")
 def beam():
-    """The 9-mode cantilever-like system and its kernel constants (sim.flight.Constants) at 1 kHz excitation."""
+    """The 9-mode cantilever-like system and its kernel constants (sim.integration.flight.Constants) at 1 kHz excitation."""
     sys = system_arrays(cantilever_like_model(), Impactor())
     cst, _ = exact._prepare(OMEGA, 2e-5, sys, 48, exact.CONTACT_RTOL, 0.5 / sys.omega.max())
     return sys, cst

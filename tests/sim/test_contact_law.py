@@ -1,5 +1,5 @@
 """Eq. 10 (damped Hertz law, Sect. 5.5) against independent references: the two-body impact by scipy DOP853
-with events (sim.references.two_body_impact), the first-order energy loss of the elastic approach (quadrature),
+with events (sim.integration.references.two_body_impact), the first-order energy loss of the elastic approach (quadrature),
 and the conservative law of Eq. 4."""
 from __future__ import annotations
 
@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from sim.contact_law import ContactLaw, damped_hertz_force, restitution, xi_of_r_cont
-from sim.errors import SimulationInputError
-from sim.references import two_body_impact
-from sim.system import K_H_NOMINAL, SPHERE_MASS
+from sim.model.contact_law import ContactLaw, damped_hertz_force, restitution, xi_of_r_cont
+from sim.common.errors import SimulationInputError
+from sim.integration.references import two_body_impact
+from sim.model.system import K_H_NOMINAL, SPHERE_MASS
 
-M_BEAM = 1.57  # kg, the built-in rig's free length (sim.rig)
+M_BEAM = 1.57  # kg, the built-in rig's free length (sim.hosts.rig)
 K_H = 1.25 * K_H_NOMINAL  # best estimate of Sect. 5.4, as in Fig. 11
 R_CONT = (0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 0.99, 1.0)
 SPEEDS = (0.01, 0.1, 1.0)  # m/s
@@ -48,7 +48,7 @@ def test_dissipated_energy_equals_the_loss_of_kinetic_energy(impacts):
 
 
 def test_the_normalised_restitution_matches_the_two_body_impact(impacts):
-    """sim.contact_law.restitution (one normalised equation) against the bodies' own coordinates."""
+    """sim.model.contact_law.restitution (one normalised equation) against the bodies' own coordinates."""
     for (r_cont, v), out in impacts.items():
         assert restitution(float(xi_of_r_cont(r_cont))) == pytest.approx(out["r"], abs=1e-9)
 

@@ -1,5 +1,5 @@
 """The damped contact law of Eq. 10 inside both integrators: one impact of the sphere on a free rigid wall of the
-beam's mass against the two-body DOP853 reference (`sim.references.two_body_impact`), the energy the ledger books
+beam's mass against the two-body DOP853 reference (`sim.integration.references.two_body_impact`), the energy the ledger books
 as contact dissipation against the loss of kinetic energy, the energy balance of a rig hold with the damped law,
 and r_cont = 1 as exactly the elastic law."""
 from __future__ import annotations
@@ -9,12 +9,12 @@ import math
 import numpy as np
 import pytest
 
-from sim import exact, ode3
-from sim.contact_law import ContactLaw
-from sim.energy import Ledger, stored_energy
-from sim.references import two_body_impact
-from sim.rig import seed_rig_model
-from sim.system import K_H_NOMINAL, SPHERE_MASS, Impactor, ModalModel, a_base_star, system_arrays
+from sim.integration import exact, ode3
+from sim.model.contact_law import ContactLaw
+from sim.integration.energy import Ledger, stored_energy
+from sim.integration.references import two_body_impact
+from sim.hosts.rig import seed_rig_model
+from sim.model.system import K_H_NOMINAL, SPHERE_MASS, Impactor, ModalModel, a_base_star, system_arrays
 
 M_BEAM = 1.573  # kg, the built-in rig's free length without the block
 K_H = 1.25 * K_H_NOMINAL

@@ -6,11 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from sim import exact, ode3
-from sim.energy import Ledger, stored_energy
-from sim.references import reference_run
-from sim.rig import seed_rig_model
-from sim.system import Impactor, ModalModel, a_base_star, system_arrays
+from sim.integration import exact, ode3
+from sim.integration.energy import Ledger, stored_energy
+from sim.integration.references import reference_run
+from sim.hosts.rig import seed_rig_model
+from sim.model.system import Impactor, ModalModel, a_base_star, system_arrays
 
 F1 = 117.4
 

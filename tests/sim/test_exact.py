@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from sim import dopri5, exact, flight, ode3
-from sim.errors import SimulationInputError
-from sim.rig import seed_rig_model
-from sim.system import Impactor, a_base_star, system_arrays
+from sim.integration import dopri5, exact, flight, ode3
+from sim.common.errors import SimulationInputError
+from sim.hosts.rig import seed_rig_model
+from sim.model.system import Impactor, a_base_star, system_arrays
 
-from sim.references import cantilever_like_model, rebound_error, reference_run, ringing_energy_drift
+from sim.integration.references import cantilever_like_model, rebound_error, reference_run, ringing_energy_drift
 
 N9 = 9
 
@@ -258,7 +258,7 @@ def test_recording_through_contacts_neither_stalls_nor_perturbs():
 
 def test_recorded_states_inside_contacts_match_scipy():
     """Each recorded row inside a contact, and the first after it, against DOP853 (rtol 1e-12, restarted at
-    every contact event, `sim.references.reference_run`) from the last recorded row before the contact (free
+    every contact event, `sim.integration.references.reference_run`) from the last recorded row before the contact (free
     flight: exact). The rows inside are as accurate as the integrator's own state after the contact."""
     y0, Omega, a_base, sys = _stall_case()
     M = 447
@@ -287,7 +287,7 @@ def test_recorded_states_inside_contacts_match_scipy():
 
 
 def test_registry_and_contract(three_mode_model):
-    from sim.integrators import get_integrator
+    from sim.integration.integrators import get_integrator
 
     run_step = get_integrator("exact")
     assert run_step is exact.run_step

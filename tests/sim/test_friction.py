@@ -1,5 +1,5 @@
-"""Appendix C's elastic Coulomb (Jenkins) element: the closed-form phase solver (sim.friction) against the
-independent DOP853 reference with stick/slip events (sim.references.jenkins_reference), the analytic pure-stick
+"""Appendix C's elastic Coulomb (Jenkins) element: the closed-form phase solver (sim.model.friction) against the
+independent DOP853 reference with stick/slip events (sim.integration.references.jenkins_reference), the analytic pure-stick
 response, the loop area of the force-displacement hysteresis and the force at the transitions."""
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from sim.errors import SimulationInputError
-from sim.friction import JenkinsElement, floor_driven_response, floor_values
-from sim.references import cantilever_like_model, jenkins_reference
-from sim.rig import seed_rig_model
-from sim.system import SPHERE_MASS
+from sim.common.errors import SimulationInputError
+from sim.model.friction import JenkinsElement, floor_driven_response, floor_values
+from sim.integration.references import cantilever_like_model, jenkins_reference
+from sim.hosts.rig import seed_rig_model
+from sim.model.system import SPHERE_MASS
 
 ELEMENT = JenkinsElement()  # 22 kN/mm, mu = 0.07, N = m_a g
 OMEGA = 2 * math.pi * 117.4

@@ -1,6 +1,6 @@
 """Dry friction (Appendix C) inside the paper's integrator (ode3): the sphere on a floor that moves with the base
-(a host whose floor value is 0) against the closed-form stick/slip solution (`sim.friction.floor_driven_response`)
-and the independent DOP853 reference with events (`sim.references.jenkins_reference`), the located transitions'
+(a host whose floor value is 0) against the closed-form stick/slip solution (`sim.model.friction.floor_driven_response`)
+and the independent DOP853 reference with events (`sim.integration.references.jenkins_reference`), the located transitions'
 order of convergence, the energy bookkeeping with friction on a rig point, mu = 0 as exactly no friction, and the
 exact integrator's refusal."""
 from __future__ import annotations
@@ -10,13 +10,13 @@ import math
 import numpy as np
 import pytest
 
-from sim import exact, ode3
-from sim.energy import Ledger
-from sim.errors import SimulationInputError
-from sim.friction import GRAVITY, JenkinsElement, floor_driven_response
-from sim.references import jenkins_reference
-from sim.rig import seed_rig_model
-from sim.system import SPHERE_MASS, Impactor, ModalModel, a_base_star, system_arrays
+from sim.integration import exact, ode3
+from sim.integration.energy import Ledger
+from sim.common.errors import SimulationInputError
+from sim.model.friction import GRAVITY, JenkinsElement, floor_driven_response
+from sim.integration.references import jenkins_reference
+from sim.hosts.rig import seed_rig_model
+from sim.model.system import SPHERE_MASS, Impactor, ModalModel, a_base_star, system_arrays
 
 OMEGA = 2 * math.pi * 117.4
 MU = 0.07

@@ -1,4 +1,4 @@
-"""Impact detection of Appendix D.1 (sim.impacts): filters against the analytic Butterworth response, the
+"""Impact detection of Appendix D.1 (sim.analysis.impacts): filters against the analytic Butterworth response, the
 envelope and the excitation frequency against known signals, and the detector against synthetic signals
 with known impacts and against the simulator's own contact list.
 
@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 from scipy import signal as sps
 
-from sim.errors import SimulationInputError
-from sim.impacts import (DEFAULT_THRESHOLDS, detect_impacts, envelope, estimate_excitation_hz, match_impacts,
+from sim.common.errors import SimulationInputError
+from sim.analysis.impacts import (DEFAULT_THRESHOLDS, detect_impacts, envelope, estimate_excitation_hz, match_impacts,
                          parse_thresholds, ring_down_bound, synthetic_impact_signal, zero_phase_filter)
-from sim.signals import make_signal
+from sim.analysis.signals import make_signal
 
 TOLERANCE = 0.2e-3
 

@@ -1,4 +1,4 @@
-"""The kernel cache of `sim` follows edits of any kernel file (sim.jit): in a copy of the package, a kernel of
+"""The kernel cache of `sim` follows edits of any kernel file (sim.integration.jit): in a copy of the package, a kernel of
 exact.py calls a kernel of flight.py; a constant of flight.py is changed between two runs in fresh processes.
 A control pair of modules compiled with plain numba.njit(cache=True) shows the stale result this prevents."""
 import re
@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 import sim
-from sim import jit
+from sim.integration import jit
 
 SIM_DIR = Path(sim.__file__).resolve().parent
 
@@ -84,7 +84,7 @@ def test_an_edit_of_a_callee_file_reaches_the_cached_caller(tmp_path):
     _set_probe(tmp_path / "plain_callee.py", "PROBE = 1.0", "PROBE = 2.0")
     assert _run(tmp_path, run_sim) == "2.0"
     assert _run(tmp_path, run_plain) == "1.0", (
-        "numba now follows edits of callee files by itself: sim.jit's invalidation may no longer be needed")
+        "numba now follows edits of callee files by itself: sim.integration.jit's invalidation may no longer be needed")
 
 
 def test_every_module_with_kernels_is_fingerprinted():

@@ -4,10 +4,10 @@ import math
 import numpy as np
 import pytest
 
-from sim.measures import (APR, LINEAR, SMR, classify_regime, hold_measures, linear_tip_amplitude,
+from sim.stepped_sine.measures import (APR, LINEAR, SMR, classify_regime, hold_measures, linear_tip_amplitude,
                           physical_amplitude)
-from sim.protocol import SteppedSine, sweep
-from sim.system import ModalModel, Nominal, a_base_star, a_noabs_star
+from sim.stepped_sine.protocol import SteppedSine, sweep
+from sim.model.system import ModalModel, Nominal, a_base_star, a_noabs_star
 
 
 def test_single_mode_resonance_is_a_noabs_star():

@@ -1,14 +1,14 @@
-"""Modal-model files (sim.modal_file): exact round trip, hand-written files, one-line errors for malformed ones."""
+"""Modal-model files (sim.hosts.modal_file): exact round trip, hand-written files, one-line errors for malformed ones."""
 import os
 import tomllib
 
 import numpy as np
 import pytest
 
-from sim.errors import SimulationInputError
-from sim.modal_file import ARRAY_KEYS, load_modal_model, save_modal_model
-from sim.rig import seed_rig_model
-from sim.system import ModalModel
+from sim.common.errors import SimulationInputError
+from sim.hosts.modal_file import ARRAY_KEYS, load_modal_model, save_modal_model
+from sim.hosts.rig import seed_rig_model
+from sim.model.system import ModalModel
 
 GOOD = """\
 # two modes from some FE tool

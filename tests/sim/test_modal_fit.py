@@ -1,4 +1,4 @@
-"""Modal reconstruction between impacts, Eq. 9 (sim.modal_fit): exact recovery of known coefficients, the
+"""Modal reconstruction between impacts, Eq. 9 (sim.analysis.modal_fit): exact recovery of known coefficients, the
 conditioning of the mode-1 split, the warnings, and the simulator's modal energies after impacts."""
 import json
 import os
@@ -7,10 +7,10 @@ import stat
 import numpy as np
 import pytest
 
-from sim.errors import SimulationInputError
-from sim.modal_fit import GUARD, MAX_CONDITION, fit_modes, load_model, plot_modal_fit
-from sim.modal_file import save_modal_model
-from sim.signals import make_signal
+from sim.common.errors import SimulationInputError
+from sim.analysis.modal_fit import GUARD, MAX_CONDITION, fit_modes, load_model, plot_modal_fit
+from sim.hosts.modal_file import save_modal_model
+from sim.analysis.signals import make_signal
 
 FS = 51200.0
 #: High-pass of the detector on simulated traces of the rig (Hz): above its mode 9 at 19.83 kHz.

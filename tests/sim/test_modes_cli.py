@@ -7,8 +7,8 @@ import sys
 import numpy as np
 import pytest
 
-from sim.rig import F_MEASURED_HZ, F_PAPER_MODEL_ERROR, seed_rig_model
-from sim.system import SPHERE_MASS, a_base_star
+from sim.hosts.rig import F_MEASURED_HZ, F_PAPER_MODEL_ERROR, seed_rig_model
+from sim.model.system import SPHERE_MASS, a_base_star
 from uq.cli import main
 
 KEYS = {"frequencies_hz", "damping_ratios", "phi_wall_left", "phi_wall_right", "phi_tip", "participation",
@@ -118,8 +118,8 @@ JOB = ["--from-calculix", os.path.join(CALCULIX, "beam.frd"), "--mesh", os.path.
 
 
 def test_from_calculix_saves_the_same_model_with_its_provenance(tmp_path, capsys):
-    from sim.calculix import calculix_modal_model
-    from sim.modal_file import load_modal_model, load_provenance
+    from sim.hosts.calculix import calculix_modal_model
+    from sim.hosts.modal_file import load_modal_model, load_provenance
 
     data = run_json(capsys, *JOB, "--save", str(tmp_path / "ccx.toml"))
     direct = calculix_modal_model(JOB[1], JOB[3], "WALL_LEFT", "WALL_RIGHT", "TIP", n_modes=2).model
@@ -138,12 +138,12 @@ def test_solid_model_of_a_small_beam_through_the_cli(tmp_path, capsys):
                  str(tmp_path / "short-rig.toml")]) == 0
     out = capsys.readouterr().out
     assert "solid model: hex20" in out and "mesh convergence against 12 mm" in out
-    assert "modal model: 3D solid model (sim.solid" in out
+    assert "modal model: 3D solid model (sim.hosts.solid" in out
     assert (tmp_path / "short-rig.toml").is_file()
 
 
 def test_solid_variant_through_the_cli(tmp_path, capsys):
-    """A named solid variant (sim.variants.SOLID_VARIANTS) saves its name, justification and contact offset."""
+    """A named solid variant (sim.hosts.variants.SOLID_VARIANTS) saves its name, justification and contact offset."""
     pytest.importorskip("skfem")
     path = tmp_path / "rig3d.toml"
     assert main(["modes", "--solid", "--variant", "updated-contact+2mm", "--json", "--save", str(path)]) == 0

@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from sim.energy import energy_parts
-from sim.errors import SimulationDiverged, SimulationInputError
-from sim.integrators import get_integrator
-from sim.ode3 import paper_time_step, run_step, steps_per_period
-from sim.system import Impactor, a_base_star, contact_forces, system_arrays
+from sim.integration.energy import energy_parts
+from sim.common.errors import SimulationDiverged, SimulationInputError
+from sim.integration.integrators import get_integrator
+from sim.integration.ode3 import paper_time_step, run_step, steps_per_period
+from sim.model.system import Impactor, a_base_star, contact_forces, system_arrays
 
 
 def linear_system(model):
@@ -65,7 +65,7 @@ def test_linear_forced_response_and_observed_order_3(three_mode_model):
 
 def test_per_period_amplitude_matches_analytic_frequency_response(three_mode_model):
     """After the transient (15 s, Sect. 5.1) |c_1| of q_tip equals the analytic FRF of Eq. 7 within 0.1 %."""
-    from sim.measures import linear_tip_amplitude
+    from sim.stepped_sine.measures import linear_tip_amplitude
 
     sys = linear_system(three_mode_model)
     a_base = 1e-6
@@ -116,7 +116,7 @@ def test_single_hertz_impact_on_rigid_wall(rigid_wall_model, v0, steps_per_conta
 
 def test_energy_conserved_over_1000_impacts_without_damping_and_excitation():
     """Modes + sphere + Hertz potential (2/5 k_H delta^2.5) are conserved within 1e-4 over >= 1000 impacts."""
-    from sim.system import ModalModel
+    from sim.model.system import ModalModel
 
     model = ModalModel([117.4, 2494.0], [0.01, 0.01], [1.05, 0.95], [1.05, 0.95], [1.0, 0.8], [0.95, 0.35])
     sys = system_arrays(model, Impactor(clearance=0.1e-3))._replace(D=np.zeros(2))
@@ -134,7 +134,7 @@ def test_energy_conserved_over_1000_impacts_without_damping_and_excitation():
 
 
 def reference_rhs(sys, a_base, Omega):
-    """Eqs. 3-7 in numpy with the lead's reference contact law `sim.system.contact_forces`."""
+    """Eqs. 3-7 in numpy with the lead's reference contact law `sim.model.system.contact_forces`."""
     n = sys.omega.size
 
     def rhs(t, y):

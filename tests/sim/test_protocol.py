@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from sim.errors import SimulationInputError
-from sim.protocol import SteppedSine, aggregate_runs, run_sweep, sweep
-from sim.system import Impactor
+from sim.common.errors import SimulationInputError
+from sim.stepped_sine.protocol import SteppedSine, aggregate_runs, run_sweep, sweep
+from sim.model.system import Impactor
 
 # short holds keep these tests fast; physics of the hold lengths is tested elsewhere
 FAST = dict(eta_start=0.98, eta_stop=1.0, n_eta=3, wait=0.02, hold=0.03)
@@ -71,8 +71,8 @@ def test_run_is_reproducible_from_seed_and_rep_in_any_order(three_mode_model, pe
 def test_a_perturbed_start_leaves_the_linear_response_unbiased(three_mode_model):
     """Without the IES every run ends up on the analytic frequency response (Eq. 7) whatever its perturbed start:
     after the lead-in at eta_0 (1 + e), each point waits 15 s (Sect. 5.1) and holds at its nominal frequency."""
-    from sim.measures import linear_tip_amplitude
-    from sim.system import a_base_star, a_noabs_star
+    from sim.stepped_sine.measures import linear_tip_amplitude
+    from sim.model.system import a_base_star, a_noabs_star
 
     protocol = SteppedSine(eta_start=0.999, eta_stop=1.001, n_eta=5, wait=15.0, hold=1.0, perturbation=5e-3)
     result = sweep(three_mode_model, None, 1.0, protocol, reps=3, seed=0)
@@ -87,8 +87,8 @@ def test_each_point_perturbation_is_reported_at_the_frequencies_simulated(three_
     the average follows the analytic response (within 1 % on the linear peak, half-power width +-8.5e-4, grid
     step 5e-4, offsets +-1e-4: linear interpolation cuts the peak's top); averaging at the nominal frequencies
     would lower the peak by twice as much."""
-    from sim.measures import linear_tip_amplitude
-    from sim.system import a_base_star, a_noabs_star
+    from sim.stepped_sine.measures import linear_tip_amplitude
+    from sim.model.system import a_base_star, a_noabs_star
 
     protocol = SteppedSine(eta_start=0.996, eta_stop=1.004, n_eta=17, wait=15.0, hold=1.0, perturbation=1e-4,
                            perturb="each-point")

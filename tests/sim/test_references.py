@@ -1,4 +1,4 @@
-"""The simulator's reference (sim.references.reference_run, scipy DOP853 with contact events) checked
+"""The simulator's reference (sim.integration.references.reference_run, scipy DOP853 with contact events) checked
 against the analytic rigid-wall Hertz impact."""
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from scipy.special import gamma as gamma_fn
 
-from sim.references import reference_run
-from sim.system import Impactor, ModalModel, system_arrays
+from sim.integration.references import reference_run
+from sim.model.system import Impactor, ModalModel, system_arrays
 
 
 def test_reference_reproduces_the_hertz_impact_on_a_rigid_wall():

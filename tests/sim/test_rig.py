@@ -1,4 +1,4 @@
-"""The rig's Timoshenko beam model (sim.rig) against references that are not the FE code itself:
+"""The rig's Timoshenko beam model (sim.hosts.rig) against references that are not the FE code itself:
 
 * Euler-Bernoulli cantilever roots of 1 + cos(bL) cosh(bL) = 0 (slender limit), with an order-of-accuracy fit;
 * the exact Timoshenko cantilever: the 4x4 first-order ODE system [w, theta, M, V]' = A(omega) y solved by
@@ -16,15 +16,15 @@ import scipy.linalg
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from sim.errors import SimulationInputError
-from sim.rig import (
+from sim.common.errors import SimulationInputError
+from sim.hosts.rig import (
     DAMPING_RATIOS, DEFAULT_VARIANT, ELEMENT_SIZE, F9_PAPER_HZ, F_MEASURED_HZ, F_PAPER_MODEL_ERROR,
     MODAL_MASS_RATIO_PAPER, NU_STEEL, PHI_TIP_OVER_PHI_C_PAPER, RHO_STEEL, RIG_VARIANTS, UPDATED_PARAMETERS,
     RigGeometry, RigParameters, Section, Segment, assemble_beam, assemble_chain, cowper_box, cowper_rectangle,
     mass_normalised_modes, rig_mesh, rig_modes, seed_rig_model, timoshenko_element, update_rig, updating_residuals,
     variant_parameters,
 )
-from sim.system import ModalModel, a_base_star
+from sim.model.system import ModalModel, a_base_star
 
 E_STEEL = 207e9
 
@@ -388,7 +388,7 @@ def test_fixed_joint_updating_and_the_range_the_data_allow():
     f9 within twice the free fit's 1.05 %) holds the free optimum; a soft joint lowers the high modes more than the
     low ones (their root shear forces are larger), so below about 0.9e9 N/m no E <= 215 GPa and neck fit f4, f9,
     while a rigid joint with a longer neck still fits (E 209.5 GPa): the data bound the joint from below only."""
-    from sim.rig import (F9_PAPER_HZ, JOINT_SPRING_PARAMETERS, joint_stiffness_range, update_rig_fixed_joint,
+    from sim.hosts.rig import (F9_PAPER_HZ, JOINT_SPRING_PARAMETERS, joint_stiffness_range, update_rig_fixed_joint,
                          worst_target_error)
 
     k0 = JOINT_SPRING_PARAMETERS.joint_translational_stiffness

@@ -7,12 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from sim import exact
-from sim.energy import Ledger
-from sim.measures import modal_restitution, point_measures, scattering_measures, significant_impacts
-from sim.references import reference_run
-from sim.rig import seed_rig_model
-from sim.system import Impactor, ModalModel, Nominal, a_base_star, a_noabs_star, system_arrays
+from sim.integration import exact
+from sim.integration.energy import Ledger
+from sim.stepped_sine.measures import modal_restitution, point_measures, scattering_measures, significant_impacts
+from sim.integration.references import reference_run
+from sim.hosts.rig import seed_rig_model
+from sim.model.system import Impactor, ModalModel, Nominal, a_base_star, a_noabs_star, system_arrays
 
 
 def _single_mode_restitution(phi: float) -> tuple[float, float]:

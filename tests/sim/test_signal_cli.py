@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
-from sim.files import write_csv
-from sim.impacts import DEFAULT_THRESHOLDS, detect_impacts, synthetic_impact_signal
-from sim.modal_file import save_modal_model
+from sim.common.files import write_csv
+from sim.analysis.impacts import DEFAULT_THRESHOLDS, detect_impacts, synthetic_impact_signal
+from sim.hosts.modal_file import save_modal_model
 from uq.cli import main
 
 
@@ -42,7 +42,7 @@ def test_impacts_table_with_one_threshold_and_given_frequency(synthetic_csv, cap
 @pytest.fixture(scope="module")
 def simulated(tmp_path_factory):
     """A short trace of the three-mode model by ies trace (its 19.8 kHz mode rings through 20 kHz)."""
-    from sim.system import ModalModel
+    from sim.model.system import ModalModel
 
     folder = tmp_path_factory.mktemp("trace")
     model = ModalModel(frequencies_hz=np.array([117.4, 2494.0, 19800.0]), damping_ratios=np.array([0.00085, 0.0005, 0.001]),

@@ -1,11 +1,11 @@
-"""Signal files and simulated traces (sim.signals): reading with validation, the columns of a simulated trace
+"""Signal files and simulated traces (sim.analysis.signals): reading with validation, the columns of a simulated trace
 against the analytic solution of Eq. 7 and the contact law, and the simulator's own contact list."""
 import numpy as np
 import pytest
 
-from sim.errors import SimulationInputError
-from sim.signals import make_signal, read_signal, simulated_contacts, simulated_signal
-from sim.system import Impactor, contact_forces, system_arrays
+from sim.common.errors import SimulationInputError
+from sim.analysis.signals import make_signal, read_signal, simulated_contacts, simulated_signal
+from sim.model.system import Impactor, contact_forces, system_arrays
 
 TRACE_HEADER = "t,q_tip,v_tip,a_tip,q_wall_left,q_wall_right,a_left,a_right,q_sphere,f_left,f_right"
 

@@ -1,4 +1,4 @@
-"""The 3D solid model (sim/solid.py, seed paper Sect. 3.1) against analytic beam theory, its input checks, and its
+"""The 3D solid model (sim/hosts/solid.py, seed paper Sect. 3.1) against analytic beam theory, its input checks, and its
 mode selection. References: the Euler-Bernoulli cantilever (beta_n L roots of cos cosh = -1, tip value 2/sqrt(m)) and
 the exact Timoshenko cantilever (closed-form solution of the two coupled ODEs, frequencies from its 4 x 4 boundary
 determinant, mode shapes from its null vector), neither of which uses our FE code."""
@@ -11,8 +11,8 @@ from scipy.optimize import brentq
 
 pytest.importorskip("skfem")
 
-from sim.errors import SimulationInputError  # noqa: E402
-from sim.solid import (SolidGeometry, SolidMaterial, select_x_bending, solid_mesh, solid_modal_model,  # noqa: E402
+from sim.common.errors import SimulationInputError  # noqa: E402
+from sim.hosts.solid import (SolidGeometry, SolidMaterial, select_x_bending, solid_mesh, solid_modal_model,  # noqa: E402
                        solve_solid_modes)
 
 E, NU, RHO = 207e9, 0.3, 7843.0
@@ -194,7 +194,7 @@ def test_bad_mesh_and_material_inputs():
         solid_mesh(cantilever(0.1, 0.01, 0.01), element_size=0.01, element="tet10")
     with pytest.raises(SimulationInputError, match="material needs"):
         SolidMaterial(nu=0.5)
-    from sim.solid import solid_rig_model
+    from sim.hosts.solid import solid_rig_model
 
     with pytest.raises(SimulationInputError, match="unknown mesh level 'huge'; choose one of coarse, medium, fine"):
         solid_rig_model(mesh="huge")
@@ -209,7 +209,7 @@ def test_missing_scikit_fem_is_one_line(monkeypatch):
 
 
 def test_rig_geometry_defaults_match_the_beam_model():
-    from sim.rig import JOINT_SPRING_PARAMETERS, RigGeometry, rig_modes
+    from sim.hosts.rig import JOINT_SPRING_PARAMETERS, RigGeometry, rig_modes
 
     g, rig = SolidGeometry(), RigGeometry()
     assert g.contact_height == pytest.approx(rig.contact_height, abs=1e-12)
@@ -268,7 +268,7 @@ def _neck_beam(neck_length: float, neck_width_y: float) -> SolidGeometry:
 def test_updating_recovers_a_known_neck():
     """Frequencies f1..f4, f9 of a known neck (85 x 12 mm) as targets: the updating from another neck finds it
     (same element counts, so the targets are reachable exactly) and reports the errors, mass and modal ratios."""
-    from sim.solid import update_solid_geometry
+    from sim.hosts.solid import update_solid_geometry
 
     truth = _neck_beam(0.085, 0.012)
     f = solve_solid_modes(solid_mesh(truth, element_size=0.016, symmetry="quarter"), 9).frequencies_hz
@@ -288,7 +288,7 @@ def test_updating_recovers_a_known_neck():
     (dict(mesh="huge"), "unknown mesh level 'huge'"),
 ])
 def test_updating_bad_input_is_one_line(kwargs, message):
-    from sim.solid import update_solid_geometry
+    from sim.hosts.solid import update_solid_geometry
 
     with pytest.raises(SimulationInputError, match=message):
         update_solid_geometry(**kwargs)
@@ -309,11 +309,11 @@ def test_wall_values_are_continuous_and_rise_towards_the_open_end():
 
 @pytest.mark.slow
 def test_stored_updated_geometry_reproduces_its_fit():
-    """sim.solid.UPDATED_SOLID_GEOMETRY still gives what its comment states (coarse mesh, E = 207 GPa): f1..f4 of
+    """sim.hosts.solid.UPDATED_SOLID_GEOMETRY still gives what its comment states (coarse mesh, E = 207 GPa): f1..f4 of
     Table A.1 within +0.004, -1.36, +0.63, +0.12 %, f9 = 20.41 kHz, beam 1.545 kg, m_a phi_c1^2 = 3.57 %."""
-    from sim.rig import F_MEASURED_HZ
-    from sim.solid import UPDATED_SOLID_GEOMETRY
-    from sim.system import SPHERE_MASS
+    from sim.hosts.rig import F_MEASURED_HZ
+    from sim.hosts.solid import UPDATED_SOLID_GEOMETRY
+    from sim.model.system import SPHERE_MASS
 
     g = UPDATED_SOLID_GEOMETRY
     modes = solve_solid_modes(solid_mesh(g, element_size=0.008, symmetry="quarter"), 9)
@@ -326,7 +326,7 @@ def test_stored_updated_geometry_reproduces_its_fit():
 
 def test_solid_and_its_timoshenko_counterpart_like_for_like():
     """The same rig (the updated solid geometry without the block, clamped at its root section, E = 207 GPa) as a
-    solid (medium mesh, quarter) and as the Timoshenko beam of sim.rig. Bands: the issue's claims where the beam
+    solid (medium mesh, quarter) and as the Timoshenko beam of sim.hosts.rig. Bands: the issue's claims where the beam
     theory's assumptions hold (f1..f9 within 0.4 %, the contact values of modes 1-5 within 2 %; mesh-converged at
     1.8 mm: 0.36 % and 1.2 %). Above them the physics of the open cavity: its walls are plates, more compliant than
     the tube's plane sections, so the solid's contact values of modes 6-9 exceed the beam's, and more so at
@@ -335,7 +335,7 @@ def test_solid_and_its_timoshenko_counterpart_like_for_like():
     section's warping and contraction) makes every solid frequency higher than the beam's."""
     from dataclasses import replace
 
-    from sim.solid import UPDATED_SOLID_GEOMETRY, compare_with_timoshenko
+    from sim.hosts.solid import UPDATED_SOLID_GEOMETRY, compare_with_timoshenko
 
     rig = replace(UPDATED_SOLID_GEOMETRY, block_edge=0.0, measurement_on_face=False)
     c = compare_with_timoshenko(rig, SolidMaterial(E, NU, RHO), "medium")

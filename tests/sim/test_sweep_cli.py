@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from sim.modal_file import save_modal_model
+from sim.hosts.modal_file import save_modal_model
 from uq.cli import main
 
 FAST = ["--eta", "0.98:1.0:3", "--wait", "0.02", "--hold", "0.03", "--reps", "2"]
@@ -29,7 +29,7 @@ def test_sweep_json_out_and_plot(tmp_path, model_file, capsys):
     assert data["eta"] == pytest.approx([0.98, 0.99, 1.0])
     assert data["resonant_mean"] == pytest.approx(max(data["mean"]))
     assert data["n_samples"] == 2 and data["protocol"]["integrator"] == "exact"
-    assert data["protocol"]["start"] == "base-velocity"  # the default initial conditions (sim.protocol)
+    assert data["protocol"]["start"] == "base-velocity"  # the default initial conditions (sim.stepped_sine.protocol)
     table = np.genfromtxt(out / "sweep.csv", delimiter=",", names=True, dtype=None, encoding=None)
     np.testing.assert_allclose(table["mean"], data["mean"], rtol=1e-12)
     assert json.loads((out / "sweep.json").read_text())["resonant_max"] == pytest.approx(data["resonant_max"])
@@ -136,9 +136,9 @@ def test_the_linear_response_at_default_settings_is_the_analytic_one(capsys):
     """`ies sweep --no-impactor --level 1 --eta 0.999:1.001:21` with every other default (built-in rig, 5 runs with
     perturbed starts, 15 s wait) is the analytic frequency response of Eq. 7 within 0.5 % at every point, though
     the grid (step 1e-4) lies inside the perturbation (+-5e-4) and the peak's half-power width (+-8.5e-4)."""
-    from sim.measures import linear_tip_amplitude
-    from sim.rig import seed_rig_model
-    from sim.system import a_base_star, a_noabs_star
+    from sim.stepped_sine.measures import linear_tip_amplitude
+    from sim.hosts.rig import seed_rig_model
+    from sim.model.system import a_base_star, a_noabs_star
 
     assert main(["sweep", "--no-impactor", "--level", "1", "--eta", "0.999:1.001:21", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)

@@ -4,13 +4,13 @@ against the simulator's modal energies after impacts, and why the 20 kHz high-pa
 import numpy as np
 import pytest
 
-from sim.impacts import detect_impacts, envelope, match_impacts, zero_phase_filter
-from sim.modal_fit import fit_modes
-from sim.protocol import SteppedSine
-from sim.rig import seed_rig_model
-from sim.signals import make_signal
-from sim.system import Impactor
-from sim.trace import record_trace
+from sim.analysis.impacts import detect_impacts, envelope, match_impacts, zero_phase_filter
+from sim.analysis.modal_fit import fit_modes
+from sim.stepped_sine.protocol import SteppedSine
+from sim.hosts.rig import seed_rig_model
+from sim.analysis.signals import make_signal
+from sim.model.system import Impactor
+from sim.analysis.trace import record_trace
 
 #: Far enough above the rig's mode 9 (19.83 kHz) that its ringing stays below the threshold at both points: the
 #: zero-phase high-pass passes 43 % of its amplitude at the paper's 20 kHz, 12.5 % at 21 kHz (enough for 52 %
@@ -40,7 +40,7 @@ def test_detector_agrees_with_the_simulator_above_the_threshold(trace):
     tr, model = trace
     s = tr.signal
     found = detect_impacts(s, [1.0], excitation_hz=tr.Omega / (2 * np.pi), highpass_hz=HIGHPASS)
-    from sim.system import system_arrays
+    from sim.model.system import system_arrays
 
     sys = system_arrays(model, Impactor())
     direct = -(sys.phi_l @ sys.phi_l) * s["f_left"] - (sys.phi_l @ sys.phi_r) * s["f_right"]
@@ -85,7 +85,7 @@ def test_the_20_kHz_high_pass_counts_the_ringing_of_mode_9(trace):
     tr, model = trace
     s = tr.signal
     f = tr.Omega / (2 * np.pi)
-    from sim.system import system_arrays
+    from sim.model.system import system_arrays
 
     sys = system_arrays(model, Impactor())
     y, n = tr.states, model.n_modes

@@ -6,10 +6,10 @@ import math
 import numpy as np
 import pytest
 
-from sim.modal_file import save_modal_model
-from sim.protocol import SteppedSine, run_sweep
-from sim.system import Impactor
-from sim.trace import COLUMNS, record_trace
+from sim.hosts.modal_file import save_modal_model
+from sim.stepped_sine.protocol import SteppedSine, run_sweep
+from sim.model.system import Impactor
+from sim.analysis.trace import COLUMNS, record_trace
 from uq.cli import main
 
 FAST = ["--wait", "0.05", "--hold", "0.05"]

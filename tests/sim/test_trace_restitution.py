@@ -1,16 +1,16 @@
-"""The modal coefficient of restitution (Eq. D.1) computed from a saved trace alone (`sim.signals.trace_restitution`:
+"""The modal coefficient of restitution (Eq. D.1) computed from a saved trace alone (`sim.analysis.signals.trace_restitution`:
 the sampled displacements and contact forces of `ies trace`) against the simulator's own value from its exact impact
-records (`sim.measures.scattering_measures`), at a_base/a_base* = 7.4 in the almost periodic (eta 0.976, reached
+records (`sim.stepped_sine.measures.scattering_measures`), at a_base/a_base* = 7.4 in the almost periodic (eta 0.976, reached
 by a down-sweep) and the strongly modulated (0.99) response."""
 import numpy as np
 import pytest
 
-from sim.measures import scattering_measures
-from sim.protocol import SteppedSine
-from sim.rig import seed_rig_model
-from sim.signals import trace_restitution
-from sim.system import CLEARANCE_NOMINAL, SPHERE_MASS, Impactor
-from sim.trace import record_trace
+from sim.stepped_sine.measures import scattering_measures
+from sim.stepped_sine.protocol import SteppedSine
+from sim.hosts.rig import seed_rig_model
+from sim.analysis.signals import trace_restitution
+from sim.model.system import CLEARANCE_NOMINAL, SPHERE_MASS, Impactor
+from sim.analysis.trace import record_trace
 
 
 @pytest.mark.parametrize("eta, protocol", [

@@ -1,9 +1,9 @@
-"""sim.units: numbers with units for g and k_H, and the magnitudes that are probably a unit slip."""
+"""sim.common.units: numbers with units for g and k_H, and the magnitudes that are probably a unit slip."""
 import pytest
 
-from sim.errors import SimulationInputError
-from sim.system import CLEARANCE_NOMINAL, K_H_NOMINAL
-from sim.units import CLEARANCE, K_H, implausible, parse_quantity
+from sim.common.errors import SimulationInputError
+from sim.model.system import CLEARANCE_NOMINAL, K_H_NOMINAL
+from sim.common.units import CLEARANCE, K_H, implausible, parse_quantity
 
 
 @pytest.mark.parametrize("text, value", [

@@ -1,4 +1,4 @@
-"""Fidelity landmarks and variants (sim/variants.py): the switch and optimum read from overviews built by hand, the
+"""Fidelity landmarks and variants (sim/hosts/variants.py): the switch and optimum read from overviews built by hand, the
 rolling sphere's effective mass against its energy, and the higher modes' damping."""
 import math
 from types import SimpleNamespace
@@ -6,15 +6,15 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from sim.errors import SimulationInputError
-from sim.rig import seed_rig_model
-from sim.variants import landmarks, rolling_mass_factor, with_higher_mode_damping
+from sim.common.errors import SimulationInputError
+from sim.hosts.rig import seed_rig_model
+from sim.hosts.variants import landmarks, rolling_mass_factor, with_higher_mode_damping
 
 ETA = np.linspace(0.96, 1.0, 21)
 
 
 def fake_sweep(level: float, peaks: list[float], cvs: list[float], peak_eta: float = 0.976, maxes=None):
-    """A stand-in for sim.protocol.SweepResult: one repetition sample per peak, each with its resonant mean at
+    """A stand-in for sim.stepped_sine.protocol.SweepResult: one repetition sample per peak, each with its resonant mean at
     peak_eta, amplitude spread cv there, and 2 impacts per period everywhere."""
     k = int(np.argmin(np.abs(ETA - peak_eta)))
     mean_samples = np.full((len(peaks), ETA.size), 0.01)
@@ -87,7 +87,7 @@ def test_higher_mode_damping():
 
 
 def test_solid_variants_name_their_contact_points():
-    from sim.variants import SOLID_VARIANTS, solid_variant_model
+    from sim.hosts.variants import SOLID_VARIANTS, solid_variant_model
 
     up = SOLID_VARIANTS["updated-contact+2mm"]
     left, right = up.wall_points()
@@ -106,7 +106,7 @@ def test_hertz_patch_variant_averages_over_the_contact_disc():
     (medium mesh, 1.01-1.11 times; on a 16 mm mesh the slope's kink at the element face through the contact point
     makes the departure first order in the radius, 6-7 times the r^2 law, and this fails)."""
     pytest.importorskip("skfem")
-    from sim.variants import HERTZ_PATCH_RADIUS, SOLID_VARIANTS, solid_variant_model
+    from sim.hosts.variants import HERTZ_PATCH_RADIUS, SOLID_VARIANTS, solid_variant_model
 
     assert SOLID_VARIANTS["updated-hertz-patch"].patch_radius == HERTZ_PATCH_RADIUS == 0.00045
     point, hertz, wide = (solid_variant_model(name, "medium", convergence=False)
@@ -119,7 +119,7 @@ def test_hertz_patch_variant_averages_over_the_contact_disc():
 
 
 def test_switch_line_names_the_switch_and_the_papers_landmarks():
-    from sim.variants import switch_line
+    from sim.hosts.variants import switch_line
 
     line = switch_line({"last_smr": 5.3, "first_apr": 5.5, "resonant_mean_7.4": 0.3641})
     assert "between a_base/a_base* = 5.3 and 5.5" in line and "0.364" in line and "6.7" in line

@@ -1,4 +1,4 @@
-"""sim.integrators.warm_up: the kernels are compiled before a progress bar starts, and a slow (first) compilation
+"""sim.integration.integrators.warm_up: the kernels are compiled before a progress bar starts, and a slow (first) compilation
 says so while it happens."""
 import io
 import time
@@ -6,7 +6,7 @@ import time
 import numpy as np
 import pytest
 
-from sim import integrators
+from sim.integration import integrators
 
 
 @pytest.fixture(autouse=True)
@@ -55,7 +55,7 @@ def test_the_tiny_system_impacts(name):
 
 
 def test_an_unknown_integrator_is_refused_before_anything_runs():
-    from sim.errors import SimulationInputError
+    from sim.common.errors import SimulationInputError
 
     with pytest.raises(SimulationInputError, match="unknown integrator 'rk4'"):
         integrators.warm_up("rk4")

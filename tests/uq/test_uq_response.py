@@ -79,7 +79,7 @@ def test_reproduce_all_runs_figures_5_to_8(tmp_path, monkeypatch, capsys):
 
 
 def test_regime_labels_come_from_the_simulator(tmp_path, capsys):
-    """points.csv carries the regime that sim.protocol.aggregate_runs classifies; the tables and figures read it."""
+    """points.csv carries the regime that sim.stepped_sine.protocol.aggregate_runs classifies; the tables and figures read it."""
     from uq.results import nominal_regimes
 
     path = tmp_path / "i.toml"

@@ -129,8 +129,8 @@ def test_wrong_kind_for_command(tmp_path, capsys):
 def test_a_modal_model_file_replaces_the_built_in_rig(tmp_path):
     """The built-in rig saved as a modal file (`ies modes --save`) gives the same numbers; the file's content,
     not its path, is part of the task key, so an edited file is recomputed."""
-    from sim.modal_file import save_modal_model
-    from sim.rig import seed_rig_model
+    from sim.hosts.modal_file import save_modal_model
+    from sim.hosts.rig import seed_rig_model
 
     save_modal_model(seed_rig_model(n_modes=9), tmp_path / "rig.toml")
     tiny = ("[study]\nkind = 'interval'\n{}[parameters.k_H]\n[excitation]\nlevels = [7.4]\n"
@@ -150,8 +150,8 @@ def test_a_modal_model_file_replaces_the_built_in_rig(tmp_path):
 def test_variant_table_changes_the_sphere_mass_and_the_higher_modes_damping(tmp_path):
     """[variant] sphere_mass_factor scales m_a, higher_mode_damping sets D of modes 5..N; both enter the task key,
     and a study without [variant] keeps its key (cached results stay valid)."""
-    from sim.rig import seed_rig_model
-    from sim.system import SPHERE_MASS
+    from sim.hosts.rig import seed_rig_model
+    from sim.model.system import SPHERE_MASS
 
     tiny = ("[study]\nkind = 'response'\n{}[excitation]\nlevels = [7.4]\n"
             "eta = {{ start = 0.975, stop = 0.98, n = 2 }}\nwait = 0.05\nhold = 0.1\n")

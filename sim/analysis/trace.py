@@ -1,0 +1,197 @@
+"""Time histories of one stepped-sine point (seed paper Sect. 5.1, Fig. 4; Sect. 5.5, Fig. 9a): `ies trace`.
+
+The stepped-sine run of a protocol (`sim.stepped_sine.protocol.visit_points`: lead-in, wait, and the holds of the points
+before) is walked to its last point; after that point's wait, `periods` excitation periods of its hold are
+simulated with the state recorded at M = round(fs / f_exc) instants per period, exactly at those instants
+(the integrator's states, not interpolated: `sim.model.system` record contract). The sampling rate is therefore
+M f_exc, the nearest to the requested one that puts a whole number of samples in every period. The recorded
+states become the signal columns of `sim.analysis.signals.simulated_signal` (SI units). The impact list comes from the
+integrator's own impact records (`sim.integration.energy.Ledger`: exact onset time, duration, impulse, velocities and modal
+energies of each contact) with the stretch's scattering measures (Sect. 5.5, Appendix D); an integrator that keeps
+no records (ode3) falls back to the contacts seen between samples (`sim.analysis.signals.simulated_contacts`).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sim.common.errors import SimulationInputError
+from sim.integration.energy import Ledger
+from sim.stepped_sine.measures import SCATTERING_MEASURES, hold_measures, point_measures
+from sim.stepped_sine.protocol import SteppedSine, check_level, simulated_system, visit_points
+from sim.analysis.signals import Signal, SimulatedContacts, simulated_contacts, simulated_signal
+from sim.model.system import Impactor, ModalModel, Nominal, a_base_star, a_noabs_star
+
+#: The paper's sampling rate (Sect. 5.5: 51.2 kHz).
+DEFAULT_FS = 51.2e3
+DEFAULT_PERIODS = 50
+#: The columns of the trace's CSV, in order (`sim.analysis.signals.simulated_signal`; t first).
+COLUMNS = ("t", "q_tip", "v_tip", "a_tip", "q_wall_left", "q_wall_right", "a_left", "a_right", "q_sphere",
+           "f_left", "f_right")
+#: Units of the columns (SI).
+UNITS = {"t": "s", "q_tip": "m", "v_tip": "m/s", "a_tip": "m/s^2", "q_wall_left": "m", "q_wall_right": "m",
+         "a_left": "m/s^2", "a_right": "m/s^2", "q_sphere": "m", "f_left": "N", "f_right": "N"}
+
+
+@dataclass(frozen=True)
+class Trace:
+    """The recorded stretch of one stepped-sine point.
+
+    signal: the columns (`COLUMNS`, SI) from t = 0 at the start of the recorded stretch (phase 0 of the
+    excitation q_base = a_base cos(Omega t)); states: the recorded rows y = [s, s', u_a, u_a'] (`sim.model.system`);
+    contacts: the simulator's contacts between samples; samples_per_period M; fs = M Omega / (2 pi) (Hz);
+    amplitudes: |c_1| of q_tip per recorded period (m, Sect. 5); impacts: contact onsets per period;
+    level a_base/a_base*, a_base, a_noabs (m); eta, eta_actual: the point's nominal and simulated
+    Omega / omega_1; Omega (rad/s); ledger: the energy bookkeeping and impact records of the recorded stretch.
+    """
+
+    signal: Signal
+    states: np.ndarray
+    contacts: SimulatedContacts
+    samples_per_period: int
+    fs: float
+    amplitudes: np.ndarray
+    impacts: np.ndarray
+    level: float
+    a_base: float
+    a_noabs: float
+    eta: float
+    eta_actual: float
+    Omega: float
+    ledger: Ledger | None = None
+
+    @property
+    def normalised_amplitudes(self) -> np.ndarray:
+        """a / a_noabs* per recorded period (-), the paper's Fig. 4 ordinate."""
+        return self.amplitudes / self.a_noabs
+
+
+def samples_per_period(fs: float, Omega: float) -> int:
+    """M = round(fs / f_exc) for a requested sampling rate fs (Hz) at the excitation Omega (rad/s); at least two
+    samples per period (one-line SimulationInputError otherwise)."""
+    f_exc = Omega / (2.0 * math.pi)
+    if not (math.isfinite(fs) and fs >= 2.0 * f_exc):
+        raise SimulationInputError(f"--fs {fs:g} Hz is below twice the excitation frequency ({2.0 * f_exc:.4g} Hz); "
+                                   f"give --fs of at least that (default {DEFAULT_FS:g})")
+    return int(round(fs / f_exc))
+
+
+def check_trace_settings(model: ModalModel, protocol: SteppedSine, periods: int, fs: float) -> None:
+    """One-line SimulationInputError for a record length `periods` that is not a whole number >= 1 or a rate fs (Hz)
+    below two samples per period at the protocol's lowest excitation: checked before anything is simulated (or
+    compiled)."""
+    if int(periods) != periods or periods < 1:
+        raise SimulationInputError(f"--periods must be a whole number >= 1, got {periods!r}")
+    lowest = protocol.eta[0] * float(model.omega[0]) * (1.0 - protocol.perturbation)
+    samples_per_period(float(fs), lowest)
+
+
+def record_trace(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *,
+                 periods: int = DEFAULT_PERIODS, fs: float = DEFAULT_FS, seed: int = 0, rep: int = 0,
+                 nominal: Nominal = Nominal()) -> Trace:
+    """Simulate the stepped-sine run of `protocol` at a_base = level a_base* (Sect. 5.1) to its last point and
+    record `periods` excitation periods of that point's hold at fs (Hz, rounded to M f_exc; module docstring).
+
+    impactor None: the host structure alone. Raises SimulationInputError for bad settings.
+    """
+    from sim.integration.integrators import get_integrator
+
+    level = check_level(level)
+    check_trace_settings(model, protocol, periods, fs)
+    fs = float(fs)
+    run_step = get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
+    sys = simulated_system(model, impactor)
+    a_base = level * a_base_star(model, nominal)
+    a_noabs = a_noabs_star(model, a_base, nominal)
+    y = np.zeros(2 * model.n_modes + 2)
+    points = len(protocol.legs) * int(protocol.n_eta)
+    for visited, (_, eta, eta_actual, Omega) in enumerate(visit_points(model, sys, a_base, protocol, y, seed=seed,
+                                                                        rep=rep), start=1):
+        if visited == points:
+            break
+        run_step(y, protocol.periods(Omega)[1], Omega, a_base, sys, None)
+    M = samples_per_period(fs, Omega)
+    states = np.empty((int(periods) * M + 1, y.size))
+    ledger = Ledger()
+    amplitudes, impacts = run_step(y, int(periods), Omega, a_base, sys, states, ledger=ledger)
+    return Trace(simulated_signal(states, M, Omega, a_base, sys), states,
+                 simulated_contacts(states, M, Omega, a_base, sys), M, M * Omega / (2.0 * math.pi), amplitudes,
+                 impacts, level, a_base, a_noabs, eta, eta_actual, Omega, ledger)
+
+
+def trace_rows(trace: Trace) -> np.ndarray:
+    """The CSV table of a trace: one row per sample, the columns of `COLUMNS`."""
+    return np.column_stack([trace.signal[name] for name in COLUMNS])
+
+
+def trace_data(trace: Trace, settings: dict[str, Any]) -> dict[str, Any]:
+    """The JSON object of a trace (SI units): `settings` (the command's parameters), the actual sampling rate,
+    the per-period amplitudes a / a_noabs* with their mean and max (Fig. 4), the contact onsets per period, and
+    the simulator's impacts (`impact_list`) and the stretch's scattering measures (`sim.stepped_sine.measures`)."""
+    a = trace.normalised_amplitudes
+    m = hold_measures(trace.amplitudes, trace.impacts, trace.a_noabs)
+    scattering = {} if trace.ledger is None else point_measures(trace.amplitudes, trace.impacts, trace.a_noabs,
+                                                                trace.ledger).scattering
+    return {
+        **settings,
+        "level": trace.level, "a_base": trace.a_base, "a_noabs": trace.a_noabs, "eta": trace.eta,
+        "eta_actual": trace.eta_actual, "excitation_hz": trace.Omega / (2.0 * math.pi),
+        "fs": trace.fs, "samples_per_period": trace.samples_per_period,
+        "periods": int(a.size), "n_samples": int(trace.signal.t.size),
+        "amplitudes": a, "mean": m.mean, "max": m.max, "cv": m.cv,
+        "impacts_per_period": m.impacts_per_period, "onsets_per_period": trace.impacts,
+        **impact_list(trace),
+        **{name: getattr(scattering, name, math.nan) for name in SCATTERING_MEASURES},
+        "columns": list(COLUMNS), "units": UNITS,
+    }
+
+
+def impact_list(trace: Trace) -> dict[str, Any]:
+    """{"impacts": [...], "impacts_source": ...}: one entry per contact of the recorded stretch with its onset
+    time "t" (s, from the stretch's start) and "wall" ("left"/"right"). From the integrator's records
+    ("integrator": exact onset; also duration (s), impulse int |f| dt (N s), approach_speed (m/s), the sphere's
+    velocity relative to the base before/after (m/s) and the energies of mode 1 and modes 2..N at onset and
+    release (J), Appendix D) when it keeps them, else from the samples ("samples": onset to one sample interval,
+    signed impulse, `sim.analysis.signals.simulated_contacts`)."""
+    records = None if trace.ledger is None else trace.ledger.impacts
+    if records is None or (records.size == 0 and trace.impacts.sum() > 0):
+        contacts = trace.contacts
+        return {"impacts_source": "samples",
+                "impacts": [{"t": t, "wall": wall, "impulse": impulse}
+                            for t, wall, impulse in zip(contacts.times, contacts.walls, contacts.impulses)]}
+    T = 2.0 * math.pi / trace.Omega
+    rows = []
+    for r in records:
+        row = {"t": float(r["period"] * T + r["t_onset"]), "wall": "left" if r["wall"] == 0 else "right"}
+        row.update({name: float(r[name]) for name in records.dtype.names if name not in ("wall", "period", "t_onset")})
+        rows.append(row)
+    return {"impacts_source": "integrator", "impacts": rows}
+
+
+def write_trace(folder: Path, trace: Trace, settings: dict[str, Any], plot: str | Path | None = None,
+                started: float | None = None) -> tuple[dict[str, Any], list[Path | str]]:
+    """Write trace.csv and trace.json into `folder` (and Figs. 4 / 9a to `plot`), all or nothing; returns (the JSON
+    data, the paths written). started: time.perf_counter() at the command's start (for wall_time_s)."""
+    from sim.plots.figures import plot_trace
+    from sim.common.files import dumps, write_csv, write_text
+
+    data = trace_data(trace, settings)
+    written: list[Path | str] = []
+    try:
+        written.append(write_csv(folder / "trace.csv", COLUMNS, trace_rows(trace)))
+        if started is not None:
+            data["wall_time_s"] = time.perf_counter() - started
+        written.append(write_text(folder / "trace.json", dumps(data) + "\n"))
+        if plot:
+            plot_trace(data, trace.signal.t, trace.signal["q_tip"], trace.signal["v_tip"], plot)
+            written.append(plot)
+    except BaseException:
+        for path in written:  # all or nothing
+            Path(path).unlink(missing_ok=True)
+        raise
+    return data, written

@@ -1,0 +1,177 @@
+"""The one way every stage writes a file: atomically, with the permissions a user expects.
+
+A file is written to a new temporary file beside its target and renamed onto it (`os.replace`) only when
+the writing succeeded, so a reader never sees half a file and a failure leaves the old file (or nothing).
+The temporary file is created with mode 0666 and the process umask applied by the kernel (0644 under the
+usual umask 022), as `open()` would; `tempfile.mkstemp` would give 0600. No fsync: the files are results,
+not a database; an interrupted write leaves a hidden ``.NAME.*`` temporary file at worst.
+
+It lives in `sim` because `sim` stands alone (it imports no other stage): scans, bem_contact and uq may
+all import it without a cycle, while scans and sim must never import uq (the pipeline's arrows,
+README.md). JSON for machines (`dumps`: numpy values and NaN made plain), CSV tables (`write_csv`) and
+matplotlib figures (`save_figure`, `plot_to`, Agg back end) are written through it too.
+"""
+from __future__ import annotations
+
+import csv
+import errno
+import io
+import json
+import math
+import os
+import secrets
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, Iterable, Iterator, Sequence
+
+import numpy as np
+
+#: mode of a new file before the umask is applied (what `open(path, "w")` uses)
+NEW_FILE_MODE = 0o666
+
+
+def read_text(path: str | os.PathLike, kind: str, fmt: str, hint: str = "") -> str:
+    """The UTF-8 text of a user's input file; a missing file, a folder or a binary file is one line
+    (SimulationInputError) naming the file, its `kind` (e.g. "modal file"), the format `fmt` and a `hint`."""
+    from sim.common.errors import SimulationInputError
+
+    path = Path(path)
+    try:
+        return path.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise SimulationInputError(f"{kind} {path} not found{hint}") from None
+    except IsADirectoryError:
+        raise SimulationInputError(f"{path} is a folder, not a {kind}") from None
+    except UnicodeDecodeError:
+        raise SimulationInputError(f"{path}: not a text (UTF-8 {fmt}) file") from None
+
+
+@contextmanager
+def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
+    """Yield a new empty temporary file beside `path` for the caller to write (by its name); on success it
+    is renamed onto `path`, on any exception it is removed and `path` is left untouched.
+
+    Raises FileNotFoundError (folder missing) or IsADirectoryError (`path` is a folder) with a one-line
+    message before anything is created.
+    """
+    target = Path(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    if not folder.is_dir():
+        raise FileNotFoundError(errno.ENOENT, f"cannot write {target}: folder {folder} does not exist; create it or "
+                                   "choose another path")
+    if target.is_dir():
+        raise IsADirectoryError(errno.EISDIR, f"cannot write {target}: it is a folder; give a file name")
+    tmp = _new_temporary_file(folder, target)
+    try:
+        yield tmp
+        os.replace(tmp, target)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def _new_temporary_file(folder: Path, target: Path) -> Path:
+    """A new empty file `.STEM.RANDOM.SUFFIX` in `folder`, created exclusively with NEW_FILE_MODE & ~umask."""
+    while True:
+        tmp = folder / f".{target.stem}.{secrets.token_hex(4)}{target.suffix}"
+        try:
+            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, NEW_FILE_MODE))
+        except FileExistsError:
+            continue
+        return tmp
+
+
+def write_bytes(path: str | os.PathLike, data: bytes) -> Path:
+    """Write `data` to `path` atomically; returns the path."""
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+    return Path(path)
+
+
+def write_text(path: str | os.PathLike, text: str) -> Path:
+    """Write `text` (UTF-8) to `path` atomically; returns the path."""
+    return write_bytes(path, text.encode("utf-8"))
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Convert numpy scalars/arrays (and NaN/inf, which JSON lacks, to None) into plain JSON values."""
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        value = float(obj)
+        return value if math.isfinite(value) else None
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def dumps(obj: Any) -> str:
+    """One JSON object as indented text (numpy values made plain, NaN written as null)."""
+    return json.dumps(to_jsonable(obj), indent=2, allow_nan=False)
+
+
+def csv_value(value: Any) -> str:
+    """A table cell: numpy integers and booleans as integers, finite floats by repr (exact round trip),
+    NaN and inf as "nan", anything else by str."""
+    if isinstance(value, (np.integer, np.bool_)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value)) if math.isfinite(value) else "nan"
+    return str(value)
+
+
+def write_csv(path: str | os.PathLike, header: Sequence[str], rows: Iterable[Sequence[Any]]) -> Path:
+    """A CSV table (one header line, `csv_value` cells, "\\n" line ends) written atomically; returns the path."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(header)
+    writer.writerows([csv_value(v) for v in row] for row in rows)
+    return write_text(path, buffer.getvalue())
+
+
+def report_written(paths: Iterable[str | os.PathLike], *, json_mode: bool = False) -> None:
+    """One confirmation line ``wrote PATH`` per file a command wrote: on stdout after a text report, on stderr
+    when stdout carries one JSON object (`json_mode`)."""
+    stream = sys.stderr if json_mode else sys.stdout
+    for path in paths:
+        stream.write(f"wrote {path}\n")
+
+
+def save_figure(fig: Any, path: str | os.PathLike) -> Path:
+    """Save a matplotlib figure atomically (format from the file suffix, e.g. .png, .pdf; 150 dpi)."""
+    target = Path(path)
+    with atomic_path(target) as tmp:
+        fig.savefig(tmp, format=target.suffix.lstrip(".") or "png", dpi=150, bbox_inches="tight")
+    return target
+
+
+def pyplot() -> Any:
+    """matplotlib.pyplot on the Agg back end (files only, no display needed)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+@contextmanager
+def plot_to(path: str | os.PathLike, figsize: tuple[float, float] = (6.0, 4.0)) -> Iterator[tuple[Any, Any]]:
+    """Yield (figure, axes) of a new matplotlib figure (Agg back end); on success it is saved atomically to
+    `path` (format from the suffix), and it is always closed."""
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=figsize)
+    try:
+        yield fig, ax
+        save_figure(fig, path)
+    finally:
+        plt.close(fig)

@@ -1,0 +1,109 @@
+"""Value types of the command-line options that every stage shares (argparse ``type=`` functions).
+
+A bad value is refused by argparse before the command runs: one line ``ies COMMAND: error: argument --X: ...``,
+exit code 2, nothing computed or written. Used by `sim.cli`, `bem_contact.cli` and `uq.commands`.
+
+* `figure_file`: a figure path whose suffix matplotlib can write (``--plot``); checked up front, so a long
+  computation never ends in an unsupported format.
+* `figure_formats`, `level_list`: ``ies plot``'s formats (png,pdf) and levels (5.3,6.7).
+* `positive_int`: counts such as ``--jobs``, ``--reps``, ``--n``.
+* `clearance`, `hertz_constant`: g and k_H (Table 2) as SI numbers or with a unit (`sim.common.units`), with a warning
+  line on stderr for an implausible magnitude.
+"""
+from __future__ import annotations
+
+import argparse
+import functools
+import math
+import sys
+from pathlib import Path
+
+from sim.common.errors import SimulationInputError
+from sim.common.units import CLEARANCE, K_H, K_T, Quantity, implausible, parse_quantity
+
+
+@functools.lru_cache(maxsize=1)
+def figure_suffixes() -> tuple[str, ...]:
+    """The file suffixes matplotlib's Agg canvas can write (.png, .pdf, .svg, ...)."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    return tuple(f".{ext}" for ext in FigureCanvasBase.get_supported_filetypes())
+
+
+def figure_file(text: str) -> str:
+    """A figure path with a suffix matplotlib can write; a missing or unknown suffix is refused."""
+    suffix = Path(text).suffix.lower()
+    if suffix not in figure_suffixes():
+        what = f"unsupported figure format {suffix!r}" if suffix else "no file suffix"
+        raise argparse.ArgumentTypeError(f"{text!r}: {what}; name the file with one of {', '.join(figure_suffixes())}")
+    return text
+
+
+def figure_formats(text: str) -> tuple[str, ...]:
+    """A comma-separated list of figure formats matplotlib can write ("png,pdf" -> (".png", ".pdf"))."""
+    formats = tuple(f".{part.strip().lower().lstrip('.')}" for part in text.split(",") if part.strip())
+    unknown = [f for f in formats if f not in figure_suffixes()]
+    if not formats or unknown:
+        raise argparse.ArgumentTypeError(f"unsupported figure format(s) {', '.join(unknown) or repr(text)}; use "
+                                         f"{', '.join(s.lstrip('.') for s in figure_suffixes())}")
+    return formats
+
+
+def level_list(text: str) -> tuple[float, ...]:
+    """Excitation levels a_base/a_base* as a comma-separated list of positive numbers ("5.3,6.7")."""
+    try:
+        levels = tuple(float(part) for part in text.split(",") if part.strip())
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be numbers like 5.3,6.7, got {text!r}") from None
+    if not levels or any(not level > 0 for level in levels):
+        raise argparse.ArgumentTypeError(f"must be positive numbers like 5.3,6.7, got {text!r}")
+    return levels
+
+
+def positive_int(text: str) -> int:
+    """An integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer (1 or more), got {value}")
+    return value
+
+
+def quantity_value(text: str, quantity: Quantity) -> float:
+    """The SI value of `text` (`sim.common.units.parse_quantity`); an implausible magnitude is one warning line."""
+    try:
+        value = parse_quantity(text, quantity)
+    except SimulationInputError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    warning = implausible(value, quantity)
+    if warning:
+        sys.stderr.write(f"warning: {warning}\n")
+    return value
+
+
+def clearance(text: str) -> float:
+    """The clearance g in m: ``0.58e-3``, ``0.58mm``, ``580um``."""
+    return quantity_value(text, CLEARANCE)
+
+
+def tangential_stiffness(text: str) -> float:
+    """The tangential stiffness k_t of the floor contact in N/m: ``22e6``, ``22kN/mm`` (Appendix C)."""
+    return quantity_value(text, K_T)
+
+
+def friction_coefficient(text: str) -> float:
+    """The Coulomb coefficient mu of the floor contact (-), >= 0 (0: no friction)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number; give the friction coefficient, e.g. 0.07") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"the friction coefficient must be >= 0 (0: no friction, e.g. 0.07), got {text}")
+    return value
+
+
+def hertz_constant(text: str) -> float:
+    """The Hertzian spring constant k_H in N/m^1.5: ``8.918e9``, ``282e3N/mm^1.5``."""
+    return quantity_value(text, K_H)

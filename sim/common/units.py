@@ -1,0 +1,83 @@
+"""Quantities typed by people: a plain SI number or a number with its unit, and a check of its magnitude.
+
+The uncertain contact parameters of the seed paper (Table 2) are easy to type in the wrong unit: the
+clearance g* = 0.58 mm and the Hertzian spring constant k_H* = 282e3 N/mm^1.5 (Eq. 8) are quoted in mm, while
+the code works in SI units (m, N/m^1.5). `parse_quantity` reads ``0.58e-3``, ``"0.58mm"``, ``"580 um"`` or
+``"282e3 N/mm^1.5"`` and returns SI; `implausible` names a magnitude outside the physically plausible range
+and the value that was probably meant (e.g. ``--g 0.58`` is 0.58 m, probably 0.58 mm). The command line
+(`sim.common.options`) and the study files (`uq.study`) both read g and k_H through this module.
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+from sim.common.errors import SimulationInputError
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """A kind of quantity: its SI unit, the units accepted (factor to SI) and the plausible SI range."""
+
+    name: str
+    si_unit: str
+    units: dict[str, float]
+    plausible: tuple[float, float]
+    example: str
+
+    def format(self, value: float) -> str:
+        """`value` (SI) in the accepted unit that gives the shortest number, e.g. 0.58 mm."""
+        return min((f"{value / factor:.4g} {unit}" for unit, factor in self.units.items()), key=len)
+
+
+#: a length such as the clearance g (Table 2: 0.58-0.612 mm); plausible 0.01-10 mm
+CLEARANCE = Quantity("clearance g", "m", {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6}, (1e-5, 1e-2), "0.58mm")
+#: the Hertzian spring constant k_H (Eq. 8: 282e3 N/mm^1.5 = 8.918e9 N/m^1.5); plausible 1e6-1e14 N/m^1.5
+K_H = Quantity("Hertzian spring constant k_H", "N/m^1.5", {"N/m^1.5": 1.0, "N/mm^1.5": 1e3**1.5}, (1e6, 1e14), "282e3N/mm^1.5")
+#: the tangential stiffness k_t of the floor contact (Appendix C: 22 kN/mm = 2.2e7 N/m); plausible 1e4-1e10 N/m
+K_T = Quantity("tangential stiffness k_t", "N/m", {"N/m": 1.0, "N/mm": 1e3, "kN/mm": 1e6}, (1e4, 1e10), "22kN/mm")
+
+_NUMBER = re.compile(r"^\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(.*?)\s*$")
+
+
+def _unit_key(unit: str) -> str:
+    """Spelling variants of a unit made one: N/m**1.5 and N/m1.5 as N/m^1.5, the Greek mu as the micro sign."""
+    return unit.replace("**", "^").replace("m1.5", "m^1.5").replace("μ", "µ")
+
+
+def parse_quantity(text: str | float, quantity: Quantity) -> float:
+    """The SI value of `text`: a plain number (taken as SI) or a number followed by one of the quantity's units
+    (``"0.58mm"``, ``"282e3 N/mm^1.5"``). Raises SimulationInputError naming the accepted units."""
+    if isinstance(text, bool):
+        raise SimulationInputError(f"{quantity.name} must be a number, got {text!r}")
+    if isinstance(text, (int, float)):
+        return float(text)
+    match = _NUMBER.match(str(text))
+    units = ", ".join(u for u in quantity.units if u != "µm")
+    if not match:
+        raise SimulationInputError(f"{quantity.name}: cannot read {text!r}; give a number in {quantity.si_unit} "
+                                   f"or a number with a unit ({units}), e.g. {quantity.example}")
+    number, unit = float(match.group(1)), _unit_key(match.group(2))
+    if not unit:
+        return number
+    factors = {_unit_key(u): f for u, f in quantity.units.items()}
+    if unit not in factors:
+        raise SimulationInputError(f"{quantity.name}: unknown unit {match.group(2)!r} in {text!r}; use one of {units}")
+    return number * factors[unit]
+
+
+def implausible(value: float, quantity: Quantity) -> str | None:
+    """None when `value` (SI) lies in the quantity's plausible range; otherwise one sentence saying so and, when
+    the number read in another accepted unit lies in range (0.58 as mm), the value that was probably meant."""
+    lo, hi = quantity.plausible
+    if not math.isfinite(value) or value <= 0 or lo <= value <= hi:
+        return None
+    side = f"above {quantity.format(hi)}" if value > hi else f"below {quantity.format(lo)}"
+    message = f"{quantity.name} = {value:.4g} {quantity.si_unit} is implausible ({side})"
+    centre = math.sqrt(lo * hi)
+    meant = [(unit, value * factor) for unit, factor in quantity.units.items() if lo <= value * factor <= hi]
+    if meant:
+        unit, si = min(meant, key=lambda m: abs(math.log(m[1] / centre)))
+        message += f"; did you mean {value:g} {unit} = {si:.4g} {quantity.si_unit}? Give the unit: {value:g}{unit}"
+    return message

@@ -1,0 +1,146 @@
+"""Modal-model files: bring the modes of the host structure from any FE tool (seed paper Eq. 7).
+
+Format (TOML, UTF-8). Arrays have one value per retained mode, in ascending frequency order:
+
+    format = "ies-modal-model"       # optional, but if present it must be this
+    version = 1                      # optional, 1
+    source = "CalculiX job beam.inp" # optional free text
+    frequencies_hz = [117.4, 886.0]  # natural frequencies f_j = omega_j / (2 pi), Hz, strictly ascending
+    damping_ratios = [0.00085, 0.0044]  # modal damping ratios D_j, in (0, 1) (0.001 = 0.1 %)
+    phi_wall_left  = [1.376, 1.390]  # mass-normalised x-value of mode j at the left cavity wall, 1/sqrt(kg)
+    phi_wall_right = [1.376, 1.390]  # same at the right cavity wall, 1/sqrt(kg)
+    phi_tip        = [1.324, 1.194]  # same at the measurement point (response output), 1/sqrt(kg)
+    participation  = [1.106, -0.553] # phi_j^T M b, b = unit x-translation of the base, sqrt(kg)
+    beam_mass_kg   = 1.573           # optional: mass of the beam's free length without the block, kg (Eq. 10)
+    phi_floor      = [1.380, 1.267]  # optional: same at the cavity floor on the beam axis, 1/sqrt(kg) (App. C)
+
+    [units]                          # optional; if present each entry must name the unit above
+    frequencies_hz = "Hz"
+    damping_ratios = "1"
+    phi = "1/sqrt(kg)"
+    participation = "sqrt(kg)"
+
+    [provenance]                     # optional, free-form: how the modes were made (written by sim.hosts.solid and
+    model = "3D solid ..."           # sim.hosts.calculix: geometry, material, mesh, DOF count, solve time, and a
+    [provenance.convergence]         # mesh-convergence table); readers ignore it
+
+The optional keys are needed only by the damped contact law (beam_mass_kg) and by friction (phi_floor);
+files without them load as before, and those laws then refuse the model with one line naming the key.
+
+Signs follow sim/model/system.py: the wall directions w_l, w_r are both +x, so phi_wall_* are the x-components of
+the mass-normalised modes (phi_j^T M phi_j = 1 kg^0). A mode's overall sign is free, but phi_wall_*, phi_tip,
+phi_floor and participation of that mode must use the same sign.
+"""
+from __future__ import annotations
+
+import math
+import os
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from sim.common.errors import SimulationInputError
+from sim.common.files import read_text, write_text
+from sim.model.system import ModalModel
+
+FORMAT_NAME = "ies-modal-model"
+FORMAT_VERSION = 1
+ARRAY_KEYS = ("frequencies_hz", "damping_ratios", "phi_wall_left", "phi_wall_right", "phi_tip", "participation")
+OPTIONAL_ARRAY_KEYS = ("phi_floor",)
+BEAM_MASS_KEY = "beam_mass_kg"
+UNITS = {"frequencies_hz": "Hz", "damping_ratios": "1", "phi": "1/sqrt(kg)", "participation": "sqrt(kg)"}
+
+_HEADER = """\
+# ies modal model of the host structure without the sphere (seed paper Eq. 7); format described in
+# sim/hosts/modal_file.py. One value per mode, ascending frequency. Mode values are mass-normalised x-values
+# (1/sqrt(kg)) at the left/right cavity walls, the measurement point and (optional) the cavity floor;
+# participation = phi^T M b (sqrt(kg)); beam_mass_kg (optional): the beam's free length without the block (kg).
+"""
+
+
+def _numbers(path: Path, key: str, value: object) -> np.ndarray:
+    if not isinstance(value, list) or not value:
+        raise SimulationInputError(f"{path}: '{key}' must be a non-empty array of numbers, e.g. {key} = [117.4, 886.0]")
+    for item in value:
+        if isinstance(item, bool) or not isinstance(item, (int, float)):
+            raise SimulationInputError(f"{path}: '{key}' contains the non-numeric value {item!r}; give plain numbers")
+        if not math.isfinite(item):
+            raise SimulationInputError(f"{path}: '{key}' contains {item!r}; every value must be finite")
+    return np.array(value, dtype=float)
+
+
+def load_modal_model(path: str | os.PathLike) -> ModalModel:
+    """Read a modal-model file (format in this module's docstring) into a ModalModel.
+
+    Raises SimulationInputError with one line naming the file and the problem for a missing or unreadable
+    file, invalid TOML, a missing key, a non-numeric entry (also in the optional phi_floor, beam_mass_kg),
+    arrays of different lengths, frequencies that are not positive and strictly ascending, damping ratios
+    outside (0, 1) or a beam mass that is not positive.
+    """
+    path = Path(path)
+    text = read_text(path, "modal file", "TOML", "; give the path of a .toml modal-model file")
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SimulationInputError(f"{path}: not valid TOML ({exc})") from None
+    if "format" in data and data["format"] != FORMAT_NAME:
+        raise SimulationInputError(f"{path}: format is {data['format']!r}, expected {FORMAT_NAME!r}")
+    if "version" in data and data["version"] != FORMAT_VERSION:
+        raise SimulationInputError(f"{path}: version {data['version']!r} is not supported; this reader knows version {FORMAT_VERSION}")
+    missing = [key for key in ARRAY_KEYS if key not in data]
+    if missing:
+        raise SimulationInputError(f"{path}: missing key(s) {', '.join(missing)}; a modal file needs {', '.join(ARRAY_KEYS)}")
+    units = data.get("units", {})
+    if not isinstance(units, dict):
+        raise SimulationInputError(f"{path}: 'units' must be a table, e.g. [units] frequencies_hz = \"Hz\"")
+    for key, unit in units.items():
+        if key in UNITS and unit != UNITS[key]:
+            raise SimulationInputError(f"{path}: units.{key} is {unit!r} but must be {UNITS[key]!r}; convert the values")
+    arrays = {key: _numbers(path, key, data[key]) for key in ARRAY_KEYS + OPTIONAL_ARRAY_KEYS if key in data}
+    lengths = {key: a.size for key, a in arrays.items()}
+    n = lengths["frequencies_hz"]
+    wrong = [f"{key} has {size}" for key, size in lengths.items() if size != n]
+    if wrong:
+        raise SimulationInputError(f"{path}: arrays must all have {n} values (one per mode) but {'; '.join(wrong)}")
+    source = data.get("source", str(path))
+    beam_mass = data.get(BEAM_MASS_KEY)
+    if beam_mass is not None and (isinstance(beam_mass, bool) or not isinstance(beam_mass, (int, float))):
+        raise SimulationInputError(f"{path}: '{BEAM_MASS_KEY}' must be a number (kg), e.g. {BEAM_MASS_KEY} = 1.573")
+    try:
+        return ModalModel(**arrays, source=str(source), beam_mass=beam_mass)
+    except SimulationInputError as exc:
+        raise SimulationInputError(f"{path}: {exc}") from None
+
+
+def modal_model_document(model: ModalModel, provenance: dict | None = None) -> dict:
+    """The file content of a model as plain data (what save_modal_model writes), with an optional [provenance]
+    table (plain TOML data: strings, numbers, booleans, lists and tables)."""
+    doc: dict = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "source": model.source}
+    for key in ARRAY_KEYS:
+        doc[key] = [float(v) for v in getattr(model, key)]
+    if model.phi_floor is not None:
+        doc["phi_floor"] = [float(v) for v in model.phi_floor]
+    if model.beam_mass is not None:
+        doc[BEAM_MASS_KEY] = model.beam_mass
+    doc["units"] = dict(UNITS)
+    if provenance:
+        doc["provenance"] = provenance
+    return doc
+
+
+def load_provenance(path: str | os.PathLike) -> dict:
+    """The [provenance] table of a modal-model file ({} when it has none); call load_modal_model first to check
+    the file."""
+    return dict(tomllib.loads(Path(path).read_text(encoding="utf-8")).get("provenance", {}))
+
+
+def save_modal_model(model: ModalModel, path: str | os.PathLike, provenance: dict | None = None) -> Path:
+    """Write `model` (and an optional [provenance] table) as a modal-model file (format in this module's
+    docstring), atomically (`sim.common.files`)."""
+    import tomli_w
+
+    try:
+        return write_text(path, _HEADER + tomli_w.dumps(modal_model_document(model, provenance)))
+    except (FileNotFoundError, IsADirectoryError) as exc:  # a missing folder, or a folder named as the file
+        raise SimulationInputError(exc.strerror) from None

@@ -1,0 +1,104 @@
+"""Integrators of the coupled system by name (Sect. 3.2), imported lazily, and their warm-up.
+
+Every entry follows the contract of `sim.model.system`:
+``run_step(y, n_periods, Omega, a_base, sys, record=None) -> (amplitudes, impacts)``.
+
+The kernels are numba functions cached on disk (``cache=True``, in ``__pycache__`` beside the sources). The
+first run on a machine compiles them, which takes minutes; `warm_up` does it before a command's progress bar
+starts (so that the bar's rate and ETA measure simulation only) and says so while it happens.
+"""
+from __future__ import annotations
+
+import functools
+import importlib
+import sys as _sys
+import threading
+import time
+from typing import Callable, TextIO
+
+import numpy as np
+
+from sim.common.errors import SimulationInputError
+from sim.model.system import Impactor, ModalModel, SystemArrays, system_arrays
+
+RunStep = Callable[[np.ndarray, int, float, float, SystemArrays, "np.ndarray | None"], tuple[np.ndarray, np.ndarray]]
+
+#: name -> (module, function). "ode3" is the paper's reference; "exact" is the fast free-flight integrator.
+REGISTRY: dict[str, tuple[str, str]] = {
+    "ode3": ("sim.integration.ode3", "run_step"),
+    "exact": ("sim.integration.exact", "run_step"),
+}
+#: integrators that accept ``dt_scale`` (a multiple of the paper's dt = 2 pi/(15 omega_9))
+_ACCEPTS_DT_SCALE = {"ode3"}
+
+
+def available() -> list[str]:
+    """Names of the registered integrators."""
+    return list(REGISTRY)
+
+
+def get_integrator(name: str, *, dt_scale: float | None = None) -> RunStep:
+    """The `run_step` function registered under `name`, with ``dt_scale`` bound if given (ode3 only)."""
+    if name not in REGISTRY:
+        raise SimulationInputError(f"unknown integrator {name!r}; available: {', '.join(available())}")
+    module_name, attribute = REGISTRY[name]
+    run_step = getattr(importlib.import_module(module_name), attribute)
+    if dt_scale is None or dt_scale == 1.0:
+        return run_step
+    if name not in _ACCEPTS_DT_SCALE:
+        raise SimulationInputError(f"dt_scale applies only to {', '.join(sorted(_ACCEPTS_DT_SCALE))}, not to {name!r}")
+    return functools.partial(run_step, dt_scale=float(dt_scale))
+
+
+#: how long compiling the kernels of one integrator takes with a cold cache (`warm_up`), measured on the 2-core
+#: development machine while other work shared the cores (load average 6-8): "exact" 101 s in a fresh install
+#: (up to 390 s under heavier load), "ode3" 32 s
+COMPILE_MINUTES = {"exact": 2, "ode3": 1}
+#: seconds after which `warm_up` says that it is compiling: loading the cached kernels of "exact" takes 1-3 s
+#: (2.5-3 s measured with the machine's 2 cores shared by four engineers), compiling them minutes
+NOTICE_AFTER_S = 5.0
+
+
+def _run_tiny_system(run_step: RunStep) -> None:
+    """One short run of a tiny impacting system (2 modes, the sphere sent into a wall): every kernel of the
+    integrator is compiled for the argument types of a real run."""
+    model = ModalModel(frequencies_hz=np.array([100.0, 20000.0]), damping_ratios=np.array([0.01, 0.01]),
+                       phi_wall_left=np.array([1.0, 0.5]), phi_wall_right=np.array([1.0, 0.5]),
+                       phi_tip=np.array([1.0, 0.5]), participation=np.array([1.0, 0.3]), source="warm-up")
+    y = np.zeros(2 * model.n_modes + 2)
+    y[-1] = 0.5  # m/s: the sphere meets a wall within the first period
+    run_step(y, 3, 2.0 * np.pi * 100.0, 1e-5, system_arrays(model, Impactor()), None)
+
+
+def warm_up(name: str, *, stream: TextIO | None = None) -> float:
+    """Compile (or load from numba's on-disk cache) the kernels of the integrator `name` in this process by one
+    short run of a tiny system, before any timed or progress-reported work. When that takes longer than
+    NOTICE_AFTER_S (a cold cache), one line ``compiling ... kernels (first run only, about N min) ...`` goes to
+    `stream` (stderr) while it happens, and one line with the time when it is done. Returns the seconds spent
+    (0 when this process has warmed the integrator before)."""
+    if name in _WARM:
+        return 0.0
+    run_step = get_integrator(name)
+    stream = stream or _sys.stderr
+
+    def say_so() -> None:
+        stream.write(f"compiling the {name} integrator's kernels (first run only, about "
+                     f"{COMPILE_MINUTES.get(name, 2)} min) ...\n")
+        stream.flush()
+
+    notice = threading.Timer(NOTICE_AFTER_S, say_so)
+    started = time.perf_counter()
+    notice.start()
+    try:
+        _run_tiny_system(run_step)
+    finally:
+        notice.cancel()
+    elapsed = time.perf_counter() - started
+    _WARM.add(name)
+    if elapsed > NOTICE_AFTER_S:
+        stream.write(f"kernels compiled in {elapsed:.0f} s; later runs load them from the cache\n")
+    return elapsed
+
+
+#: integrators warmed up in this process (the kernels' argument types do not depend on dt_scale)
+_WARM: set[str] = set()

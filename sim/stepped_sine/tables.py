@@ -1,0 +1,127 @@
+"""Tables of stepped-sine results: a frequency response (Fig. 5, Sect. 5.2) and the resonant level against the
+excitation level (Fig. 6, Sect. 5.3), as `ies sweep`, `ies overview` and the uq response studies write and print
+them. Amplitudes are a / a_noabs* and levels a_base / a_base* (dimensionless, Sect. 5); a column with a unit
+says it in its name (a_base_m). The columns are documented in the README's output reference.
+"""
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+from sim.stepped_sine.measures import PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, PAPER_REDUCTION_MEAN, SCATTERING_MEASURES
+from sim.stepped_sine.protocol import SweepResult, scattering_keys
+
+#: the columns of the energy scattering and impact measures (Sect. 5.5, Appendix D; `sim.stepped_sine.measures`), appended to
+#: both tables: the measure names, the input power with its unit (W) in the name
+SCATTERING_COLUMNS = tuple("input_power_W" if name == "input_power" else name for name in SCATTERING_MEASURES)
+#: sweep.csv: one row per eta of the grid (`SweepResult` arrays)
+SWEEP_COLUMNS = ("eta", "mean", "mean_lo", "mean_hi", "max", "max_lo", "max_hi", "cv", "impacts_per_period", "regime",
+                 *SCATTERING_COLUMNS)
+#: overview.csv: one row per excitation level (`overview_data`)
+OVERVIEW_COLUMNS = ("level", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "resonant_max", "resonant_max_lo",
+                    "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max", "impacts_per_period", "regime",
+                    "a_base_m", "resonant_mean_se", "resonant_max_se", *SCATTERING_COLUMNS)
+
+
+def _scattering_column(column: str) -> str:
+    """The `sim.stepped_sine.measures.SCATTERING_MEASURES` name of a SCATTERING_COLUMNS column."""
+    return "input_power" if column == "input_power_W" else column
+
+
+def sweep_rows(result: SweepResult) -> list[list[Any]]:
+    """The rows of sweep.csv (SWEEP_COLUMNS) of one frequency response."""
+    n = result.eta.size
+    columns = [result.regime_per_eta if name == "regime" else
+               result.scattering.get(_scattering_column(name), [float("nan")] * n) if name in SCATTERING_COLUMNS else
+               getattr(result, name) for name in SWEEP_COLUMNS]
+    return [list(row) for row in zip(*columns)]
+
+
+def overview_data(levels: Sequence[float], results: Sequence[SweepResult]) -> dict[str, list]:
+    """The resonant levels (Sect. 5.3) of one frequency response per excitation level, as lists by key: the
+    OVERVIEW_COLUMNS ("levels" for the column "level"); spreads from `SweepResult.resonant_spread`; the
+    scattering measures at the resonant mean's eta."""
+    spread = {name: [r.resonant_spread(name) for r in results] for name in ("mean", "max")}
+    return {
+        "levels": [float(level) for level in levels],
+        "resonant_mean": [r.resonant_mean for r in results],
+        "resonant_max": [r.resonant_max for r in results],
+        "resonant_mean_lo": [s[0] for s in spread["mean"]],
+        "resonant_mean_hi": [s[1] for s in spread["mean"]],
+        "resonant_max_lo": [s[0] for s in spread["max"]],
+        "resonant_max_hi": [s[1] for s in spread["max"]],
+        "resonant_mean_se": [s[2] for s in spread["mean"]],
+        "resonant_max_se": [s[2] for s in spread["max"]],
+        "a_base_m": [r.a_base for r in results],
+        "eta_resonant_mean": [r.eta_resonant_mean for r in results],
+        "eta_resonant_max": [r.eta_resonant_max for r in results],
+        "regime": [r.regime for r in results],
+        "impacts_per_period": [float(r.impacts_per_period[r.eta == r.eta_resonant_mean][0]) for r in results],
+        **{column: [_at_resonance(r, _scattering_column(column)) for r in results] for column in SCATTERING_COLUMNS},
+    }
+
+
+def _at_resonance(result: SweepResult, name: str) -> float:
+    """A scattering measure of the frequency response at its resonant mean's eta (NaN if it has none)."""
+    values = result.scattering.get(name)
+    return float(values[result.eta == result.eta_resonant_mean][0]) if values is not None else float("nan")
+
+
+def dissipation_key(data: dict[str, list]) -> dict[str, list]:
+    """The JSON key "dissipation" of `ies overview` from `overview_data` (as `sim.stepped_sine.protocol.scattering_keys`)."""
+    return scattering_keys({_scattering_column(column): data[column] for column in SCATTERING_COLUMNS})["dissipation"]
+
+
+def overview_rows(data: dict[str, list]) -> list[list[Any]]:
+    """The rows of overview.csv (OVERVIEW_COLUMNS) of `overview_data`."""
+    return [list(row) for row in zip(*(data["levels" if name == "level" else name] for name in OVERVIEW_COLUMNS))]
+
+
+def overview_text(data: dict[str, list]) -> str:
+    """The table `ies overview` prints: resonant mean and max per level, where they occur, impacts, regime."""
+    lines = [f"{'level':>7} {'res.mean':>9} {'res.max':>9} {'eta(mean)':>9} {'imp/T':>6}  regime"]
+    for i, level in enumerate(data["levels"]):
+        lines.append(f"{level:7.3f} {data['resonant_mean'][i]:9.4f} {data['resonant_max'][i]:9.4f} "
+                     f"{data['eta_resonant_mean'][i]:9.4f} {data['impacts_per_period'][i]:6.2f}  {data['regime'][i]}")
+    return "\n".join(lines)
+
+
+def scattering_text(data: dict[str, list]) -> str:
+    """Per level, at the resonant eta: all and significant impacts per period, r from the tip and from the wall,
+    the energy share of modes 2..N after impacts and the dissipation shares (Sect. 5.5, Appendix D)."""
+    lines = [f"{'level':>7} {'imp/T':>6} {'sig/T':>6} {'r_tip':>6} {'r_wall':>6} {'E2..N':>6} {'D_1':>6} {'D_2..N':>6}  regime"]
+    for i, level in enumerate(data["levels"]):
+        lines.append(f"{level:7.3f} {data['impacts_per_period'][i]:6.2f} {data['significant_impacts_per_period'][i]:6.2f} "
+                     f"{data['restitution'][i]:6.3f} {data['restitution_wall'][i]:6.3f} "
+                     f"{data['higher_mode_energy_share'][i]:6.3f} {data['dissipation_fundamental'][i]:6.3f} "
+                     f"{data['dissipation_higher_modes'][i]:6.3f}  {data['regime'][i]}")
+    return "\n".join(lines)
+
+
+def series_text(series: list[tuple[str, dict[str, list]]]) -> str:
+    """Figs. 11 and C.1's table: per level, the resonant mean of each value of the series, and the shares (%) of the
+    input dissipated in the contact, by friction, in mode 1 and in modes 2..N at the resonant eta (Sect. 5.5)."""
+    width = 28
+    head = f"{'level':>7} " + " ".join(f"{label:>{width}}" for label, _ in series)
+    lines = [head, f"{'':>7} " + " ".join(f"{'mean cont/fric/D_1/D_2..N':>{width}}" for _ in series)]
+    for level in series[0][1]["levels"]:
+        cells = []
+        for _, data in series:
+            if level not in data["levels"]:
+                cells.append(f"{'-':>{width}}")
+                continue
+            at = data["levels"].index(level)
+            shares = "/".join(f"{100 * data[key][at]:.1f}" for key in ("dissipation_contact", "dissipation_friction",
+                                                                        "dissipation_fundamental", "dissipation_higher_modes"))
+            cells.append(f"{data['resonant_mean'][at]:.3f} {shares}%")
+        lines.append(f"{level:7.3f} " + " ".join(f"{c:>{width}}" for c in cells))
+    return "\n".join(lines)
+
+
+def optimum_line(data: dict[str, list]) -> str:
+    """Where the resonant mean level is lowest (the optimum, Sect. 5.3) and the reductions there, 1 / level (the
+    levels are normalised by the linear resonant amplitude a_noabs* at the same excitation)."""
+    i = min(range(len(data["levels"])), key=lambda k: data["resonant_mean"][k])
+    return (f"optimum: a_base/a_base* = {data['levels'][i]:g} ({data['regime'][i]}), resonant mean "
+            f"{data['resonant_mean'][i]:.4f} and max {data['resonant_max'][i]:.4f} of a_noabs*: reduced "
+            f"{1 / data['resonant_mean'][i]:.0f}x (mean) and {1 / data['resonant_max'][i]:.0f}x (max); the paper: "
+            f"{PAPER_OPTIMUM_LEVEL:g}, {PAPER_REDUCTION_MEAN:.0f}x and {PAPER_REDUCTION_MAX:.0f}x")
