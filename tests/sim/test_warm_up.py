@@ -23,7 +23,7 @@ def test_a_slow_warm_up_says_that_it_compiles_while_it_happens(monkeypatch):
         said_during.append(stream.getvalue())
 
     monkeypatch.setattr(integrators, "NOTICE_AFTER_S", 0.1)
-    monkeypatch.setattr(integrators, "_run_tiny_system", slow_compile)
+    monkeypatch.setattr(integrators, "_run_tiny_system", lambda run_step, damped: slow_compile(run_step))
     assert integrators.warm_up("exact", stream=stream) >= 0.5
     assert said_during == ["compiling the exact integrator's kernels (first run only, about "
                            f"{integrators.COMPILE_MINUTES['exact']} min) ...\n"]
@@ -34,7 +34,7 @@ def test_a_slow_warm_up_says_that_it_compiles_while_it_happens(monkeypatch):
 def test_a_quick_warm_up_is_silent(monkeypatch):
     stream = io.StringIO()
     calls = []
-    monkeypatch.setattr(integrators, "_run_tiny_system", calls.append)
+    monkeypatch.setattr(integrators, "_run_tiny_system", lambda run_step, damped: calls.append(run_step))
     integrators.warm_up("ode3", stream=stream)
     assert stream.getvalue() == "" and len(calls) == 1
 
@@ -45,8 +45,8 @@ def test_the_tiny_system_impacts(name):
     record = {}
     run_step = integrators.get_integrator(name)
 
-    def counting(y, n, Omega, a_base, sys, rec):
-        record["out"] = run_step(y, n, Omega, a_base, sys, rec)
+    def counting(y, n, Omega, a_base, sys, rec, **options):
+        record["out"] = run_step(y, n, Omega, a_base, sys, rec, **options)
         return record["out"]
 
     integrators._run_tiny_system(counting)
@@ -59,3 +59,48 @@ def test_an_unknown_integrator_is_refused_before_anything_runs():
 
     with pytest.raises(SimulationInputError, match="unknown integrator 'rk4'"):
         integrators.warm_up("rk4")
+
+
+NEW_SIGNATURES = """
+import importlib, sys
+from sim.integration import integrators, jit
+from sim.hosts.rig import seed_rig_model
+from sim.model.contact_law import ContactLaw
+from sim.model.system import Impactor
+from sim.stepped_sine.protocol import SteppedSine, run_sweep
+
+name, damped = sys.argv[1], sys.argv[2] == "damped"
+
+def signatures():
+    found = {}
+    for stem in jit.KERNEL_MODULES + ("energy",):
+        for attr, obj in vars(importlib.import_module(f"sim.integration.{stem}")).items():
+            if hasattr(obj, "signatures") and hasattr(obj, "py_func"):
+                found[f"{stem}.{attr}"] = set(obj.signatures)
+    return found
+
+integrators.warm_up(name, damped=damped)
+before = signatures()
+law = ContactLaw("hertz-damped", 0.95) if damped else ContactLaw()
+protocol = SteppedSine(eta_start=0.99, eta_stop=1.0, n_eta=2, wait=0.03, hold=0.03, integrator=name)
+run = run_sweep(seed_rig_model(), Impactor(contact_law=law), 7.4, protocol, seed=3, rep=0)
+assert run.impacts_per_period.sum() > 0  # the hold reached the contact kernels
+after = signatures()
+print(sorted(k for k in after if after[k] - before.get(k, set())))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, law", [("exact", "elastic"), ("ode3", "elastic"), ("exact", "damped")])
+def test_after_the_warm_up_a_stepped_sine_run_compiles_nothing_more(name, law):
+    """Issue 25: workers load every kernel from the cache and never compile. A real stepped-sine run (lead-in,
+    wait, hold with the energy ledger) in a fresh process after `warm_up` adds no specialisation to any kernel."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    done = subprocess.run([sys.executable, "-c", NEW_SIGNATURES, name, law], cwd=root, capture_output=True,
+                          text=True, timeout=1200)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip().splitlines()[-1] == "[]"

@@ -1,0 +1,58 @@
+"""Sphere materials for the design of an IES (`ies design`): density, Young's modulus and Poisson's ratio, the
+sphere's mass from its radius and its Hertz constant against the host's steel wall (seed paper Eq. 8).
+
+Values are handbook values at room temperature (ASM Handbook vol. 2 and MatWeb for the alloys named): brass is the
+free-cutting brass CuZn39Pb3 (CW614N / C38500) of turned balls, with the seed paper's E = 102 GPa (Table 1; handbooks
+give 97-105 GPa); steel is AISI 52100 bearing steel of commercial balls; tungsten is a sintered tungsten heavy alloy
+(W-Ni-Fe, 95 % W) that balls are made of, not pure tungsten (19.3 g/cm^3, 411 GPa, too brittle to make balls from).
+The paper's brass sphere of radius 7.92 mm weighs 17.7 g (Table 1); 8470 kg/m^3 gives 17.6 g.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from sim.common.errors import SimulationInputError
+
+
+@dataclass(frozen=True)
+class SphereMaterial:
+    """An isotropic sphere material: density (kg/m^3), E (Pa), nu (-), and what it is."""
+
+    name: str
+    density: float
+    E: float
+    nu: float
+    what: str
+
+
+MATERIALS: dict[str, SphereMaterial] = {m.name: m for m in (
+    SphereMaterial("brass", 8470.0, 102e9, 0.30, "free-cutting brass CuZn39Pb3 (the seed paper's sphere, Table 1)"),
+    SphereMaterial("steel", 7810.0, 207e9, 0.30, "bearing steel AISI 52100 (E as the paper's host, Table 1)"),
+    SphereMaterial("tungsten", 18000.0, 360e9, 0.29, "tungsten heavy alloy W-Ni-Fe, 95 % W"),
+)}
+#: the host's wall: the rig's steel (Table 1)
+HOST_E, HOST_NU = 207e9, 0.30
+
+
+def material(name: str) -> SphereMaterial:
+    """The sphere material called `name` (one line naming the known ones otherwise)."""
+    try:
+        return MATERIALS[name.strip().lower()]
+    except KeyError:
+        raise SimulationInputError(f"unknown sphere material {name!r}; choose one of {', '.join(MATERIALS)}") from None
+
+
+def sphere_mass(radius: float, mat: SphereMaterial) -> float:
+    """Mass (kg) of a solid sphere of `radius` (m): (4/3) pi R^3 rho."""
+    return 4.0 / 3.0 * math.pi * radius**3 * mat.density
+
+
+def contact_modulus(mat: SphereMaterial, host_E: float = HOST_E, host_nu: float = HOST_NU) -> float:
+    """E* = [(1 - nu_s^2)/E_s + (1 - nu_h^2)/E_h]^-1 in Pa, sphere on the host's wall (the bracket of Eq. 8)."""
+    return 1.0 / ((1.0 - mat.nu**2) / mat.E + (1.0 - host_nu**2) / host_E)
+
+
+def hertz_constant(radius: float, mat: SphereMaterial) -> float:
+    """k_H of a sphere of `radius` (m) on the host's flat steel wall, Eq. 8: (4/3) sqrt(R) E*, in N/m^1.5."""
+    return 4.0 / 3.0 * math.sqrt(radius) * contact_modulus(mat)
