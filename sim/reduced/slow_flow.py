@@ -79,10 +79,17 @@ from sim.errors import SimulationInputError
 from sim.measures import APR, LINEAR, SMR
 from sim.system import Impactor, ModalModel, Nominal
 
-#: Amplitude grid of the SIM used to locate the fold and to invert (7): A^_w from A^_min to A^_min * SPAN,
-#: log-spaced; SPAN covers wall amplitudes far above any level of the paper (A^_w ~ 4 at a_base/a_base* = 10).
+#: Amplitude grid of the SIM used to locate the fold and to invert (7): A^_w from A^_min to at least
+#: _GRID_TOP (and A^_min * _GRID_SPAN), log-spaced: far above any level of the paper (A^_w ~ 4 at a_base/a_base* = 10).
 _GRID_POINTS = 1200
 _GRID_SPAN = 2000.0
+_GRID_TOP = 50.0
+
+
+def _sim_grid(r: float, eps: float, n: int = _GRID_POINTS) -> np.ndarray:
+    """Log-spaced wall amplitudes / g on the SIM (Eq. 4), from just above its end."""
+    A_min = float(sim_min_amplitude(r, eps))
+    return np.geomspace(A_min * (1.0 + 1e-9), max(A_min * _GRID_SPAN, _GRID_TOP), n)
 
 
 @dataclass(frozen=True)
@@ -265,7 +272,7 @@ class FoldCurve:
 def fold_curve(eps: float, r: float, D: float, coupling: float,
                eta_range: tuple[float, float] | None = None, n: int = _GRID_POINTS) -> FoldCurve:
     """Eq. 9: the smallest base ratio b over eta for each wall amplitude on the SIM (log grid from A^_min)."""
-    A = sim_min_amplitude(r, eps) * np.geomspace(1.0 + 1e-9, _GRID_SPAN, n)
+    A = _sim_grid(r, eps, n)
     C1 = impact_stiffness(A, r, eps)
     eta = _best_eta(C1, D, eta_range)
     return FoldCurve(A, base_ratio(A, eta, eps, r, D, coupling), eta)
@@ -356,7 +363,7 @@ def periodic_orbits(model: SlowFlowModel, level: float, eta: float) -> list[TwoI
         raise SimulationInputError(f"slow flow: level and eta must be positive, got {level!r}, {eta!r}")
     h = model.host
     b_target = level * model.a_base_star / model.g
-    A = sim_min_amplitude(model.r, model.eps) * np.geomspace(1.0 + 1e-9, _GRID_SPAN, _GRID_POINTS)
+    A = _sim_grid(model.r, model.eps)
 
     def f(x: float | np.ndarray) -> float | np.ndarray:
         return base_ratio(x, eta, model.eps, model.r, h.D, h.coupling) - b_target
