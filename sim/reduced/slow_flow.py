@@ -84,6 +84,8 @@ from sim.system import Impactor, ModalModel, Nominal
 _GRID_POINTS = 1200
 _GRID_SPAN = 2000.0
 _GRID_TOP = 50.0
+#: The paper's starred values (D*, g*) that define a_base* (Sect. 5.3) unless a model says otherwise.
+NOMINAL = Nominal()
 
 
 def _sim_grid(r: float, eps: float, n: int = _GRID_POINTS) -> np.ndarray:
@@ -137,7 +139,7 @@ class SlowFlowModel:
     m_a: float
     g: float
     r: float
-    nominal: Nominal = Nominal()
+    nominal: Nominal = NOMINAL
 
     def __post_init__(self) -> None:
         for name, label in (("m_a", "sphere mass m_a (kg)"), ("g", "clearance g (m)")):
@@ -161,7 +163,7 @@ class SlowFlowModel:
         return np.asarray(b) * self.g / self.a_base_star
 
 
-def slow_flow_model(model: ModalModel, impactor: Impactor, r: float, nominal: Nominal = Nominal()) -> SlowFlowModel:
+def slow_flow_model(model: ModalModel, impactor: Impactor, r: float, nominal: Nominal = NOMINAL) -> SlowFlowModel:
     """The slow-flow inputs of a modal model and an impactor (its mass and clearance; k_H does not enter: rigid
     walls) with the modal restitution r (Eq. D.1, e.g. the simulator's `restitution_wall`)."""
     return SlowFlowModel(host_mode(model), float(impactor.mass), float(impactor.clearance), float(r), nominal)
@@ -494,10 +496,34 @@ def screen(host: HostMode, clearances: np.ndarray, masses: np.ndarray, a_base: n
     return Screening(tip=tip, regime=regime, two_impact_stable=stable, switch_a_base=switch)
 
 
-__all__ = ["ExactOrbit", "FoldCurve", "HostMode", "Screening", "SlowFlowModel", "SwitchPrediction", "TwoImpactOrbit", "apr_branch",
-           "base_ratio", "check_restitution", "effective_factor", "fast_multipliers", "fast_stability_limit", "fast_stable",
-           "exact_orbit", "fold_curve", "host_mode", "impact_stiffness", "periodic_orbits", "restitution_factor", "screen",
-           "sim_min_amplitude", "sim_phase", "slow_flow_model", "sphere_mass", "switch_level"]
+__all__ = [
+    "ExactOrbit",
+    "FoldCurve",
+    "HostMode",
+    "Screening",
+    "SlowFlowModel",
+    "SwitchPrediction",
+    "TwoImpactOrbit",
+    "apr_branch",
+    "base_ratio",
+    "check_restitution",
+    "effective_factor",
+    "exact_orbit",
+    "fast_multipliers",
+    "fast_stability_limit",
+    "fast_stable",
+    "fold_curve",
+    "host_mode",
+    "impact_stiffness",
+    "periodic_orbits",
+    "restitution_factor",
+    "screen",
+    "sim_min_amplitude",
+    "sim_phase",
+    "slow_flow_model",
+    "sphere_mass",
+    "switch_level",
+]
 
 
 # --- The exact symmetric orbit of the one-mode Newton model (the slow flow's reference) ---------------------
@@ -555,8 +581,8 @@ def exact_orbit(model: SlowFlowModel, level: float, eta: float, guess: TwoImpact
     b = level * model.a_base_star / g
     T = 2.0 * math.pi / eta
     Xp = h.coupling * eta**2 * b / (1.0 - eta**2 + 2j * h.D * eta)
-    wall = lambda x, tau: x + b * np.cos(eta * tau)  # noqa: E731
-    wall_v = lambda v, tau: v - b * eta * np.sin(eta * tau)  # noqa: E731
+    wall = lambda x, tau: x + b * np.cos(eta * tau)
+    wall_v = lambda v, tau: v - b * eta * np.sin(eta * tau)
 
     def residual(z: np.ndarray) -> np.ndarray:
         x0, v0, V, tau0 = z
@@ -570,7 +596,7 @@ def exact_orbit(model: SlowFlowModel, level: float, eta: float, guess: TwoImpact
     a = a_w - b
     x0 = float((a * np.exp(1j * eta * tau0)).real)
     v0 = float((1j * eta * a * np.exp(1j * eta * tau0)).real)
-    z, info, ok, _ = fsolve(residual, [x0, v0, guess.sphere_speed / (h.omega * g), tau0], full_output=True,
+    z, _info, _ok, _ = fsolve(residual, [x0, v0, guess.sphere_speed / (h.omega * g), tau0], full_output=True,
                             xtol=1e-13)
     x0, v0, V, tau0 = z
     tau = tau0 + np.linspace(0.0, T / 2.0, 4001)

@@ -10,9 +10,22 @@ from scipy.optimize import brentq
 
 from sim.errors import SimulationInputError
 from sim.measures import APR, LINEAR, SMR
-from sim.reduced.slow_flow import (SlowFlowModel, apr_branch, exact_orbit, fast_multipliers, fast_stability_limit,
-                                   fold_curve, host_mode, periodic_orbits, restitution_factor, screen,
-                                   sim_min_amplitude, sim_phase, slow_flow_model, switch_level)
+from sim.reduced.slow_flow import (
+    SlowFlowModel,
+    apr_branch,
+    exact_orbit,
+    fast_multipliers,
+    fast_stability_limit,
+    fold_curve,
+    host_mode,
+    periodic_orbits,
+    restitution_factor,
+    screen,
+    sim_min_amplitude,
+    sim_phase,
+    slow_flow_model,
+    switch_level,
+)
 from sim.rig import seed_rig_model
 from sim.system import Impactor
 
@@ -132,7 +145,7 @@ def test_slow_flow_matches_the_exact_orbit_at_the_rig_mass_ratio(host):
 
 def test_energy_loss_per_period_matches_the_direct_simulation(rig_orbit):
     """Eq. 8 against the energy the direct simulation's impacts dissipate over its last 20 periods (within 1 %)."""
-    model, orbit, impacts, pieces, T, n, eta = rig_orbit
+    model, orbit, impacts, _pieces, T, n, _eta = rig_orbit
     last = impacts[impacts[:, 0] > (n - 20) * T]
     lost = last[:, 2].sum() / 20 * model.m_a * (model.host.omega * G) ** 2  # J per period
     assert lost == pytest.approx(orbit.energy_loss, rel=1e-2)
