@@ -15,10 +15,12 @@ import json
 import math
 import os
 import time
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
+from sim.contact_law import ContactLaw
 from sim.protocol import SteppedSine, sweep
 from sim.reduced.slow_flow import SlowFlowModel, apr_branch, host_mode, switch_level
 from sim.rig import seed_rig_model
@@ -29,13 +31,22 @@ pytestmark = pytest.mark.benchmark
 LEVELS = np.arange(2.0, 9.01, 0.5)
 STEP = 0.5
 DESIGNS = {"rig": (1.0, 1.0), "g*/2": (0.5, 1.0), "2 g*": (2.0, 1.0), "m_a/2": (1.0, 0.5), "2 m_a": (1.0, 2.0)}
+#: Diagnostic row, not part of the check: the rig's mode 1 alone with the damped contact law (Eq. 10,
+#: r_cont = 0.86), the full simulator's closest analogue of the slow flow's one-mode Newton model.
+ONE_MODE_R_CONT = 0.86
 PROTOCOL = SteppedSine(eta_start=0.96, eta_stop=1.0, n_eta=21, sequence="up", wait=3.0, hold=5.0,
                        perturbation=5e-4, repetition="run", integrator="exact", start="base-velocity")
 
 
-def simulated(model, g, m_a):
+def one_mode(model):
+    return replace(model, **{name: getattr(model, name)[:1] for name in (
+        "frequencies_hz", "damping_ratios", "phi_wall_left", "phi_wall_right", "phi_tip", "participation")},
+        phi_floor=None, source="rig mode 1")
+
+
+def simulated(model, g, m_a, law):
     nominal = Nominal(clearance=g)
-    results = [sweep(model, Impactor(mass=m_a, clearance=g), float(level), PROTOCOL, reps=1, seed=2024,
+    results = [sweep(model, Impactor(mass=m_a, clearance=g, contact_law=law), float(level), PROTOCOL, reps=1, seed=2024,
                      nominal=nominal, progress=False) for level in LEVELS]
     marks = landmarks(results)
     r_values = []
@@ -51,10 +62,12 @@ def test_predicted_switch_within_one_grid_level_of_the_simulated_one():
     model = seed_rig_model()
     host = host_mode(model)
     rows = []
-    for name, (g_factor, m_factor) in DESIGNS.items():
+    cases = [(name, g_f, m_f, model, ContactLaw()) for name, (g_f, m_f) in DESIGNS.items()]
+    cases.append(("1 mode", 1.0, 1.0, one_mode(model), ContactLaw("hertz-damped", ONE_MODE_R_CONT)))
+    for name, g_factor, m_factor, host_model, law in cases:
         g, m_a = g_factor * CLEARANCE_NOMINAL, m_factor * SPHERE_MASS
         started = time.perf_counter()
-        marks, r = simulated(model, g, m_a)
+        marks, r = simulated(host_model, g, m_a, law)
         flow = SlowFlowModel(host, m_a, g, r, Nominal(clearance=g))
         predicted = switch_level(flow, (0.96, 1.0)).level
         lo = marks.last_smr if marks.last_smr is not None else LEVELS[0] - STEP
@@ -75,4 +88,5 @@ def test_predicted_switch_within_one_grid_level_of_the_simulated_one():
     if out:
         with open(out, "w") as f:
             json.dump(rows, f, indent=1)
-    assert all(row["agree"] for row in rows), [row["design"] for row in rows if not row["agree"]]
+    failed = [row["design"] for row in rows if not row["agree"] and row["design"] in DESIGNS]
+    assert not failed, failed
