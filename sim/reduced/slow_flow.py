@@ -75,9 +75,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from sim.errors import SimulationInputError
-from sim.measures import APR, LINEAR, SMR
-from sim.system import Impactor, ModalModel, Nominal
+from sim.common.errors import SimulationInputError
+from sim.stepped_sine.measures import APR, LINEAR, SMR
+from sim.model.system import Impactor, ModalModel, Nominal
 
 #: Amplitude grid of the SIM used to locate the fold and to invert (7): A^_w from A^_min to at least
 #: _GRID_TOP (and A^_min * _GRID_SPAN), log-spaced: far above any level of the paper (A^_w ~ 4 at a_base/a_base* = 10).

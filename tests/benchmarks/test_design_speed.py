@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from sim.reduced.slow_flow import host_mode, screen, sphere_mass
-from sim.rig import seed_rig_model
+from sim.hosts.rig import seed_rig_model
 
 pytestmark = pytest.mark.benchmark
 TARGET_S = 2.0

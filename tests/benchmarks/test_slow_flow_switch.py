@@ -1,5 +1,5 @@
 """Check (c) of issue 28: the slow flow's predicted SMR -> APR switch (`sim.reduced.slow_flow.switch_level`,
-Eq. 9) against the full simulator's (`sim.protocol.sweep`, landmarks of `sim.variants`) on five designs: the
+Eq. 9) against the full simulator's (`sim.stepped_sine.protocol.sweep`, landmarks of `sim.hosts.variants`) on five designs: the
 paper's rig at g*, 0.5 g*, 2 g*, and a sphere half and twice as heavy (same k_H, Eq. 4 contact).
 
 Protocol as the fidelity studies (uq/studies/fidelity/baseline.toml): eta 0.96:1.0:21 up, 3 s wait, 5 s hold,
@@ -20,12 +20,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from sim.contact_law import ContactLaw
-from sim.protocol import SteppedSine, sweep
+from sim.model.contact_law import ContactLaw
+from sim.stepped_sine.protocol import SteppedSine, sweep
 from sim.reduced.slow_flow import SlowFlowModel, apr_branch, host_mode, switch_level
-from sim.rig import seed_rig_model
-from sim.system import CLEARANCE_NOMINAL, SPHERE_MASS, Impactor, Nominal
-from sim.variants import landmarks
+from sim.hosts.rig import seed_rig_model
+from sim.model.system import CLEARANCE_NOMINAL, SPHERE_MASS, Impactor, Nominal
+from sim.hosts.variants import landmarks
 
 pytestmark = pytest.mark.benchmark
 LEVELS = np.arange(2.0, 9.01, 0.5)

@@ -8,8 +8,8 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from sim.errors import SimulationInputError
-from sim.measures import APR, LINEAR, SMR
+from sim.common.errors import SimulationInputError
+from sim.stepped_sine.measures import APR, LINEAR, SMR
 from sim.reduced.slow_flow import (
     SlowFlowModel,
     apr_branch,
@@ -26,8 +26,8 @@ from sim.reduced.slow_flow import (
     slow_flow_model,
     switch_level,
 )
-from sim.rig import seed_rig_model
-from sim.system import Impactor
+from sim.hosts.rig import seed_rig_model
+from sim.model.system import Impactor
 
 G = 0.58e-3
 
