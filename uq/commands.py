@@ -27,9 +27,10 @@ import argparse
 import functools
 import os
 import sys
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from sim.common.options import figure_formats, level_list, positive_int
 
@@ -62,7 +63,8 @@ def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
                                                 ("response", RESPONSE_HELP, add_response_arguments, response_command),
                                                 ("reproduce", REPRODUCE_HELP, add_reproduce_arguments, reproduce),
                                                 ("plot", PLOT_HELP, add_plot_arguments, plot_command),
-                                                ("compare", COMPARE_HELP, add_compare_arguments, compare_command)):
+                                                ("compare", COMPARE_HELP, add_compare_arguments, compare_command),
+                                                ("design", DESIGN_HELP, add_design_arguments, design_command)):
         parser = subparsers.add_parser(name, help=help_text, description=help_text)
         add_arguments(parser)
         parser.set_defaults(_run=run)
@@ -184,14 +186,13 @@ def print_response_result(folder: Path, name: str) -> None:
     scattering measures at the resonant eta."""
     import json
 
-    from sim.stepped_sine.tables import optimum_line, overview_text, scattering_text
-
     from sim.hosts.variants import switch_line
+    from sim.stepped_sine.tables import optimum_line, overview_text, scattering_text
 
     data = json.loads((folder / "study.json").read_text())
     if "series_folders" in data:
-        from uq.figures import series_overviews
         from sim.stepped_sine.tables import series_text
+        from uq.figures import series_overviews
 
         print(f"{name}: resonant mean (a / a_noabs*) and the input's dissipation shares at the resonant eta "
               f"(contact / friction / mode 1 / modes 2..N) for each value:")
@@ -395,10 +396,16 @@ def add_compare_arguments(parser: argparse.ArgumentParser) -> None:
 def compare_command(args: argparse.Namespace) -> int:
     """`ies compare`: every folder is read and checked before anything is written (`uq.compare`)."""
     from sim.common.errors import SimulationInputError
-    from sim.plots.figures import plot_series
     from sim.common.files import dumps, report_written, write_csv, write_text
+    from sim.plots.figures import plot_series
     from sim.plots.redraw import style
-    from uq.compare import COMPARE_COLUMNS, PAPER_ROW, compare_row, compare_text, read_response_folder
+    from uq.compare import (
+        COMPARE_COLUMNS,
+        PAPER_ROW,
+        compare_row,
+        compare_text,
+        read_response_folder,
+    )
 
     studies = [read_response_folder(folder) for folder in args.folders]
     rows = [compare_row(study) for study in studies]
@@ -417,4 +424,111 @@ def compare_command(args: argparse.Namespace) -> int:
             written.append(path)
     print(dumps({"studies": rows, "paper": PAPER_ROW}) if args.json else compare_text(rows))
     report_written(written, json_mode=args.json)
+    return 0
+
+
+# ---- ies design ---------------------------------------------------------------------------------------------------
+
+DESIGN_HELP = ("choose the clearance and the sphere (radius, material) for a host structure: the worst case of the "
+               "resonant tip amplitude over an excitation range and the uncertain D, clearance and k_H, screened by "
+               "the slow flow and verified by stepped-sine simulation (uq.design)")
+#: option -> (key in a design study file's [design] table, default)
+DESIGN_OPTIONS = {"excitation": None, "clearance": "0.3mm:1.2mm:10", "radius": "7.92mm", "material": "brass",
+                  "model": None, "objective": "mean", "damping": None, "clearance_tolerance": None,
+                  "k_H_factor": None, "candidates": 5, "reps": 3, "restitution": None, "baseline": None,
+                  "block_width": None, "min_wall": None, "output": "ies-out/design"}
+
+
+def add_design_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("study", nargs="?", type=Path, metavar="STUDY.toml",
+                        help="a design study file ([study] kind = \"design\", [design] with the options below as keys); "
+                             "options given here win")
+    parser.add_argument("--excitation", metavar="RANGE",
+                        help="operating base amplitudes START:STOP[:COUNT] with units (e.g. 0.66um:6.6um:10) or base "
+                             "accelerations (0.5m/s2:2m/s2); required")
+    parser.add_argument("--clearance", metavar="RANGE", help="clearances to consider (default 0.3mm:1.2mm:10)")
+    parser.add_argument("--radius", metavar="RANGE", help="sphere radii (default the paper's 7.92mm)")
+    parser.add_argument("--material", metavar="LIST", help="sphere materials, comma separated: brass, steel, tungsten "
+                                                           "(default brass)")
+    parser.add_argument("--model", metavar="FILE", help="the host as a modal-model file (default: the built-in rig)")
+    parser.add_argument("--objective", choices=("mean", "max"), help="the amplitude whose worst case is minimised: "
+                                                                     "the resonant mean (default) or max")
+    parser.add_argument("--damping", metavar="LOW:HIGH", help="interval of D_1 (default Table 2: 0.00075:0.0009)")
+    parser.add_argument("--clearance-tolerance", metavar="LOW:HIGH",
+                        help="tolerance added to each clearance (default Table 2: 0:0.032mm)")
+    parser.add_argument("--k-H-factor", metavar="LOW:HIGH", help="factor on Eq. 8's k_H (default Table 2: 1:1.518)")
+    parser.add_argument("--candidates", type=positive_int, metavar="N", help="screened designs to verify (default 5)")
+    parser.add_argument("--reps", type=positive_int, metavar="N", help="repetitions per verification run (default 3)")
+    parser.add_argument("--restitution", type=float, metavar="R",
+                        help="modal restitution r (Eq. D.1) of the screening (default 0.86, the simulator's at the rig)")
+    parser.add_argument("--baseline", metavar="G[,R[,MAT]]",
+                        help="a design to verify beside the recommendation, e.g. the paper's 0.58mm,7.92mm,brass")
+    parser.add_argument("--block-width", metavar="LENGTH", help="the host's block across the cavity (default 28mm)")
+    parser.add_argument("--min-wall", metavar="LENGTH", help="thinnest wall left beside the cavity (default 5.5mm)")
+    add_run_arguments(parser)
+
+
+def design_problem(args: argparse.Namespace) -> tuple[Any, Path]:
+    """The design problem and output folder of `ies design`'s options and study file (options win)."""
+    import tomllib
+
+    from uq import design as d
+    from uq.errors import StudyError
+
+    table: dict[str, Any] = {}
+    protocol = dict(d.PROTOCOL)
+    if args.study is not None:
+        try:
+            data = tomllib.loads(args.study.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+            raise StudyError(f"cannot read design study {args.study}: {exc}") from None
+        if data.get("study", {}).get("kind") != "design":
+            raise StudyError(f"{args.study}: [study] kind must be \"design\" for ies design")
+        table = dict(data.get("design", {}))
+        unknown = sorted(set(table) - set(DESIGN_OPTIONS))
+        if unknown:
+            raise StudyError(f"{args.study}: unknown key(s) in [design]: {', '.join(unknown)}; known: "
+                             f"{', '.join(DESIGN_OPTIONS)}")
+        table.setdefault("output", data.get("study", {}).get("output", DESIGN_OPTIONS["output"]))
+        protocol.update(d.protocol_of(data.get("excitation", {}), f"{args.study}: [excitation]"))
+
+    def value(name: str) -> Any:
+        given = getattr(args, name, None)
+        return given if given is not None else table.get(name, DESIGN_OPTIONS[name])
+
+    if value("excitation") is None:
+        raise StudyError("--excitation is required: the operating base amplitudes, e.g. --excitation 0.66um:6.6um:10")
+    problem = d.DesignProblem(excitation=(), clearances=(), radii=(), modal_file=value("model"), protocol=protocol)
+    mode = d.host_mode(d.host_model(problem))
+    materials = tuple(m.strip().lower() for m in str(value("material")).split(",") if m.strip())
+    radii = d.parse_range(value("radius"), "radius", count=4)
+    fields: dict[str, Any] = dict(
+        excitation=d.parse_range(value("excitation"), "excitation", count=10, omega=mode.omega),
+        clearances=d.parse_range(value("clearance"), "clearance", count=10), radii=radii, materials=materials,
+        objective=value("objective"), candidates=int(value("candidates")), repetitions=int(value("reps")))
+    for name, key, quantity in (("damping", "D", None), ("clearance_tolerance", "clearance_tolerance", "clearance"),
+                                ("k_H_factor", "k_H_factor", None)):
+        if value(name) is not None:
+            fields[key] = d.parse_interval(value(name), "--" + name.replace("_", "-"), quantity)
+    for name, key in (("block_width", "block_width"), ("min_wall", "min_wall")):
+        if value(name) is not None:
+            fields[key] = d.parse_range(value(name), "radius", count=1)[0]
+    if value("restitution") is not None:
+        fields["restitution"] = float(value("restitution"))
+    if value("baseline") is not None:
+        fields["baseline"] = d.parse_baseline(value("baseline"), radii, materials)
+    problem = replace(problem, **fields)
+    problem.check()
+    return problem, Path(args.out or value("output"))
+
+
+def design_command(args: argparse.Namespace) -> int:
+    """`ies design`: screen, verify and recommend (uq.design)."""
+    from uq.design import design_table, run_design
+
+    problem, out = design_problem(args)
+    result = run_design(problem, out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
+                        progress=not args.quiet, figures=not args.no_figures)
+    print(design_table(result))
+    print(f"wrote {len(result.files)} files to {result.folder}")
     return 0

@@ -78,7 +78,8 @@ class IESModel:
     #: parameters a study may add to Table 2's (they enter a task's point, and so its key, only when listed):
     #: r_cont,diss of the damped contact law (Eq. 10; listing it implies contact_law = "hertz-damped"), and the
     #: friction coefficient mu and tangential stiffness k_t (N/m) of dry friction at the floor (Appendix C; ode3)
-    optional_parameters = ("r_cont", "friction", "k_t")
+    #: and the sphere's mass m_a (kg; `ies design` varies the sphere)
+    optional_parameters = ("r_cont", "friction", "k_t", "m_a")
     #: the resonant levels, the regime (1 = APR) and the scattering measures of `sim.stepped_sine.measures` at the resonant
     #: mean's eta (Sect. 5.5, Appendix D)
     outputs = ("mean", "max", "apr", *SCATTERING_MEASURES)
@@ -90,8 +91,10 @@ class IESModel:
         """The default of an optional parameter (`optional_parameters`), before the study's table fills it in."""
         from sim.model.contact_law import DEFAULT_R_CONT
         from sim.model.friction import K_T_PAPER, MU_PAPER
+        from sim.model.parameters import SPHERE_MASS
 
-        nominal, unit, label = {"r_cont": (DEFAULT_R_CONT, "-", "r_cont,diss of the damped contact law (Eq. 10)"),
+        nominal, unit, label = {"m_a": (SPHERE_MASS, "kg", "sphere mass m_a (Table 1)"),
+                                "r_cont": (DEFAULT_R_CONT, "-", "r_cont,diss of the damped contact law (Eq. 10)"),
                                 "friction": (MU_PAPER, "-", "friction coefficient mu at the floor (App. C)"),
                                 "k_t": (K_T_PAPER, "N/m", "tangential stiffness k_t at the floor (App. C)")}[name]
         return Parameter(name, nominal, nominal, nominal, unit, label, positive=name != "friction")  # mu = 0: off
@@ -167,7 +170,7 @@ class IESModel:
         from sim.model.friction import K_T_PAPER
         from sim.model.system import SPHERE_MASS, Impactor
 
-        mass = SPHERE_MASS * self.variant.get("sphere_mass_factor", 1.0)
+        mass = params.get("m_a", SPHERE_MASS) * self.variant.get("sphere_mass_factor", 1.0)
         law = (ContactLaw(self.contact_law, params.get("r_cont", DEFAULT_R_CONT)) if self.contact_law != "hertz"
                else ContactLaw())
         return Impactor(mass=mass, clearance=params["g"], k_H=params["k_H"], contact_law=law,
@@ -186,7 +189,7 @@ class IESModel:
         """Compile the integrator's kernels in this process (`sim.integration.integrators.warm_up`; minutes on a first run)."""
         from sim.integration.integrators import warm_up
 
-        warm_up(self._stepped_sine().integrator)
+        warm_up(self._stepped_sine().integrator, damped=self.contact_law == "hertz-damped")
 
     def with_rig(self) -> "IESModel":
         """This model carrying the rig's modal model (built here, used unchanged by every worker)."""
