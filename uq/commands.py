@@ -290,13 +290,17 @@ def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
         studies = [replace(s, protocol={**s.protocol, "integrator": args.integrator}) for s in studies]
     if args.model is not None:
         studies = [replace(s, modal_model=args.model) for s in studies]
-    for s in studies:
-        s.make_model().check()  # bad settings (e.g. an unknown integrator) fail here, before anything is written
+    models = [s.make_model() for s in studies]
+    for model in models:
+        model.check()  # bad settings (e.g. an unknown integrator) fail here, before anything is written
     calibration = None
     if args.calibration is not None:  # a bad file fails here too
         calibration = {"k_H": calibrated_k_H(args.calibration), "source": str(args.calibration)}
     with dask_client(args.scheduler) as client:  # connected once, first: a bad address leaves nothing behind
         check_writable(args.out)
+        for model in models:  # every kernel any study's workers will call, compiled here once, before the first bar
+            if hasattr(model, "warm_up"):
+                model.warm_up()
         return _reproduce(args, figures, studies, client, calibrate, calibration)
 
 
