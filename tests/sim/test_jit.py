@@ -13,6 +13,7 @@ import sim
 from sim.integration import jit
 
 SIM_DIR = Path(sim.__file__).resolve().parent
+KERNEL_DIR = SIM_DIR / "integration"
 
 PROBE_CALLEE = '''
 
@@ -67,20 +68,21 @@ def _set_probe(path: Path, old: str, new: str) -> None:
 def test_an_edit_of_a_callee_file_reaches_the_cached_caller(tmp_path):
     package = tmp_path / "sim"
     shutil.copytree(SIM_DIR, package, ignore=shutil.ignore_patterns("__pycache__"))
-    (package / "flight.py").write_text((package / "flight.py").read_text() + PROBE_CALLEE.format(value=1.0))
-    (package / "exact.py").write_text((package / "exact.py").read_text() + PROBE_CALLER)
+    kernels = package / "integration"
+    (kernels / "flight.py").write_text((kernels / "flight.py").read_text() + PROBE_CALLEE.format(value=1.0))
+    (kernels / "exact.py").write_text((kernels / "exact.py").read_text() + PROBE_CALLER)
     (tmp_path / "plain_callee.py").write_text(PLAIN_CALLEE.format(value=1.0))
     (tmp_path / "plain_caller.py").write_text(PLAIN_CALLER)
-    run_sim = "from sim import exact; print(exact.probe_caller())"
+    run_sim = "from sim.integration import exact; print(exact.probe_caller())"
     run_plain = "import plain_caller; print(plain_caller.probe_caller())"
 
     assert _run(tmp_path, run_sim) == "1.0"
     assert _run(tmp_path, run_plain) == "1.0"
-    cached = list((package / "__pycache__").glob("exact.probe_caller-*.nbi"))
+    cached = list((kernels / "__pycache__").glob("exact.probe_caller-*.nbi"))
     assert cached, "the caller was not cached: the scenario would not test the cache"
     assert _run(tmp_path, run_sim) == "1.0"  # loaded from the cache
 
-    _set_probe(package / "flight.py", "PROBE = 1.0", "PROBE = 2.0")
+    _set_probe(kernels / "flight.py", "PROBE = 1.0", "PROBE = 2.0")
     _set_probe(tmp_path / "plain_callee.py", "PROBE = 1.0", "PROBE = 2.0")
     assert _run(tmp_path, run_sim) == "2.0"
     assert _run(tmp_path, run_plain) == "1.0", (
@@ -89,11 +91,11 @@ def test_an_edit_of_a_callee_file_reaches_the_cached_caller(tmp_path):
 
 def test_every_module_with_kernels_is_fingerprinted():
     """A kernel module missing from KERNEL_MODULES would not invalidate its callers' caches."""
-    with_kernels = {path.stem for path in SIM_DIR.glob("*.py")
+    with_kernels = {path.relative_to(SIM_DIR).with_suffix("").as_posix() for path in SIM_DIR.rglob("*.py")
                     if re.search(r"^@(kernel|njit|numba\.njit)\b", path.read_text(), re.MULTILINE)}
-    assert with_kernels <= set(jit.KERNEL_MODULES)
-    assert all((SIM_DIR / f"{stem}.py").is_file() for stem in jit.KERNEL_MODULES)
-    assert "njit" not in "".join((SIM_DIR / f"{stem}.py").read_text() for stem in jit.KERNEL_MODULES if stem != "jit")
+    assert with_kernels <= {f"integration/{stem}" for stem in jit.KERNEL_MODULES}  # all kernels live in one folder
+    assert all((KERNEL_DIR / f"{stem}.py").is_file() for stem in jit.KERNEL_MODULES)
+    assert "njit" not in "".join((KERNEL_DIR / f"{stem}.py").read_text() for stem in jit.KERNEL_MODULES if stem != "jit")
 
 
 def test_a_folder_that_cannot_be_written_is_left_alone(tmp_path):
