@@ -496,35 +496,6 @@ def screen(host: HostMode, clearances: np.ndarray, masses: np.ndarray, a_base: n
     return Screening(tip=tip, regime=regime, two_impact_stable=stable, switch_a_base=switch)
 
 
-__all__ = [
-    "ExactOrbit",
-    "FoldCurve",
-    "HostMode",
-    "Screening",
-    "SlowFlowModel",
-    "SwitchPrediction",
-    "TwoImpactOrbit",
-    "apr_branch",
-    "base_ratio",
-    "check_restitution",
-    "effective_factor",
-    "exact_orbit",
-    "fast_multipliers",
-    "fast_stability_limit",
-    "fast_stable",
-    "fold_curve",
-    "host_mode",
-    "impact_stiffness",
-    "periodic_orbits",
-    "restitution_factor",
-    "screen",
-    "sim_min_amplitude",
-    "sim_phase",
-    "slow_flow_model",
-    "sphere_mass",
-    "switch_level",
-]
-
 
 # --- The exact symmetric orbit of the one-mode Newton model (the slow flow's reference) ---------------------
 
@@ -634,3 +605,53 @@ def exact_orbit(model: SlowFlowModel, level: float, eta: float, guess: TwoImpact
                       impact_phase=float((eta * tau0) % (2.0 * math.pi)), sphere_speed=float(V * h.omega * g),
                       admissible=bool(np.all(inside)), residual=float(np.max(np.abs(residual(z)))),
                       multipliers=multipliers)
+
+
+# --- Which symmetric two-impact orbits exist and are stable against level and frequency (issue 28) ---------
+
+#: `orbit_map` codes per (level, eta) cell, for the symmetric two-impact orbit of the one-mode Newton model.
+NO_ORBIT, STABLE, SYMMETRY_BREAKING, SADDLE = "none", "stable", "symmetry-breaking", "saddle"
+
+
+@dataclass(frozen=True)
+class OrbitMap:
+    """Existence and stability of the symmetric two-impact 1:1 orbits on a (level, eta) grid (`orbit_map`).
+
+    levels (a_base/a_base*), etas (Omega/omega_1); n_orbits[i, j]: how many exist (Eq. 7); best[i, j]: the code of
+    the most stable one (STABLE, else SYMMETRY_BREAKING: a multiplier of the half-period map below -1, an
+    asymmetric orbit takes over; else SADDLE: a multiplier above +1, the slow flow leaves; NO_ORBIT); normalised
+    [i, j]: the tip level a/a_noabs* of that orbit (NaN where none).
+    """
+
+    levels: np.ndarray
+    etas: np.ndarray
+    n_orbits: np.ndarray
+    best: np.ndarray
+    normalised: np.ndarray
+
+
+def orbit_map(model: SlowFlowModel, levels: np.ndarray, etas: np.ndarray) -> OrbitMap:
+    """Map the symmetric two-impact orbits of the one-mode Newton model over levels x etas: the slow flow finds
+    them (Eq. 7), the exact shooting (`exact_orbit`) decides their stability (multipliers of the half-period map)."""
+    levels, etas = np.asarray(levels, dtype=float), np.asarray(etas, dtype=float)
+    shape = (levels.size, etas.size)
+    n_orbits = np.zeros(shape, dtype=int)
+    best = np.full(shape, NO_ORBIT, dtype=object)
+    normalised = np.full(shape, np.nan)
+    rank = {STABLE: 0, SYMMETRY_BREAKING: 1, SADDLE: 2}
+    for i, level in enumerate(levels):
+        for j, eta in enumerate(etas):
+            orbits = periodic_orbits(model, float(level), float(eta))
+            n_orbits[i, j] = len(orbits)
+            for orbit in orbits:
+                exact = exact_orbit(model, float(level), float(eta), orbit)
+                if not exact.admissible:
+                    continue
+                worst = max(exact.multipliers, key=abs)
+                code = STABLE if exact.stable else (SYMMETRY_BREAKING if worst.real < 0 else SADDLE)
+                if best[i, j] == NO_ORBIT or rank[code] < rank[best[i, j]]:
+                    best[i, j], normalised[i, j] = code, exact.normalised
+    return OrbitMap(levels, etas, n_orbits, best, normalised)
+
+
+__all__ = ["NO_ORBIT", "SADDLE", "STABLE", "SYMMETRY_BREAKING", "ExactOrbit", "FoldCurve", "HostMode", "OrbitMap", "Screening", "SlowFlowModel", "SwitchPrediction", "TwoImpactOrbit", "apr_branch", "base_ratio", "check_restitution", "effective_factor", "exact_orbit", "fast_multipliers", "fast_stability_limit", "fast_stable", "fold_curve", "host_mode", "impact_stiffness", "orbit_map", "periodic_orbits", "restitution_factor", "screen", "sim_min_amplitude", "sim_phase", "slow_flow_model", "sphere_mass", "switch_level"]

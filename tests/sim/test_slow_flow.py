@@ -258,3 +258,17 @@ def test_slow_flow_model_from_the_simulator_objects():
 def test_restitution_outside_the_open_unit_interval_is_refused(host, r):
     with pytest.raises(SimulationInputError, match="restitution r must lie in"):
         SlowFlowModel(host, 0.0177, G, r)
+
+
+def test_orbit_map_codes_match_the_direct_simulations(host):
+    """`orbit_map` on the cells the direct simulations above settle: (4.31, 0.955) stays on the symmetric orbit
+    (test (a)), (4.0, 0.965) breaks its symmetry; no orbit below the fold (3.5) nor above eta = 0.985 (the
+    two-impact orbit lives on the low-frequency side of the resonance)."""
+    from sim.reduced.slow_flow import NO_ORBIT, STABLE, SYMMETRY_BREAKING, orbit_map
+
+    model = SlowFlowModel(host, 0.0177, G, 0.86)
+    result = orbit_map(model, np.array([3.5, 4.0, 4.31]), np.array([0.955, 0.965, 0.99]))
+    assert result.best[2, 0] == STABLE
+    assert result.best[1, 1] == SYMMETRY_BREAKING
+    assert np.all(result.best[0] == NO_ORBIT) and np.all(result.best[:, 2] == NO_ORBIT)
+    assert np.all(result.n_orbits[result.best == NO_ORBIT] == 0)
