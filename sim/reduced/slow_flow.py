@@ -65,8 +65,8 @@ A^ = A/g, tau = omega t, eta = Omega/omega, b = a_base/g.
     breaks its symmetry near it, as the direct simulation confirms.
 
 Accuracy (tests/sim/test_slow_flow.py): against the exact orbit of the one-mode Newton model at the rig's eps
-the slow flow is within 0.15 % in tip amplitude and 0.003 rad in impact phase (without the recoil terms of
-(2)-(4b): 6-7 %); a direct solve_ivp simulation settles on it to 1e-4. Assumed: one mode, rigid walls with a
+the slow flow is within 0.15 % in tip amplitude and 0.003 rad in impact phase (the recoil terms of (2)-(4b)
+matter at that eps); a direct solve_ivp simulation settles on the exact orbit to 1e-4. Assumed: one mode, rigid walls with a
 fixed r (k_H does not enter; the similarity law then makes the response depend on g only through a_base/g),
 first-order averaging in eps and D, no friction, no gravity along x.
 """
