@@ -447,8 +447,9 @@ class Screening:
     switch_a_base: np.ndarray
 
 
-def screen(host: HostMode, clearances: np.ndarray, masses: np.ndarray, a_base: np.ndarray, r: float,
-           eta_range: tuple[float, float] | None = None) -> Screening:
+def screen(host: HostMode, clearances: np.ndarray, masses: np.ndarray | None, a_base: np.ndarray, r: float,
+           eta_range: tuple[float, float] | None = None, *, radii: np.ndarray | None = None,
+           density: float | None = None) -> Screening:
     """Vectorised screening of designs (issue 28, `ies design`): for every clearance g (m), sphere mass m_a (kg)
     and base amplitude a_base (m) the predicted resonant tip amplitude (m) and regime.
 
@@ -456,8 +457,13 @@ def screen(host: HostMode, clearances: np.ndarray, masses: np.ndarray, a_base: n
     response; APR: at or above the switch (Eq. 9), tip of the rising branch at its best eta; SMR: between the
     first impacts and the switch, tip estimated by the orbit at the fold (a rough mean of the relaxation cycle,
     not an average of it). Each mass costs one fold curve; clearances and levels are interpolations on it
-    (the slow flow with rigid walls depends on g and a_base only through b = a_base/g).
+    (the slow flow with rigid walls depends on g and a_base only through b = a_base/g). Give the spheres as
+    masses (kg), or masses=None with radii (m) and density (kg/m^3). eta_range: the stepped sine's eta range.
     """
+    if masses is None:
+        if radii is None or density is None or not (isinstance(density, (int, float)) and density > 0):
+            raise SimulationInputError("screening: give sphere masses (kg), or radii (m) with a positive density (kg/m^3)")
+        masses = sphere_mass(radii, density)
     g = np.asarray(clearances, dtype=float)[:, None, None]
     m = np.asarray(masses, dtype=float)
     L = np.asarray(a_base, dtype=float)[None, None, :]

@@ -243,6 +243,9 @@ def test_switch_is_the_fold_and_screening_agrees_with_the_scalar_path(host):
     result = screen(host, np.array([G]), np.array([0.0177]), a_base, 0.86)
     assert result.switch_a_base[0, 0] == pytest.approx(s.level * model.a_base_star, rel=1e-12)
     assert list(result.regime[0, 0]) == [LINEAR, SMR, APR, APR]
+    radius = (0.0177 / (4 / 3 * np.pi * 8490.0)) ** (1 / 3)
+    by_radius = screen(host, np.array([G]), None, a_base, 0.86, radii=np.array([radius]), density=8490.0)
+    np.testing.assert_allclose(by_radius.tip, result.tip, rtol=1e-9)
     a_noabs = host.phi_tip * host.participation * a_base / (2 * model.nominal.D1)
     assert result.tip[0, 0, 2:] / a_noabs[2:] == pytest.approx(apr_branch(model, levels[2:]), rel=1e-9)
 
