@@ -438,7 +438,8 @@ def sphere_mass(radius: float | np.ndarray, density: float) -> np.ndarray:
 class Screening:
     """Result of `screen`, arrays of shape (n_clearances, n_masses, n_levels): tip (resonant tip amplitude
     relative to the base, m), regime ('linear', 'SMR', 'APR'), two_impact_stable (the APR's two-impact orbit is
-    fast-stable, Eq. 10; False elsewhere); switch_a_base (n_clearances, n_masses): the base amplitude of the
+    fast-stable by the eps -> 0 criterion of Eq. 10, False elsewhere; at eps of a few % the exact orbit breaks
+    its symmetry earlier, `orbit_map`); switch_a_base (n_clearances, n_masses): the base amplitude of the
     switch (m)."""
 
     tip: np.ndarray
