@@ -82,8 +82,8 @@ switch = (last SMR level, first APR level] of `sim.variants.landmarks`; "agrees"
   m_a/2        0.580    8.85    0.892        2.5 -> 3.0        1.84           no       0.666 / 0.699
   2 m_a        0.580   35.4     0.783 (SMR)  none up to 9      12.9           beyond the grid (both > 9)
 
-The fold (9) comes out 0.7-0.8 times the simulated switch on every design that switches (1.1-1.9 levels
-low); it follows the simulator's trends (clearance: weak; lighter sphere: much earlier; heavier: later) and
+The fold (9) comes out at 0.67-0.82 times the middle of the simulated switch interval on every design that
+switches (0.6-2.0 levels low); it follows the simulator's trends (clearance: weak; lighter sphere: much earlier; heavier: later) and
 the almost periodic level within 5-13 %. The simulated switches correspond to the fold at an r 0.02-0.09
 below the measured one (rig: 0.78-0.80). With the paper's r = 0.8 the fold of the rig lies at 5.43 (4.00 at
 the simulator's 0.857): lowering r by that much moves the switch up by 1.4 levels, the size of the gap
