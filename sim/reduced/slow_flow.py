@@ -62,7 +62,11 @@ A^ = A/g, tau = omega t, eta = Omega/omega, b = a_base/g.
     beyond it a multiplier passes -1: the two flights become unequal (symmetry breaking; asymmetric and
     multi-impact orbits take over). At the rig's eps = 3.5 % the exact multipliers (`exact_orbit`) move that
     boundary: the symmetric orbit is stable only below the resonance (eta <= 0.96 at r = 0.86, `orbit_map`) and
-    breaks its symmetry near it, as the direct simulation confirms.
+    breaks its symmetry near it, as the direct simulation confirms. Where the stepped sine's resonant point lies
+    (one run at a_base/a_base* = 7.5, eta 0.96:1.0:21 up): with mode 1 alone the response is almost periodic
+    with 2.0 significant impacts per period for eta = 0.960-0.970 and its resonant maximum at eta = 0.980 has
+    3.7; the rig (9 modes) is almost periodic only at 0.972-0.980, maximum at 0.980 with 4.0. The maximum thus
+    sits beyond the symmetric two-impact orbit's stable range, on a multi-impact branch (issue 28).
 
 Accuracy (tests/sim/test_slow_flow.py): against the exact orbit of the one-mode Newton model at the rig's eps
 the slow flow is within 0.15 % in tip amplitude and 0.003 rad in impact phase (the recoil terms of (2)-(4b)
@@ -81,9 +85,13 @@ switch = (last SMR level, first APR level] of `sim.variants.landmarks`; "agrees"
   2 g*         1.160   17.7     0.830        5.5 -> 6.0        4.67           no       0.321 / 0.347
   m_a/2        0.580    8.85    0.892        2.5 -> 3.0        1.84           no       0.666 / 0.699
   2 m_a        0.580   35.4     0.783 (SMR)  none up to 9      12.9           beyond the grid (both > 9)
+  mode 1 only  0.580   17.7     0.851        6.5 -> 7.0        4.15           no       0.326 / 0.395
+  (the last row is a diagnostic: the rig's mode 1 alone with the damped contact law, r_cont = 0.86)
 
 The fold (9) comes out at 0.67-0.82 times the middle of the simulated switch interval on every design that
-switches (0.6-2.0 levels low); it follows the simulator's trends (clearance: weak; lighter sphere: much earlier; heavier: later) and
+switches (0.6-2.0 levels low; with mode 1 alone 2.6 levels low, so the higher modes are not the cause): the
+fold is where the two-impact orbit starts to exist, a lower bound of the switch, and the stepped sine stays
+strongly modulated above it (the slow flow's boundary of the relaxation cycle is not modelled here); it follows the simulator's trends (clearance: weak; lighter sphere: much earlier; heavier: later) and
 the almost periodic level within 5-13 %. The simulated switches correspond to the fold at an r 0.02-0.09
 below the measured one (rig: 0.78-0.80). With the paper's r = 0.8 the fold of the rig lies at 5.43 (4.00 at
 the simulator's 0.857): lowering r by that much moves the switch up by 1.4 levels, the size of the gap
