@@ -443,7 +443,8 @@ def apr_branch(model: SlowFlowModel, levels: np.ndarray,
     tip = _tip_on_curve(curve, model.eps, model.r, h)
     i = curve.fold
     b = levels * model.a_base_star / model.g
-    A_tip = np.interp(b, curve.b[i:], tip[i:], left=np.nan, right=np.nan)
+    rising = np.maximum.accumulate(curve.b[i:])  # monotone even where eta_range clips the best eta
+    A_tip = np.interp(b, rising, tip[i:], left=np.nan, right=np.nan)
     a_noabs = h.phi_tip * h.participation * levels * model.a_base_star / (2.0 * model.nominal.D1)
     return A_tip * model.g / a_noabs
 
@@ -484,8 +485,9 @@ def screen(host: HostMode, clearances: np.ndarray, masses: np.ndarray | None, a_
 
     linear: the wall's linear resonant amplitude stays below g (no impacts), tip from the mode's frequency
     response; APR: at or above the switch (Eq. 9), tip of the rising branch at its best eta; SMR: between the
-    first impacts and the switch, tip estimated by the orbit at the fold (a rough mean of the relaxation cycle,
-    not an average of it). Each mass costs one fold curve; clearances and levels are interpolations on it
+    first impacts and the switch, tip estimated by the orbit at the fold, a pessimistic stand-in for the
+    relaxation cycle (the rig at a_base/a_base* = 5: simulated resonant mean 0.14 mm, fold orbit 0.35 mm).
+    The switch itself is the fold, a lower bound (module docstring, validity). Each mass costs one fold curve; clearances and levels are interpolations on it
     (the slow flow with rigid walls depends on g and a_base only through b = a_base/g). Give the spheres as
     masses (kg), or masses=None with radii (m) and density (kg/m^3). eta_range: the stepped sine's eta range.
     """
@@ -518,7 +520,7 @@ def screen(host: HostMode, clearances: np.ndarray, masses: np.ndarray | None, a_
         i = curve.fold
         tip_curve = _tip_on_curve(curve, eps, r, host)
         b_fold = curve.b[i]
-        rising_b, rising_tip = curve.b[i:], tip_curve[i:]
+        rising_b, rising_tip = np.maximum.accumulate(curve.b[i:]), tip_curve[i:]
         stable_curve = fast_stable(curve.A[i:], r)
         bj = b[:, 0, :]
         gj = g[:, 0, :]
