@@ -6,10 +6,12 @@ Protocol as the fidelity studies (uq/studies/fidelity/baseline.toml): eta 0.96:1
 base-velocity start, exact integrator, seed 2024, one repetition per level. Levels a_base/a_base* from 2.0 to 9.0
 in steps of 0.5, with a_base* of each design's OWN clearance (Nominal(clearance=g)): the slow flow with rigid
 walls depends on g only through a_base/g, so this is the axis on which designs differ. r: the simulator's Eq. D.1
-value at the wall (`restitution_wall`, median over the resonant points of the APR levels). Agreement: the
+value at the wall (`restitution_wall`, median over the resonant points of the APR levels, of all levels
+when none is APR). Agreement: the
 prediction lies within one grid step (0.5) of the simulated switch interval (last SMR level, first APR level].
 
-Run: pytest -m benchmark tests/benchmarks/test_slow_flow_switch.py -s   (about 5 x 15 sweeps)
+Run: pytest -m benchmark tests/benchmarks/test_slow_flow_switch.py -s   (6 x 15 sweeps; 2-4 min once compiled)
+The measured table is in the docstring of sim/reduced/slow_flow.py (the check fails on four of the five designs).
 """
 import json
 import math
@@ -49,13 +51,16 @@ def simulated(model, g, m_a, law):
     results = [sweep(model, Impactor(mass=m_a, clearance=g, contact_law=law), float(level), PROTOCOL, reps=1, seed=2024,
                      nominal=nominal, progress=False) for level in LEVELS]
     marks = landmarks(results)
-    r_values = []
+    apr, every = [], []
     for result in results:
         k = int(np.argmax(result.mean))
-        if result.regime_per_eta[k] == "APR":
-            r_values.append(result.scattering["restitution_wall"][k])
-    r_values = [r for r in r_values if math.isfinite(r)]
-    return marks, float(np.median(r_values)) if r_values else math.nan
+        value = float(result.scattering["restitution_wall"][k])
+        if math.isfinite(value):
+            every.append(value)
+            if result.regime_per_eta[k] == "APR":
+                apr.append(value)
+    # r of the APR levels; a design that never switches: r of every level's resonant point
+    return marks, float(np.median(apr or every)) if (apr or every) else math.nan
 
 
 def test_predicted_switch_within_one_grid_level_of_the_simulated_one():

@@ -107,7 +107,7 @@ def rig_orbit(host):
 
 def test_a_direct_simulation_reproduces_the_orbit_amplitude_and_impact_phase(rig_orbit):
     """(a) After 400 periods the direct simulation sits on the slow flow's orbit: 2 impacts per period, half a
-    period apart, tip amplitude and left-wall impact phase within 1 % (measured: 0.1 %, 0.06 %)."""
+    period apart, tip amplitude and left-wall impact phase within 1 % (measured: 0.03 %, 0.04 %)."""
     model, orbit, impacts, pieces, T, n, eta = rig_orbit
     exact = exact_orbit(model, orbit.level, eta, orbit)
     assert exact.stable and exact.admissible
@@ -243,6 +243,9 @@ def test_switch_is_the_fold_and_screening_agrees_with_the_scalar_path(host):
     result = screen(host, np.array([G]), np.array([0.0177]), a_base, 0.86)
     assert result.switch_a_base[0, 0] == pytest.approx(s.level * model.a_base_star, rel=1e-12)
     assert list(result.regime[0, 0]) == [LINEAR, SMR, APR, APR]
+    radius = (0.0177 / (4 / 3 * np.pi * 8490.0)) ** (1 / 3)
+    by_radius = screen(host, np.array([G]), None, a_base, 0.86, radii=np.array([radius]), density=8490.0)
+    np.testing.assert_allclose(by_radius.tip, result.tip, rtol=1e-9)
     a_noabs = host.phi_tip * host.participation * a_base / (2 * model.nominal.D1)
     assert result.tip[0, 0, 2:] / a_noabs[2:] == pytest.approx(apr_branch(model, levels[2:]), rel=1e-9)
 
@@ -258,3 +261,17 @@ def test_slow_flow_model_from_the_simulator_objects():
 def test_restitution_outside_the_open_unit_interval_is_refused(host, r):
     with pytest.raises(SimulationInputError, match="restitution r must lie in"):
         SlowFlowModel(host, 0.0177, G, r)
+
+
+def test_orbit_map_codes_match_the_direct_simulations(host):
+    """`orbit_map` on the cells the direct simulations above settle: (4.31, 0.955) stays on the symmetric orbit
+    (test (a)), (4.0, 0.965) breaks its symmetry; no orbit below the fold (3.5) nor above eta = 0.985 (the
+    two-impact orbit lives on the low-frequency side of the resonance)."""
+    from sim.reduced.slow_flow import NO_ORBIT, STABLE, SYMMETRY_BREAKING, orbit_map
+
+    model = SlowFlowModel(host, 0.0177, G, 0.86)
+    result = orbit_map(model, np.array([3.5, 4.0, 4.31]), np.array([0.955, 0.965, 0.99]))
+    assert result.best[2, 0] == STABLE
+    assert result.best[1, 1] == SYMMETRY_BREAKING
+    assert np.all(result.best[0] == NO_ORBIT) and np.all(result.best[:, 2] == NO_ORBIT)
+    assert np.all(result.n_orbits[result.best == NO_ORBIT] == 0)
