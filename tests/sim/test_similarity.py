@@ -8,9 +8,9 @@ mu m_a g_grav does not scale) breaks the law."""
 import numpy as np
 import pytest
 
-from sim.integrators import get_integrator
-from sim.rig import seed_rig_model
-from sim.system import (
+from sim.integration.integrators import get_integrator
+from sim.hosts.rig import seed_rig_model
+from sim.model.system import (
     CLEARANCE_NOMINAL,
     K_H_NOMINAL,
     Impactor,
