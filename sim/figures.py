@@ -35,7 +35,7 @@ ETA_LABEL = r"$\eta = \Omega/\omega^*$"
 N_PER_MM15 = r"N/mm$^{1.5}$"
 MICROMETRE = r"$\mu$m"
 #: the shading of a regime on the level plots (Sect. 5.1, `sim.measures.classify_regime`); SMR levels stay white
-REGIME_SHADING = {"APR": {"facecolor": "0.82", "label": "APR levels (almost periodic response); white: SMR"},
+REGIME_SHADING = {"APR": {"facecolor": "0.9", "label": "APR levels (almost periodic response); white: SMR"},
                   "linear": {"facecolor": "none", "edgecolor": "0.6", "hatch": "..",
                              "label": "linear levels (no impacts)"}}
 

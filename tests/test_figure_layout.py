@@ -241,7 +241,7 @@ def response_folder(folder: Path, figures: tuple[str, ...] = ("fig5", "fig6", "f
                     levels: list[float] = LEVELS, regimes: list[str] = REGIMES) -> Path:
     """A response study's files (study.json, overview.csv, sweeps.csv, runs.csv) as `uq.execute` writes them."""
     folder.mkdir(parents=True, exist_ok=True)
-    study = {"kind": "response", "repetitions": 3, "levels": levels, "response": {"figures": list(figures)},
+    study = {"kind": "response", "model": "ies", "repetitions": 3, "levels": levels, "response": {"figures": list(figures)},
              "contact_law": "hertz", "protocol_resolved": {"wait": 2.0, "hold": 1.0, "integrator": "exact",
                                                             "sequence": "down"}}
     (folder / "study.json").write_text(json.dumps({"study": study, "outputs": ["mean", "max"]}))
@@ -263,9 +263,13 @@ def response_folder(folder: Path, figures: tuple[str, ...] = ("fig5", "fig6", "f
     return folder
 
 
-PARAMETERS = {"D": {"nominal": 0.00085, "unit": "-", "label": "modal damping ratio D"},
-              "g": {"nominal": 0.00058, "unit": "mm", "label": "clearance g"},
-              "k_H": {"nominal": 282e3 * 1e3**1.5, "unit": "N/mm^1.5", "label": "Hertz stiffness k_H"}}
+#: Table 2 (`uq.space.TABLE2`): g and k_H vary upwards from the nominal value, so a corner lies on the nominal curve
+PARAMETERS = {"D": {"nominal": 0.00085, "min": 0.00075, "max": 0.0009, "unit": "-", "label": "modal damping ratio D_1"},
+              "g": {"nominal": 0.00058, "min": 0.00058, "max": 0.000612, "unit": "m", "label": "clearance g"},
+              "k_H": {"nominal": 282e3 * 1e3**1.5, "min": 282e3 * 1e3**1.5, "max": 428e3 * 1e3**1.5,
+                      "unit": "N/m^1.5", "label": "Hertzian spring constant k_H"}}
+#: the response of each parameter's lower and upper corner relative to the nominal one
+CORNER_FACTORS = {"D": (1.15, 0.9), "g": (1.0, 1.06), "k_H": (1.0, 0.94)}
 
 
 def interval_folder(folder: Path, output: str = "mean", levels: list[float] = LEVELS,
@@ -273,7 +277,7 @@ def interval_folder(folder: Path, output: str = "mean", levels: list[float] = LE
     """An interval study's files (study.json, points.csv, bands.csv): individual, joint and residual designs."""
     folder.mkdir(parents=True, exist_ok=True)
     outputs = ["mean", "max"] if output == "mean" else [output]
-    study = {"kind": "interval", "repetitions": 3, "levels": levels, "parameters": PARAMETERS}
+    study = {"kind": "interval", "model": "ies", "repetitions": 3, "levels": levels, "parameters": PARAMETERS}
     (folder / "study.json").write_text(json.dumps({"study": study, "outputs": outputs}))
     points, bands = [], []
     for level, regime in zip(levels, regimes):
@@ -282,14 +286,13 @@ def interval_folder(folder: Path, output: str = "mean", levels: list[float] = LE
             value = {"mean": mean, "max": peak}.get(out, 0.85 + 0.002 * level)
             points.append({"design": "nominal", "point": "nominal", "role": "nominal", "level": level, "output": out,
                            "mean": value, "se": 0.02 * value, "regime": regime})
-            for name, (lo, hi) in (("D", (0.9, 1.15)), ("g", (0.97, 1.0)), ("k_H", (0.95, 1.1))):
+            for name, factors in CORNER_FACTORS.items():
                 design = f"individual:{name}"
-                nominal = PARAMETERS[name]["nominal"]
-                for role_value, factor in ((0.9 * nominal, lo), (1.1 * nominal, hi)):
-                    points.append({"design": design, "point": f"{name}={role_value:.6g}", "role": "corner",
-                                   "level": level, "output": out, "mean": value * factor, "se": 0.02 * value,
-                                   "regime": regime})
-                bands.append(_band_row(design, out, level, value * lo, value * hi, value))
+                for corner, factor in zip(("min", "max"), factors):
+                    points.append({"design": design, "point": f"{name}={PARAMETERS[name][corner]:.6g}",
+                                   "role": "corner", "level": level, "output": out, "mean": value * factor,
+                                   "se": 0.02 * value, "regime": regime})
+                bands.append(_band_row(design, out, level, value * min(factors), value * max(factors), value))
             bands.append(_band_row("joint", out, level, 0.8 * value, 1.25 * value, value))
             bands.append(_band_row("residual", out, level, 0.93 * value, 1.08 * value, value))
     _write(folder / "points.csv", points)

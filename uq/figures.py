@@ -108,7 +108,10 @@ def parameter_text(name: str, value: float, star: bool = False) -> str:
 def parameter_title(name: str, parameter: dict) -> str:
     """A panel title of Fig. 7: the parameter's label and the unit its values are printed in (`parameter_text`)."""
     unit = {"D": "%", "g": "mm", "k_H": N_PER_MM15}.get(name, parameter.get("unit", ""))
-    label = parameter.get("label", name)
+    words, _, symbol = parameter.get("label", name).rpartition(" ")
+    if symbol.split("_")[0] == name.split("_")[0]:  # the label ends in the symbol: typeset it ('k_H' -> $k_H$)
+        symbol = f"${symbol}$"
+    label = f"{words} {symbol}".strip()
     return f"{label} ({unit})" if unit and unit != "-" else label
 
 
@@ -142,8 +145,9 @@ def _band_with_noise(ax: Any, band: dict, color: str, alpha: float, label: str, 
         ax.bar(x, band["upper"] - band["lower"], width, bottom=band["lower"], label=label, **fill)
     else:
         ax.fill_between(x, band["lower"], band["upper"], label=label, **fill)
+    at = x - 0.3 * width if discrete else x  # a box's edge errors off its centre, where the nominal point sits
     for edge in ("lower", "upper"):
-        ax.errorbar(x, band[edge], yerr=np.nan_to_num(band[f"{edge}_se"], nan=0.0), fmt="none",
+        ax.errorbar(at, band[edge], yerr=np.nan_to_num(band[f"{edge}_se"], nan=0.0), fmt="none",
                     ecolor=color, elinewidth=0.8, capsize=2, alpha=0.9)
 
 
@@ -364,7 +368,7 @@ def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list
         ax.set_ylabel("Sobol' index / variance share")
         ax.set_title(f"output: {o}", fontsize=9)
         ax.grid(alpha=0.3, axis="y")
-        legend_beside(ax, title="bars: confidence intervals", ncols=1)
+        legend_beside(ax, title="whiskers: confidence intervals")
     paths = _save(fig, folder, "sobol", options)
     plt.close(fig)
     return paths
@@ -447,14 +451,14 @@ def _series_figure(folder: Path, meta: dict, options: PlotOptions) -> list[Path]
             f"{protocol['integrator']}")
     paper = SERIES_FIGURES.get(figure, ("", None))
     paths = options.paths(folder, figure)
-    series = [(_series_label(sub), data) for sub, data in series_overviews(folder, options)]
+    series = [(series_label(sub), data) for sub, data in series_overviews(folder, options)]
     for path in paths:
         plot_series(series, path, f"Resonant mean for each {name} ({paper[0]}), contact law "
                     f"{meta['study']['contact_law']}, {runs}", paper[1], mm_per_level=_tip_mm_per_level(meta))
     return paths
 
 
-def _series_label(sub: str) -> str:
+def series_label(sub: str) -> str:
     """A series value's legend entry in Table 2's units ('g=0.00058' -> '$g$ = 0.580 mm'); else the folder name."""
     name, _, value = sub.partition("=")
     try:
