@@ -358,7 +358,7 @@ def plot_modal_fit(fit: ModalFit, path: str | os.PathLike, *, t_range: tuple[flo
     kind = Path(path).suffix.lstrip(".").lower() or "png"
     if kind not in FigureCanvasBase.get_supported_filetypes():
         raise SimulationInputError(f"cannot write {path}: unknown figure format '.{kind}'; use .png, .pdf or .svg")
-    unit = "m/s" if velocity_scale is None else r"$\Omega a^{\mathrm{noabs}*}$"
+    unit = "m/s" if velocity_scale is None else r"$\Omega a_\mathrm{noabs}^*$"
     fig, (overview, section) = plt.subplots(2, 1, figsize=(9.5, 6.0), sharey=True, layout="constrained")
     try:
         overview.plot(t, v / scale, color="0.3", lw=0.6)
@@ -380,8 +380,9 @@ def plot_modal_fit(fit: ModalFit, path: str | os.PathLike, *, t_range: tuple[flo
                          lw=1.0, label=None if label in labelled else label)
             labelled.add(label)
         section.set_xlim(lo, hi)
-        overview.set_title("(a) tip velocity and detected impacts")
-        section.set_title("(b) reconstruction from the least-squares fit of Eq. 9")
+        # the titles clear of the impact carets on the top edges
+        overview.set_title("(a) tip velocity and detected impacts", fontsize=10, pad=10)
+        section.set_title("(b) reconstruction from the least-squares fit of Eq. 9", fontsize=10, pad=10)
         for axes in (overview, section):
             axes.set_xlabel("t (s)")
             axes.set_ylabel(f"tip velocity ({unit})")

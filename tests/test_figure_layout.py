@@ -12,9 +12,11 @@ from __future__ import annotations
 
 import csv
 import json
+from collections.abc import Callable
+from itertools import pairwise
 from pathlib import Path
 from types import SimpleNamespace
-from typing import Any, Callable
+from typing import Any
 
 import matplotlib
 
@@ -410,7 +412,7 @@ def draw_modal_fit(tmp: Path) -> None:
             return v
 
     windows = [SimpleNamespace(start=a, stop=b, well_posed=k % 5 != 3) for k, (a, b) in
-               enumerate(zip(impacts[:-1], impacts[1:]))]
+               enumerate(pairwise(impacts))]
     fit = SimpleNamespace(signal=Signal(), impacts=impacts, windows=windows, excitation_hz=114.6,
                           reconstruction=lambda s: np.interp(s, t, v) * 1.02)
     sim.modal_fit.plot_modal_fit(fit, tmp / "fig9b.png", velocity_scale=2 * np.pi * 114.6 * data["a_noabs"])
