@@ -8,6 +8,12 @@ a frequency response has the keys of `sim.protocol.SweepResult.to_dict` (eta, me
 max_lo, max_hi); the resonant levels those of `sim.tables.overview_data` (levels, resonant_mean, ...,
 regime); a time history the columns t, q_tip, v_tip of `sim.trace.COLUMNS` and the keys of
 `sim.trace.trace_data`. Files are written atomically through `sim.files` (format from the suffix).
+
+Every figure of the workbench follows the same layout (checked by tests/test_figure_layout.py): legends beside
+or below the axes (`legend_beside`, `legend_below`), never on data; panels that compare one plot on one y scale;
+the regimes shaded on the level plots (`shade_regimes`); the tip amplitude in mm on a right-hand axis where one
+level is shown (`secondary_mm`) and as Eq. B.1's stated factor on the level plots (`tip_note`); symbols and
+units in mathtext; colours from the style's cycle (C0, C1, ...), so that a grayscale style greys everything.
 """
 from __future__ import annotations
 
