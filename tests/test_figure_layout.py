@@ -110,9 +110,9 @@ def _data_artists(ax: Any) -> list[Any]:
 
 
 def layout_problems(fig: Any) -> list[str]:
-    """What is wrong with a figure's layout: legends on data or on each other, legends set below 7 pt, panels of
-    the same plot (same x and y labels) on different y scales, titles (axes titles and the suptitle) overlapping
-    each other."""
+    """What is wrong with a figure's layout: legends on data or on each other, legends set below 7 pt, curves cut
+    off by the axis limits, panels of the same plot (same x and y labels) on different y scales, titles (axes
+    titles and the suptitle) overlapping each other."""
     if not hasattr(fig.canvas, "get_renderer"):  # a bare matplotlib.figure.Figure (scans.figures)
         from matplotlib.backends.backend_agg import FigureCanvasAgg
 
@@ -135,6 +135,18 @@ def layout_problems(fig: Any) -> list[str]:
         for other in legends:
             if other is not legend and other.get_window_extent(renderer).overlaps(box):
                 problems.append(f"legend {first!r} overlaps another legend")
+    for ax in fig.axes:  # no curve cut off by the axis limits (a shared scale set from one panel only)
+        x0, x1 = sorted(ax.get_xlim())
+        y0, y1 = sorted(ax.get_ylim())
+        for line in ax.lines:
+            if line.get_transform() != ax.transData or not line.get_visible():
+                continue
+            xy = np.asarray(line.get_xydata(), dtype=float)
+            xy = xy[np.isfinite(xy).all(axis=1)]
+            slack = 1e-9 * max(abs(y1 - y0), 1e-300)
+            if len(xy) and ((xy[:, 1] > y1 + slack).any() or (xy[:, 1] < y0 - slack).any()
+                            or (xy[:, 0] > x1).any() or (xy[:, 0] < x0).any()):
+                problems.append(f"{_name(line)} of the axes {ax.get_title()!r} runs beyond the axis limits")
     panels: dict[tuple[str, str], list[Any]] = {}
     for ax in fig.axes:  # the same plot in several panels (Fig. 5's levels): compared on one y scale
         if ax.get_visible() and ax.get_ylabel():
@@ -209,6 +221,8 @@ def _resonant(level: float, regime: str) -> tuple[float, float]:
 def sweep_data(level: float, regime: str) -> dict[str, Any]:
     eta = np.linspace(0.95, 1.05, 41)
     mean, peak = _resonant(level, regime)
+    if regime == "APR":  # the almost periodic peak of a frequency response stands high above the SMR plateau
+        mean, peak = 4 * mean + 0.15, 4 * peak + 0.15
     shape = 1.0 / (1.0 + ((eta - 0.99) / 0.02) ** 2)
     m, x = 0.2 * mean + 0.8 * mean * shape, 0.3 * peak + 0.7 * peak * shape
     return {"eta": eta.tolist(), "mean": m.tolist(), "mean_lo": (0.9 * m).tolist(), "mean_hi": (1.1 * m).tolist(),

@@ -347,7 +347,9 @@ def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list
                 vals = np.array([float(r[idx]) for r in pr])
                 errs = np.array([float(r[f"{idx}_conf"]) for r in pr])
                 at = x + (2 * k + m - len(names)) * width + width / 2
-                ax.bar(at, vals, width, yerr=errs, hatch=hatch, color=f"C{k}", alpha=0.8 if m == 0 else 0.45,
+                # the whiskers end at the axis edge where they would run on (marked there by a triangle)
+                shown = [np.clip(np.minimum(errs, vals - lo), 0, None), np.clip(np.minimum(errs, hi - vals), 0, None)]
+                ax.bar(at, vals, width, yerr=shown, hatch=hatch, color=f"C{k}", alpha=0.8 if m == 0 else 0.45,
                        edgecolor=f"C{k}", label=f"{idx} {pname}", capsize=2)
                 for edge, marker, out_of in ((hi, "^", vals + errs > hi), (lo, "v", vals - errs < lo)):
                     if out_of.any():
