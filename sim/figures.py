@@ -160,6 +160,8 @@ def plot_sweeps(panels: Sequence[tuple[Mapping[str, Any], str]], path: str | os.
             ax.set_visible(False)
         # one y range for all panels, from 0 to the highest band edge of any of them
         axes.flat[0].set_ylim(0.0, 1.05 * max(ax.dataLim.y1 for ax in axes.flat[:len(panels)]))
+        for ax in axes[:, 1:].flat:
+            ax.set_ylabel("")  # the shared scale is labelled once, on the left
         handles, labels = axes.flat[0].get_legend_handles_labels()
         fig.legend(handles, labels, loc="outside lower center", ncols=4, fontsize=LEGEND_PT, frameon=False)
         fig.suptitle(title, fontsize=10)
