@@ -505,3 +505,16 @@ def test_the_check_sees_a_legend_on_a_curve_and_passes_one_in_an_empty_corner():
     fig.suptitle("a figure's title", y=0.89)
     assert any("overlaps title" in p for p in layout_problems(fig))
     plt.close(fig)
+
+
+@pytest.mark.parametrize("level", [1.26, 6.7, 7.4])
+def test_the_stated_factor_to_mm_is_a_noabs_star_of_the_level(level):
+    """The level plots' factor (Eq. B.1: (phi_tip/phi_c) g* per unit level) times the level is the resonant tip
+    amplitude without absorber of Sect. 5, phi_tip (phi^T M b) a_base / (2 D*), at a_base = level a_base*: the two
+    definitions agree, so a/a_noabs* x level x factor is the tip amplitude in mm."""
+    from sim.rig import seed_rig_model
+    from sim.system import a_base_star, a_noabs_star
+
+    model = seed_rig_model()
+    expected = 1e3 * a_noabs_star(model, level * a_base_star(model))
+    assert level * sim.figures.tip_mm_per_level(model) == pytest.approx(expected, rel=1e-12)
