@@ -184,11 +184,15 @@ def colours(fig: Any) -> list[tuple[float, ...]]:
 @pytest.fixture
 def checked(monkeypatch, tmp_path):
     """Run a drawing function; every figure it would save is checked instead (drawn once, not written: the files
-    are other tests' business) before it is closed. Returns {file name: {"problems": [...], "colours": [...]}}."""
+    are other tests' business) before it is closed. Returns {file name: {"problems", "colours", "legend" (the
+    legends' texts and titles), "ylim" (per axes)}}."""
     found: dict[str, dict[str, Any]] = {}
 
     def check_then_save(fig: Any, path: Any) -> Path:
-        found[Path(path).name] = {"problems": layout_problems(fig), "colours": colours(fig)}
+        legends = [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None] + list(fig.legends)
+        found[Path(path).name] = {"problems": layout_problems(fig), "colours": colours(fig),
+                                  "legend": [t.get_text() for lg in legends for t in [*lg.get_texts(), lg.get_title()]],
+                                  "ylim": [ax.get_ylim() for ax in fig.axes]}
         return Path(path)
 
     for module in (sim.files, sim.figures, uq.figures, sim.modal_fit):
@@ -518,3 +522,17 @@ def test_the_stated_factor_to_mm_is_a_noabs_star_of_the_level(level):
     model = seed_rig_model()
     expected = 1e3 * a_noabs_star(model, level * a_base_star(model))
     assert level * sim.figures.tip_mm_per_level(model) == pytest.approx(expected, rel=1e-12)
+
+
+def test_legends_give_values_and_the_sobol_range_is_explained(checked):
+    """Fig. 7's legends name the corners' values in Table 2's units (g = 0.580 and 0.612 mm, not 'g min/max'), the
+    level plots state the factor to mm, and the Sobol' axis keeps to [-0.25, 1.25] and says why estimates run
+    beyond it (sampling error of a small n)."""
+    fig7 = checked(draw_interval)["fig7.png"]
+    assert {"$g$ = 0.580 mm", "$g$ = 0.612 mm", "$D$ = 0.075 %"} <= set(fig7["legend"])
+    assert not any(" min" in text or " max" in text for text in fig7["legend"])
+    fig6 = checked(draw_response)["fig6.png"]
+    assert any("0.557 mm (Eq. B.1)" in text for text in fig6["legend"])
+    sobol = checked(draw_sobol)["sobol.png"]
+    assert sobol["ylim"] == [(-0.25, 1.25)]
+    assert any("raise [sobol] n (now 64)" in text for text in sobol["legend"])
