@@ -327,19 +327,20 @@ def plot(data: dict[str, Any], label: str, path: str) -> None:
     """Force-indentation curve, the fit and Eq. 8 (Fig. 3c style), written atomically."""
     import numpy as np
 
+    from sim.common.figure_style import legend_beside
     from sim.common.files import plot_to
 
     d = np.asarray(data["deltas"])
     fine = np.linspace(0.0, d[-1], 200)
-    with plot_to(path, figsize=(5.0, 3.8)) as (fig, ax):
-        ax.plot(d * 1e3, data["forces"], "o", ms=4, label="BEM")
-        ax.plot(fine * 1e3, data["k_H"] * fine**1.5, "-", label=f"fit $k_H\\delta^{{1.5}}$, $k_H/k_H^*$ = {data['k_H_ratio']:.4f}")
-        ax.plot(fine * 1e3, data["k_H_star"] * fine**1.5, "--", label="Hertz, Eq. 8")
-        ax.set_xlabel("indentation $\\delta$ in mm")
-        ax.set_ylabel("normal contact force $f_c$ in N")
+    with plot_to(path, figsize=(7.5, 3.8)) as (fig, ax):
+        ax.plot(d * 1e6, data["forces"], "o", ms=4, label="BEM")
+        ax.plot(fine * 1e6, data["k_H"] * fine**1.5, "-", label=f"fit $k_H\\delta^{{1.5}}$, $k_H/k_H^*$ = {data['k_H_ratio']:.4f}")
+        ax.plot(fine * 1e6, data["k_H_star"] * fine**1.5, "--", label="Hertz, Eq. 8 ($k_H^*$)")
+        ax.set_xlabel("indentation $\\delta$ ($\\mu$m)")
+        ax.set_ylabel("normal contact force $f_c$ (N)")
         ax.set_title(label, fontsize=9)
-        ax.legend()
         ax.grid(alpha=0.3)
+        legend_beside(ax)
 
 
 def scan_plot(data: dict[str, Any], source: GapSource, path: str) -> None:

@@ -381,6 +381,7 @@ def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: 
     import dataclasses
 
     from sim.plots.figures import plot_motion
+    from uq.figures import series_label
     from sim.analysis.trace import record_trace, write_trace
 
     sub, one = study.series_studies()[-1]
@@ -404,7 +405,8 @@ def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: 
         settings = {"integrator": visit.integrator, "seed": study.seed, "protocol": dataclasses.asdict(visit),
                     "series": sub, "study": study.name}
         _, paths = write_trace(out, trace, settings, out / "trace.png")
-        title = (f"{sub}: a_base/a_base* = {level:g}, eta = {trace.eta_actual:.4f} (cf. Fig. C.1b), "
+        title = (f"{series_label(sub)}: $a_\\mathrm{{base}}/a_\\mathrm{{base}}^*$ = {level:g}, $\\eta$ = {trace.eta_actual:.4f} "
+                 "(cf. Fig. C.1b), "
                  f"{trace.amplitudes.size} periods")
         plot_motion(trace.signal.t, trace.signal, out / "motion.png", title)
         written += [Path(p) for p in paths] + [out / "motion.png"]

@@ -25,15 +25,27 @@ from typing import Any
 import numpy as np
 
 from sim.common.errors import SimulationInputError
+from sim.plots.figures import (
+    LEGEND_PT,
+    LEVEL_LABEL,
+    N_PER_MM15,
+    RESPONSE_LABEL,
+    legend_below,
+    legend_beside,
+    shade_regimes,
+    tip_mm_per_level,
+    tip_note,
+)
 from sim.common.files import pyplot, save_figure
 from sim.plots.redraw import KINDS, PlotOptions, kind_of, register, selected
 from uq.results import nominal_regimes
 
-_YLABEL = {"mean": "mean resonant level  a / a_noabs*", "max": "max resonant level  a / a_noabs*",
-           "value": "response", "restitution": "modal coefficient of restitution r (tip)",
-           "restitution_wall": "modal coefficient of restitution r (wall)"}
-_LEVEL = "excitation level  a_base / a_base*"
+_YLABEL = {"mean": f"mean resonant level {RESPONSE_LABEL}", "max": f"max resonant level {RESPONSE_LABEL}",
+           "value": "response", "restitution": "modal coefficient of restitution $r$ (tip)",
+           "restitution_wall": "modal coefficient of restitution $r$ (wall)"}
 _NOISE_NOTE = "error bars: standard error of the repetition mean ({n} runs per point)"
+#: the outputs whose bands are drawn level by level (bars, no band between levels): r exists at APR levels only
+_DISCRETE_OUTPUTS = ("restitution", "restitution_wall")
 
 
 def _rows(path: Path, options: PlotOptions | None = None) -> list[dict]:
@@ -80,60 +92,110 @@ def _band(bands: list[dict], design: str, output: str) -> dict[str, np.ndarray]:
     return out
 
 
+def parameter_text(name: str, value: float, star: bool = False) -> str:
+    """A parameter value as the figures print it, in the unit of Table 2 (mathtext): D in %, g in mm, k_H in
+    N/mm^1.5 ('$g$ = 0.580 mm'); star: the nominal symbol ('$g^*$'); other parameters by name, plain."""
+    mark = "^*" if star else ""
+    if name == "D":
+        return f"$D{mark}$ = {100 * value:.3g} %"
+    if name == "g":
+        return f"$g{mark}$ = {1e3 * value:.3f} mm"
+    if name == "k_H":
+        return f"$k_H{mark}$ = {value / 1e3**1.5 / 1e3:.0f}$\\times 10^3$ {N_PER_MM15}"
+    return f"{name}{'*' if star else ''} = {value:.4g}"
+
+
+def parameter_title(name: str, parameter: dict) -> str:
+    """A panel title of Fig. 7: the parameter's label and the unit its values are printed in (`parameter_text`)."""
+    unit = {"D": "%", "g": "mm", "k_H": N_PER_MM15}.get(name, parameter.get("unit", ""))
+    words, _, symbol = parameter.get("label", name).rpartition(" ")
+    if symbol.split("_")[0] == name.split("_")[0]:  # the label ends in the symbol: typeset it ('k_H' -> $k_H$)
+        symbol = f"${symbol}$"
+    label = f"{words} {symbol}".strip()
+    return f"{label} ({unit})" if unit and unit != "-" else label
+
+
 def nominal_label(parameters: dict) -> str:
-    """'nominal (D* = 0.085 %, g* = 0.58 mm, k_H* = 282e3 N/mm^1.5)' for the simulator's Table 2 point; the
-    parameters' nominal values for other models."""
-    parts = []
-    for name, p in parameters.items():
-        if name.startswith("_"):
-            continue
-        value = p["nominal"]
-        if name == "D":
-            parts.append(f"D* = {100 * value:.3g} %")
-        elif name == "g":
-            parts.append(f"g* = {1e3 * value:.3g} mm")
-        elif name == "k_H":
-            parts.append(f"k_H* = {value / 1e3**1.5 / 1e3:.0f}e3 N/mm^1.5")
-        else:
-            parts.append(f"{name} = {value:.4g}")
+    """'nominal ($D^*$ = 0.085 %, $g^*$ = 0.580 mm, $k_H^*$ = 282x10^3 N/mm^1.5)' for the simulator's Table 2 point;
+    the parameters' nominal values for other models."""
+    parts = [parameter_text(name, p["nominal"], star=True) for name, p in parameters.items() if not name.startswith("_")]
     return "nominal (" + ", ".join(parts) + ")"
+
+
+def _corner_value(label: str) -> float:
+    """The parameter value of a corner point of an individual design ('g=0.00061' -> 0.00061)."""
+    return float(label.split("=", 1)[1])
 
 
 def _errorbar(ax: Any, x: np.ndarray, y: np.ndarray, se: np.ndarray, fmt: str, **kwargs: Any) -> None:
     """A curve with standard-error bars (no bar where the error is unknown, NaN)."""
-    ax.errorbar(x, y, yerr=np.nan_to_num(se, nan=0.0), fmt=fmt, capsize=2, ms=4, lw=1.2, elinewidth=0.8, **kwargs)
+    ax.errorbar(x, y, yerr=np.nan_to_num(se, nan=0.0), fmt=fmt, capsize=2, ms=kwargs.pop("ms", 4), lw=kwargs.pop("lw", 1.2),
+                elinewidth=0.8, **kwargs)
 
 
-def _band_with_noise(ax: Any, band: dict, color: str, alpha: float, label: str) -> None:
-    """The band (shaded) and the standard errors of its edges (bars at both edges)."""
-    ax.fill_between(band["level"], band["lower"], band["upper"], color=color, alpha=alpha, lw=0, label=label)
+def _band_with_noise(ax: Any, band: dict, color: str, alpha: float, label: str, *, hatch: str | None = None,
+                     discrete: bool = False, offset: float = 0.0, width: float = 0.0) -> None:
+    """The band (shaded, or hatched and unfilled with `hatch` so that a band beneath stays visible) and the
+    standard errors of its edges (bars at both edges). discrete: one box per level (width in level units, shifted
+    by offset), no band drawn between levels."""
+    x = band["level"] + offset
+    fill = {"facecolor": "none", "edgecolor": color, "hatch": hatch, "lw": 0.8} if hatch else \
+        {"color": color, "alpha": alpha, "lw": 0}
+    if discrete:
+        ax.bar(x, band["upper"] - band["lower"], width, bottom=band["lower"], label=label, **fill)
+    else:
+        ax.fill_between(x, band["lower"], band["upper"], label=label, **fill)
+    at = x - 0.3 * width if discrete else x  # a box's edge errors off its centre, where the nominal point sits
     for edge in ("lower", "upper"):
-        ax.errorbar(band["level"], band[edge], yerr=np.nan_to_num(band[f"{edge}_se"], nan=0.0), fmt="none",
+        ax.errorbar(at, band[edge], yerr=np.nan_to_num(band[f"{edge}_se"], nan=0.0), fmt="none",
                     ecolor=color, elinewidth=0.8, capsize=2, alpha=0.9)
 
 
-def _marks(ax: Any, band: dict, prefix: str = "") -> None:
+def _marks(ax: Any, band: dict, prefix: str = "", offset: float = 0.0) -> None:
     """Where the nominal value lies outside the band (beyond or within the noise), where the monotonicity check
     failed (band widened) and where it could not be made; each explained in the legend."""
-    lv = band["level"]
+    lv = band["level"] + offset
     applies = band["nominal_outside"] >= 0
     beyond = applies & (band["nominal_outside"] == 1)
     outside = applies & ((band["nominal"] < band["lower"]) | (band["nominal"] > band["upper"]))
     within = outside & ~beyond
     if beyond.any():
-        ax.plot(lv[beyond], band["nominal"][beyond], "o", ms=11, mfc="none", mec="m", mew=2,
+        ax.plot(lv[beyond], band["nominal"][beyond], "o", ms=11, mfc="none", mec="C4", mew=2, ls="none",
                 label=f"{prefix}nominal outside its band, beyond the noise")
     if within.any():
         ax.plot(lv[within], band["nominal"][within], "o", ms=11, mfc="none", mec="0.5", mew=1.2, ls="none",
                 label=f"{prefix}nominal outside its band, within the noise")
     flagged = band["flagged"] == 1
     if flagged.any():
-        ax.plot(lv[flagged], band["upper"][flagged], "rx", ms=9, mew=2,
+        ax.plot(lv[flagged], band["upper"][flagged], "x", color="C3", ms=9, mew=2, ls="none",
                 label=f"{prefix}monotonicity check failed (band widened to all points)")
     untested = band["tested"] == 0
     if untested.any():
         ax.plot(lv[untested], band["upper"][untested], ls="none", marker="$?$", color="0.3", ms=9,
                 label=f"{prefix}monotonicity not tested (no noise estimate)")
+
+
+def _tip_mm_per_level(meta: dict) -> float | None:
+    """Eq. B.1's factor to the tip amplitude (`sim.plots.figures.tip_mm_per_level`) of the simulator's host model (the
+    built-in rig, or the study's modal-model file); None for other models or when the file cannot be read."""
+    study = meta.get("study", {})
+    if study.get("model") != "ies":
+        return None
+    try:
+        if study.get("modal_model"):
+            from sim.hosts.modal_file import load_modal_model
+
+            return tip_mm_per_level(load_modal_model(study["modal_model"]))
+        from sim.hosts.rig import seed_rig_model
+
+        return tip_mm_per_level(seed_rig_model())
+    except (OSError, ValueError):  # a moved or changed modal file: the figure is drawn without the factor
+        return None
+
+
+def _level_step(levels: np.ndarray) -> float:
+    unique = np.unique(levels)
+    return float(np.min(np.diff(unique))) if unique.size > 1 else 1.0
 
 
 #: the joint band's figure per banded output: file stem and title (Fig. 8 for the response level, Fig. D.3 for r)
@@ -143,7 +205,10 @@ _BOX_FIGURES = {"mean": ("fig8", "Joint variation (cf. Fig. 8)"),
 
 
 def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
-    """Draw Figs. 7 and 8 (as far as the study has the designs) and the nominal levels from folder/*.csv."""
+    """Draw Figs. 7 and 8 (as far as the study has the designs) and the nominal levels from folder/*.csv: every
+    legend beside or below its axes, the panels of Fig. 7 on one y scale, the regimes of the nominal point
+    (`uq.results.nominal_regimes`) shaded, the corners' parameter values in the legends, and the factor to the
+    tip amplitude in mm (Eq. B.1) where the output is a resonant level."""
     folder = Path(folder)
     options = options or PlotOptions()
     plt = pyplot()
@@ -155,117 +220,157 @@ def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> 
     params = meta["study"]["parameters"]
     nominal = _curve(points, "nominal", "nominal", output)
     nominal_text = nominal_label(params)
+    regimes = nominal_regimes(points, output)
+    discrete = output in _DISCRETE_OUTPUTS or len(regimes) < 4
     note = _NOISE_NOTE.format(n=meta["study"]["repetitions"])
+    factor = _tip_mm_per_level(meta) if output in ("mean", "max") else None
+    notes = "\n".join(text for text in (note, tip_note(factor)) if text)
     paths: list[Path] = []
 
     individual = [d for d in designs if d.startswith("individual:")]
     if individual:
-        fig, axes = plt.subplots(1, len(individual), figsize=(4.6 * len(individual), 4.4), squeeze=False, sharey=True)
+        fig, axes = plt.subplots(1, len(individual), figsize=(4.4 * len(individual), 5.6), squeeze=False, sharey=True,
+                                 layout="constrained")
         for ax, d in zip(axes[0], individual):
             pname = d.split(":", 1)[1]
             band = _band(bands, d, output)
-            _band_with_noise(ax, band, "tab:blue", 0.2, "band (+- SE of its edges)")
+            if not discrete:
+                shade_regimes(ax, list(regimes), list(regimes.values()))
+            width = 0.3 * _level_step(band["level"])
+            _band_with_noise(ax, band, "C0", 0.2, "band (± SE of its edges)", discrete=discrete, width=width)
+            # the nominal first and thin, so that a corner at the nominal value stays visible above it
+            _errorbar(ax, *nominal, "--" if not discrete else "D", color="k", lw=1.0, ms=3, zorder=2,
+                      label=parameter_text(pname, params[pname]["nominal"], star=True) + " (nominal)"
+                      if pname in params else "nominal")
             corners = sorted({r["point"] for r in points if r["design"] == d and r["role"] == "corner"},
-                             key=lambda label: float(label.split("=", 1)[1]))
-            for label, fmt, color, end in ((corners[0], "v-", "tab:blue", "min"), (corners[-1], "^-", "tab:red", "max")):
-                _errorbar(ax, *_curve(points, d, label, output), fmt, color=color, label=f"{pname} {end}")
-            _errorbar(ax, *nominal, "k.--", label="nominal")
+                             key=_corner_value)
+            for label, marker, style, color in ((corners[0], "v", ":", "C0"), (corners[-1], "^", "-", "C3")):
+                text = parameter_text(pname, _corner_value(label))
+                _errorbar(ax, *_curve(points, d, label, output), marker + ("" if discrete else style), color=color,
+                          mfc="none", ms=6, zorder=3, label=text)
             _marks(ax, band)
-            unit = params.get(pname, {}).get("unit", "")
-            ax.set_title(f"{params.get(pname, {}).get('label', pname)} ({unit})", fontsize=9)
-            ax.set_xlabel(_LEVEL)
+            ax.set_title(parameter_title(pname, params.get(pname, {})), fontsize=9)
+            ax.set_xlabel(LEVEL_LABEL)
             ax.grid(alpha=0.3)
-            ax.legend(fontsize=6)
+            legend_below(ax)
         axes[0][0].set_ylabel(_YLABEL.get(output, output))
-        fig.suptitle(f"Individual variation (cf. Fig. 7); {nominal_text}", fontsize=9)
-        fig.text(0.5, 0.005, note, ha="center", fontsize=7)
-        fig.tight_layout(rect=(0, 0.03, 1, 1))
+        fig.suptitle(f"Individual variation (cf. Fig. 7); {nominal_text}", fontsize=10)
+        fig.supxlabel(notes, fontsize=LEGEND_PT)
         paths += _save(fig, folder, "fig7", options)
         plt.close(fig)
 
     box = [d for d in designs if d in ("joint", "residual")]
     if box:
-        fig, ax = plt.subplots(figsize=(6.4, 4.8))
-        styles = {"joint": ("tab:blue", 0.2, "all parameters (joint)"),
-                  "residual": ("tab:orange", 0.45, "residual, k_H fixed at its best estimate")}
-        for d in box:
-            color, alpha, label = styles[d]
+        fig, ax = plt.subplots(figsize=(9.5, 4.8), layout="constrained")
+        styles = {"joint": ("C0", 0.25, None, "all parameters (joint)"),
+                  "residual": ("C1", 0.0, "////", "residual, $k_H$ fixed at its best estimate")}
+        step = _level_step(np.array([float(r["level"]) for r in bands]))
+        if not discrete:
+            shade_regimes(ax, list(regimes), list(regimes.values()))
+        for k, d in enumerate(box):
+            color, alpha, hatch, label = styles[d]
             band = _band(bands, d, output)
-            _band_with_noise(ax, band, color, alpha, f"{label} (+- SE of its edges)")
-            _marks(ax, band, prefix=f"{d}: ")
-        _errorbar(ax, *nominal, "k.--", label=nominal_text)
+            # discrete levels: the two bands side by side, so that no bar hides the other's
+            offset = (k - (len(box) - 1) / 2) * 0.25 * step if discrete else 0.0
+            _band_with_noise(ax, band, color, alpha, f"{label} (± SE of its edges)", hatch=hatch, discrete=discrete,
+                             offset=offset, width=0.22 * step)
+            _marks(ax, band, prefix=f"{d}: ", offset=offset)
+        _errorbar(ax, *nominal, "kD" if discrete else "k.--", ms=4, label=nominal_text)
         stem, title = _BOX_FIGURES.get(output, _BOX_FIGURES["mean"])
         if stem == "figD3":
-            ax.axhline(0.8, color="k", lw=1, ls="-.", alpha=0.6, label="paper: r ~ 0.8 (Fig. D.3)")
-        ax.set_xlabel(_LEVEL)
+            ax.axhline(0.8, color="k", lw=1, ls="-.", alpha=0.6, label="paper: $r$ ~ 0.8 (Fig. D.3)")
+        if discrete:
+            ax.set_xticks(np.unique(band["level"]))
+        ax.set_xlabel(LEVEL_LABEL)
         ax.set_ylabel(_YLABEL.get(output, output))
         ax.set_title(title, fontsize=10)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=6)
-        fig.text(0.5, 0.005, note, ha="center", fontsize=7)
-        fig.tight_layout(rect=(0, 0.03, 1, 1))
+        legend_beside(ax, title=notes)
         paths += _save(fig, folder, stem, options)
         plt.close(fig)
 
     if {"mean", "max"} <= set(meta["outputs"]):
-        paths += _nominal_levels(folder, points, nominal_text, note, options)
+        paths += _nominal_levels(folder, points, nominal_text, "\n".join(t for t in (note, tip_note(factor)) if t),
+                                 options)
     return paths
 
 
 def _nominal_levels(folder: Path, points: list[dict], nominal_text: str, note: str, options: PlotOptions) -> list[Path]:
     """The nominal point's resonant mean and max against the excitation level, with their standard errors and the
-    regime of each level (`uq.results.nominal_regimes`)."""
+    regime of each level shaded (`uq.results.nominal_regimes`); `note` heads the legend."""
     plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6.0, 4.4))
-    for output, fmt, color in (("max", "s--", "tab:red"), ("mean", "o-", "tab:blue")):
+    fig, ax = plt.subplots(figsize=(9.5, 4.4), layout="constrained")
+    regimes = nominal_regimes(points)
+    shade_regimes(ax, list(regimes), list(regimes.values()))
+    for output, fmt, color in (("max", "s--", "C3"), ("mean", "o-", "C0")):
         _errorbar(ax, *_curve(points, "nominal", "nominal", output), fmt, color=color, label=f"resonant {output}")
-    for level, regime in sorted(nominal_regimes(points).items()):
-        ax.annotate(regime, (level, 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom", fontsize=7,
-                    rotation=90)
-    ax.set_xlabel(_LEVEL)
-    ax.set_ylabel("resonant response level  a / a_noabs*")
-    ax.set_title(f"Resonant levels of the {nominal_text}", fontsize=8, pad=28)
+    ax.set_xlabel(LEVEL_LABEL)
+    ax.set_ylabel(f"resonant response level {RESPONSE_LABEL}")
+    ax.set_title(f"Resonant levels of the {nominal_text}", fontsize=9)
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.text(0.5, 0.005, note, ha="center", fontsize=7)
-    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    legend_beside(ax, title=note)
     paths = _save(fig, folder, "nominal-levels", options)
     plt.close(fig)
     return paths
 
 
+#: the axis range of the Sobol' figure: indices lie in [0, 1]; estimates and intervals beyond it are sampling error
+_SOBOL_RANGE = (-0.25, 1.25)
+
+
 def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
-    """S1 and ST (with confidence bars) per parameter vs level, and the noise share, per output."""
+    """S1 and ST (with confidence bars) per parameter vs level, and the noise share, per output. The y axis shows
+    [-0.25, 1.25] around the indices' range [0, 1]; an estimate or interval end beyond it (sampling error of a
+    small n) is marked by a triangle at the edge, and the legend says so and what to do (a larger [sobol] n)."""
     folder = Path(folder)
     options = options or PlotOptions()
     plt = pyplot()
     rows, var = _rows(folder / "sobol.csv", options), _rows(folder / "variance.csv", options)
     selected(sorted({float(r["level"]) for r in _rows(folder / "sobol.csv")}), options, folder)
+    meta = _study(folder) if (folder / "study.json").is_file() else {}
+    n = meta.get("study", {}).get("sobol", {}).get("n")
     outputs = list(dict.fromkeys(r["output"] for r in rows))
-    fig, axes = plt.subplots(1, len(outputs), figsize=(5 * len(outputs), 3.8), squeeze=False)
+    fig, axes = plt.subplots(1, len(outputs), figsize=(5.5 * len(outputs) + 3.0, 4.0), squeeze=False,
+                             layout="constrained")
+    lo, hi = _SOBOL_RANGE
     for ax, o in zip(axes[0], outputs):
         sub = [r for r in rows if r["output"] == o]
         levels = sorted({float(r["level"]) for r in sub})
         names = list(dict.fromkeys(r["parameter"] for r in sub))
         width = 0.8 / (2 * len(names))
         x = np.arange(len(levels))
+        beyond = False
         for k, pname in enumerate(names):
             pr = sorted((r for r in sub if r["parameter"] == pname), key=lambda r: float(r["level"]))
             for m, (idx, hatch) in enumerate((("S1", ""), ("ST", "//"))):
-                vals = [float(r[idx]) for r in pr]
-                errs = [float(r[f"{idx}_conf"]) for r in pr]
-                ax.bar(x + (2 * k + m - len(names)) * width + width / 2, vals, width, yerr=errs, hatch=hatch,
-                       color=f"C{k}", alpha=0.8 if m == 0 else 0.45, label=f"{idx} {pname}", capsize=2)
+                vals = np.array([float(r[idx]) for r in pr])
+                errs = np.array([float(r[f"{idx}_conf"]) for r in pr])
+                at = x + (2 * k + m - len(names)) * width + width / 2
+                # the whiskers end at the axis edge where they would run on (marked there by a triangle)
+                shown = [np.clip(np.minimum(errs, vals - lo), 0, None), np.clip(np.minimum(errs, hi - vals), 0, None)]
+                ax.bar(at, vals, width, yerr=shown, hatch=hatch, color=f"C{k}", alpha=0.8 if m == 0 else 0.45,
+                       edgecolor=f"C{k}", label=f"{idx} {pname}", capsize=2)
+                for edge, marker, out_of in ((hi, "^", vals + errs > hi), (lo, "v", vals - errs < lo)):
+                    if out_of.any():
+                        beyond = True
+                        ax.plot(at[out_of], [edge - 0.03 * np.sign(edge)] * int(out_of.sum()), ls="none",
+                                marker=marker, color="k", ms=5)
         noise = [float(r["noise_share"]) for r in sorted((r for r in var if r["output"] == o),
                                                          key=lambda r: float(r["level"]))]
         ax.plot(x, noise, "kd:", label="noise share of the variance")
+        ax.axhspan(0.0, 1.0, color="0.9", zorder=0, lw=0, label="range of an index, [0, 1]")
+        if beyond:
+            ax.plot([], [], "k^", ls="none", ms=5,
+                    label="estimate or interval beyond the axis:\nsampling error, raise [sobol] n"
+                          + (f" (now {n})" if n else ""))
+        ax.set_ylim(lo, hi)
         ax.set_xticks(x, [f"{lv:g}" for lv in levels])
-        ax.set_xlabel(_LEVEL)
+        ax.set_xlabel(LEVEL_LABEL)
         ax.set_ylabel("Sobol' index / variance share")
         ax.set_title(f"output: {o}", fontsize=9)
         ax.grid(alpha=0.3, axis="y")
-        ax.legend(fontsize=6, ncol=2)
+        legend_beside(ax, title="whiskers: confidence intervals")
     paths = _save(fig, folder, "sobol", options)
     plt.close(fig)
     return paths
@@ -296,6 +401,7 @@ def response_figures(folder: str | Path, options: PlotOptions | None = None) -> 
     selected([float(r["level"]) for r in _rows(folder / "overview.csv")], options, folder)
     protocol = meta["study"]["protocol_resolved"]
     runs = f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold"
+    factor = _tip_mm_per_level(meta)
     paths: list[Path] = []
     if "fig5" in meta["study"]["response"]["figures"]:
         by_level: dict[float, dict[str, list]] = defaultdict(lambda: defaultdict(list))
@@ -303,7 +409,10 @@ def response_figures(folder: str | Path, options: PlotOptions | None = None) -> 
             for key, value in r.items():
                 by_level[float(r["level"])][key].append(value if key == "regime" else float(value))
         regime = dict(zip(overview["levels"], overview["regime"]))
-        panels = [(data, f"a_base/a_base* = {level:g} (resonance: {regime.get(level, '?')})")
+        if factor is not None:  # a_noabs* at each level (m): the panels' right-hand axes in mm
+            for level, data in by_level.items():
+                data["a_noabs"] = 1e-3 * factor * level
+        panels = [(data, f"$a_\\mathrm{{base}}/a_\\mathrm{{base}}^*$ = {level:g} (resonance: {regime.get(level, '?')})")
                   for level, data in sorted(by_level.items())]
         paths += options.paths(folder, "fig5")
         for path in options.paths(folder, "fig5"):
@@ -316,13 +425,14 @@ def response_figures(folder: str | Path, options: PlotOptions | None = None) -> 
             what = "impacts per period (cf. Fig. D.2)" if figure == "figD2" else "restitution, APR levels (cf. Fig. D.3)"
             runs_rows = _rows(folder / "runs.csv", options)
             for path in options.paths(folder, figure):
-                plot_scattering(overview, runs_rows, path, f"{what} at the resonant eta, nominal parameters, {runs}", figure)
+                plot_scattering(overview, runs_rows, path, f"{what} at the resonant $\\eta$, nominal parameters, {runs}",
+                                figure)
             paths += options.paths(folder, figure)
     if "fig6" in meta["study"]["response"]["figures"]:
         paths += options.paths(folder, "fig6")
         for path in options.paths(folder, "fig6"):
             plot_overview(overview, path, f"Resonant level vs excitation level (cf. Fig. 6), nominal parameters, {runs}",
-                          paper_optimum=True)
+                          paper_optimum=True, mm_per_level=factor)
     return paths
 
 
@@ -343,10 +453,20 @@ def _series_figure(folder: Path, meta: dict, options: PlotOptions) -> list[Path]
             f"{protocol['integrator']}")
     paper = SERIES_FIGURES.get(figure, ("", None))
     paths = options.paths(folder, figure)
+    series = [(series_label(sub), data) for sub, data in series_overviews(folder, options)]
     for path in paths:
-        plot_series(series_overviews(folder, options), path, f"Resonant mean for each {name} ({paper[0]}), contact law "
-                    f"{meta['study']['contact_law']}, {runs}", paper[1])
+        plot_series(series, path, f"Resonant mean for each {name} ({paper[0]}), contact law "
+                    f"{meta['study']['contact_law']}, {runs}", paper[1], mm_per_level=_tip_mm_per_level(meta))
     return paths
+
+
+def series_label(sub: str) -> str:
+    """A series value's legend entry in Table 2's units ('g=0.00058' -> '$g$ = 0.580 mm'); else the folder name."""
+    name, _, value = sub.partition("=")
+    try:
+        return parameter_text(name, float(value))
+    except ValueError:
+        return sub
 
 
 #: the paper's figure of a series study and what the paper says (a level marked on it)

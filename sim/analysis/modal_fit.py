@@ -53,7 +53,12 @@ import numpy as np
 
 from sim.common.errors import SimulationInputError
 from sim.common.files import save_figure
-from sim.analysis.impacts import LOWPASS_HZ, NOMINAL_THRESHOLD, detect_impacts, estimate_excitation_hz
+from sim.analysis.impacts import (
+    LOWPASS_HZ,
+    NOMINAL_THRESHOLD,
+    detect_impacts,
+    estimate_excitation_hz,
+)
 from sim.analysis.signals import Signal, as_signal
 from sim.model.system import ModalModel
 
@@ -338,6 +343,8 @@ def plot_modal_fit(fit: ModalFit, path: str | os.PathLike, *, t_range: tuple[flo
     import matplotlib.pyplot as plt
     from matplotlib.backend_bases import FigureCanvasBase
 
+    from sim.common.figure_style import legend_beside
+
     t, v = fit.signal.t, fit.signal["v_tip"]
     scale = 1.0 if velocity_scale is None else float(velocity_scale)
     if not np.isfinite(scale) or scale <= 0:
@@ -351,14 +358,16 @@ def plot_modal_fit(fit: ModalFit, path: str | os.PathLike, *, t_range: tuple[flo
     kind = Path(path).suffix.lstrip(".").lower() or "png"
     if kind not in FigureCanvasBase.get_supported_filetypes():
         raise SimulationInputError(f"cannot write {path}: unknown figure format '.{kind}'; use .png, .pdf or .svg")
-    unit = "m/s" if velocity_scale is None else r"$\Omega a^{\mathrm{noabs}*}$"
-    fig, (overview, section) = plt.subplots(2, 1, figsize=(8.0, 6.0))
+    unit = "m/s" if velocity_scale is None else r"$\Omega a_\mathrm{noabs}^*$"
+    fig, (overview, section) = plt.subplots(2, 1, figsize=(9.5, 6.0), sharey=True, layout="constrained")
     try:
         overview.plot(t, v / scale, color="0.3", lw=0.6)
-        overview.axvspan(lo, hi, color="C1", alpha=0.2)
+        overview.axvspan(lo, hi, color="C1", alpha=0.2, label="section shown in (b)")
         for axes, start, stop in ((overview, t[0], t[-1]), (section, lo, hi)):
-            for impact in fit.impacts[(fit.impacts >= start) & (fit.impacts <= stop)]:
-                axes.axvline(impact, color="C3", lw=0.6, alpha=0.6)
+            # one caret per impact on the top edge: readable at any number of impacts, never on the signal
+            times = fit.impacts[(fit.impacts >= start) & (fit.impacts <= stop)]
+            axes.plot(times, np.ones(times.size), ls="none", marker=7, ms=5, color="C3", clip_on=False,
+                      transform=axes.get_xaxis_transform(), label="impact" if axes is overview else None)
         shown = (t >= lo) & (t <= hi)
         section.plot(t[shown], v[shown] / scale, color="0.3", lw=1.2, label="signal")
         labelled = set()
@@ -371,13 +380,14 @@ def plot_modal_fit(fit: ModalFit, path: str | os.PathLike, *, t_range: tuple[flo
                          lw=1.0, label=None if label in labelled else label)
             labelled.add(label)
         section.set_xlim(lo, hi)
-        overview.set_title("(a) tip velocity and detected impacts")
-        section.set_title("(b) reconstruction from the least-squares fit of Eq. 9")
+        # the titles clear of the impact carets on the top edges
+        overview.set_title("(a) tip velocity and detected impacts", fontsize=10, pad=10)
+        section.set_title("(b) reconstruction from the least-squares fit of Eq. 9", fontsize=10, pad=10)
         for axes in (overview, section):
             axes.set_xlabel("t (s)")
             axes.set_ylabel(f"tip velocity ({unit})")
-        section.legend(loc="upper right", fontsize="small")
-        fig.tight_layout()
+        legend_beside(overview)
+        legend_beside(section)
         return save_figure(fig, path)
     finally:
         plt.close(fig)

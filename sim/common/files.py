@@ -166,10 +166,11 @@ def pyplot() -> Any:
 
 @contextmanager
 def plot_to(path: str | os.PathLike, figsize: tuple[float, float] = (6.0, 4.0)) -> Iterator[tuple[Any, Any]]:
-    """Yield (figure, axes) of a new matplotlib figure (Agg back end); on success it is saved atomically to
-    `path` (format from the suffix), and it is always closed."""
+    """Yield (figure, axes) of a new matplotlib figure (Agg back end, constrained layout: titles, labels and
+    legends outside the axes get their room); on success it is saved atomically to `path` (format from the
+    suffix), and it is always closed."""
     plt = pyplot()
-    fig, ax = plt.subplots(figsize=figsize)
+    fig, ax = plt.subplots(figsize=figsize, layout="constrained")
     try:
         yield fig, ax
         save_figure(fig, path)

@@ -8,6 +8,12 @@ a frequency response has the keys of `sim.stepped_sine.protocol.SweepResult.to_d
 max_lo, max_hi); the resonant levels those of `sim.stepped_sine.tables.overview_data` (levels, resonant_mean, ...,
 regime); a time history the columns t, q_tip, v_tip of `sim.analysis.trace.COLUMNS` and the keys of
 `sim.analysis.trace.trace_data`. Files are written atomically through `sim.common.files` (format from the suffix).
+
+Every figure of the workbench follows the same layout (checked by tests/test_figure_layout.py): legends beside
+or below the axes (`legend_beside`, `legend_below`), never on data; panels that compare one plot on one y scale;
+the regimes shaded on the level plots (`shade_regimes`); the tip amplitude in mm on a right-hand axis where one
+level is shown (`secondary_mm`) and as Eq. B.1's stated factor on the level plots (`tip_note`); symbols and
+units in mathtext; colours from the style's cycle (C0, C1, ...), so that a grayscale style greys everything.
 """
 from __future__ import annotations
 
@@ -18,82 +24,164 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from sim.common.files import plot_to, save_figure
+from sim.stepped_sine.measures import (
+    PAPER_APR_LEVEL,
+    PAPER_OPTIMUM_LEVEL,
+    PAPER_REDUCTION_MAX,
+    PAPER_REDUCTION_MEAN,
+)
+from sim.common.figure_style import (  # noqa: F401 (re-exported for the figures' callers)
+    ETA_LABEL,
+    LEGEND_PT,
+    LEVEL_LABEL,
+    MICROMETRE,
+    N_PER_MM15,
+    RESPONSE_LABEL,
+    legend_below,
+    legend_beside,
+)
 from sim.plots.redraw import PlotOptions, register, selected
 
-from sim.stepped_sine.measures import PAPER_APR_LEVEL, PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, PAPER_REDUCTION_MEAN
+#: the shading of a regime on the level plots (Sect. 5.1, `sim.stepped_sine.measures.classify_regime`); SMR levels stay white
+REGIME_SHADING = {"APR": {"facecolor": "0.9", "label": "APR levels (almost periodic response); white: SMR"},
+                  "linear": {"facecolor": "none", "edgecolor": "0.6", "hatch": "..",
+                             "label": "linear levels (no impacts)"}}
+
+
+def shade_regimes(ax: Any, levels: Sequence[float], regimes: Sequence[str]) -> None:
+    """Shade the excitation levels of each regime (REGIME_SHADING) behind the data of a level plot: a level's
+    span reaches half way to its neighbours (half the nearest spacing beyond the first and last level)."""
+    import numpy as np
+
+    if not len(levels):
+        return
+    order = np.argsort(np.asarray(levels, dtype=float))
+    x = np.asarray(levels, dtype=float)[order]
+    kinds = [str(regimes[i]) for i in order]
+    step = float(np.min(np.diff(x))) if x.size > 1 else 0.5
+    edges = np.concatenate([[x[0] - step / 2], (x[1:] + x[:-1]) / 2, [x[-1] + step / 2]])
+    labelled = set()
+    i = 0
+    while i < x.size:
+        j = i
+        while j + 1 < x.size and kinds[j + 1] == kinds[i]:
+            j += 1
+        style = REGIME_SHADING.get(kinds[i])
+        if style is not None:
+            style = dict(style)
+            label = style.pop("label")
+            ax.axvspan(edges[i], edges[j + 1], lw=0, zorder=0, label=None if kinds[i] in labelled else label, **style)
+            labelled.add(kinds[i])
+        i = j + 1
+
+
+def tip_mm_per_level(model: Any) -> float:
+    """The tip amplitude (mm) of a normalised amplitude a/a_noabs* = 1 at the excitation level a_base/a_base* = 1,
+    Eq. B.1: (phi_tip/phi_c) g*; the tip amplitude at a level L is (a/a_noabs*) L times this."""
+    from sim.stepped_sine.measures import physical_amplitude
+
+    return 1e3 * float(physical_amplitude(1.0, 1.0, model))
+
+
+def tip_note(mm_per_level: float | None) -> str | None:
+    """The stated factor of a level plot (Eq. B.1) that turns a/a_noabs* at a level into the tip amplitude in mm."""
+    if mm_per_level is None:
+        return None
+    return (f"tip amplitude = {RESPONSE_LABEL} $\\times$ level $\\times$ {mm_per_level:.3f} mm (Eq. B.1)")
+
+
+def secondary_mm(ax: Any, a_noabs: float, label: str = "tip amplitude (mm)") -> Any:
+    """A right-hand axis in mm on a plot of a/a_noabs* at one level: a = (a/a_noabs*) a_noabs*, a_noabs* in m."""
+    scale = 1e3 * float(a_noabs)
+    axis = ax.secondary_yaxis("right", functions=(lambda y: y * scale, lambda y: y / scale))
+    axis.set_ylabel(label)
+    return axis
 
 
 def draw_sweep(ax: Any, data: Mapping[str, Any], title: str) -> None:
     """Fig. 5 on `ax`: mean (solid) and max (dashed) amplitude a/a_noabs* vs eta, each with the range of its
-    repetition samples as a band (the spread of the paper's figure)."""
+    repetition samples as a band (the spread of the paper's figure); with the data's a_noabs (m, a_noabs* at
+    this level, Sect. 5), a right-hand axis gives the tip amplitude in mm."""
     eta = data["eta"]
-    ax.fill_between(eta, data["max_lo"], data["max_hi"], color="tab:red", alpha=0.2, lw=0, label="max: spread")
-    ax.plot(eta, data["max"], "--", color="tab:red", label="max")
-    ax.fill_between(eta, data["mean_lo"], data["mean_hi"], color="tab:blue", alpha=0.25, lw=0, label="mean: spread")
-    ax.plot(eta, data["mean"], "-", color="tab:blue", label="mean")
-    ax.set_xlabel(r"$\eta = \Omega/\omega^*$")
-    ax.set_ylabel(r"$a / a^{noabs*}$")
+    ax.fill_between(eta, data["max_lo"], data["max_hi"], color="C3", alpha=0.2, lw=0, label="max: range of the runs")
+    ax.plot(eta, data["max"], "--", color="C3", label="max")
+    ax.fill_between(eta, data["mean_lo"], data["mean_hi"], color="C0", alpha=0.3, lw=0, hatch="////",
+                    label="mean: range of the runs")
+    ax.plot(eta, data["mean"], "-", color="C0", label="mean")
+    ax.set_xlabel(ETA_LABEL)
+    ax.set_ylabel(RESPONSE_LABEL)
     ax.set_title(title, fontsize=9)
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
+    if data.get("a_noabs"):
+        secondary_mm(ax, data["a_noabs"])
 
 
 def plot_sweep(data: Mapping[str, Any], path: str | os.PathLike, title: str) -> None:
     """Fig. 5 of one frequency response, written to `path`."""
-    with plot_to(path, figsize=(6.0, 4.0)) as (fig, ax):
+    with plot_to(path, figsize=(7.0, 4.0)) as (fig, ax):
         draw_sweep(ax, data, title)
-        ax.legend(fontsize=8)
+        legend_beside(ax)
 
 
 def plot_sweeps(panels: Sequence[tuple[Mapping[str, Any], str]], path: str | os.PathLike, title: str) -> None:
-    """Fig. 5: one panel per (frequency response, panel title), two columns, written to `path`."""
+    """Fig. 5: one panel per (frequency response, panel title), two columns on one y scale (the panels are
+    compared), one legend below them, written to `path`."""
     from sim.common.files import pyplot
 
     plt = pyplot()
     columns = min(2, len(panels))
     rows = math.ceil(len(panels) / columns)
-    fig, axes = plt.subplots(rows, columns, figsize=(5.2 * columns, 3.6 * rows), squeeze=False)
+    fig, axes = plt.subplots(rows, columns, figsize=(5.6 * columns, 3.3 * rows + 0.9), squeeze=False, sharey=True,
+                             layout="constrained")
     try:
         for ax, (data, panel_title) in zip(axes.flat, panels):
             draw_sweep(ax, data, panel_title)
         for ax in axes.flat[len(panels):]:
             ax.set_visible(False)
-        axes.flat[0].legend(fontsize=7)
+        # one y range for all panels, from 0 to the highest band edge of any of them
+        axes.flat[0].set_ylim(0.0, 1.05 * max(ax.dataLim.y1 for ax in axes.flat[:len(panels)]))
+        for ax in axes[:, 1:].flat:
+            ax.set_ylabel("")  # the shared scale is labelled once, on the left
+        handles, labels = axes.flat[0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="outside lower center", ncols=4, fontsize=LEGEND_PT, frameon=False)
         fig.suptitle(title, fontsize=10)
-        fig.tight_layout()
         save_figure(fig, path)
     finally:
         plt.close(fig)
 
 
+def _reduction(value: float) -> str:
+    """'25-fold' for a resonant level of 0.04 a_noabs*: how many times smaller than without absorber."""
+    return f"{1 / value:.0f}-fold" if value > 0 else "-"
+
+
 def draw_overview(ax: Any, data: Mapping[str, Any], title: str, *, paper_optimum: bool = False) -> None:
     """Fig. 6 on `ax`: the resonant mean (solid) and max (dashed) level vs the excitation level, each with the
     range of its repetition samples at the resonant eta as error bars, the regime of each level (APR, SMR,
-    linear: `sim.stepped_sine.measures.classify_regime` through the aggregation) above the axes, this model's optimum (the
-    lowest resonant mean) and, with `paper_optimum`, the paper's landmarks: the optimum (a_base/a_base* ~ 6.7 with its
-    mean and max levels, Sect. 5.3) and the almost periodic level at 7.4 (Appendix B)."""
+    linear: `sim.stepped_sine.measures.classify_regime` through the aggregation) shaded behind the data, this model's optimum
+    (the lowest resonant mean) and, with `paper_optimum`, the paper's landmarks: the optimum (a_base/a_base* ~ 6.7
+    with its mean and max levels, Sect. 5.3) and the almost periodic level at 7.4 (Appendix B)."""
     import numpy as np
 
     levels = np.asarray(data["levels"], dtype=float)
-    for name, style, color in (("max", "s--", "tab:red"), ("mean", "o-", "tab:blue")):
+    shade_regimes(ax, levels, data["regime"])
+    for name, style, color in (("max", "s--", "C3"), ("mean", "o-", "C0")):
         value = np.asarray(data[f"resonant_{name}"], dtype=float)
         spread = [value - np.asarray(data[f"resonant_{name}_lo"], dtype=float),
                   np.asarray(data[f"resonant_{name}_hi"], dtype=float) - value]
         ax.errorbar(levels, value, yerr=spread, fmt=style, color=color, ms=4, capsize=2, lw=1.2,
-                    label=f"resonant {name} (bars: spread of the runs)")
-    for level, regime in zip(levels, data["regime"]):
-        ax.annotate(regime, (level, 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom", fontsize=7,
-                    rotation=90)
+                    label=f"resonant {name} (bars: range of the runs)")
     best = int(np.argmin(data["resonant_mean"]))
-    ax.axvline(levels[best], color="tab:green", lw=1, ls=":",
-               label=f"optimum of this model ({levels[best]:g}: mean /{1 / data['resonant_mean'][best]:.0f}, "
-                     f"max /{1 / data['resonant_max'][best]:.0f})")
+    ax.axvline(levels[best], color="C2", lw=1.2, ls=":",
+               label=f"optimum of this model at {levels[best]:g}: mean reduced "
+                     f"{_reduction(data['resonant_mean'][best])}, max {_reduction(data['resonant_max'][best])}")
     if paper_optimum:
         draw_paper_landmarks(ax)
-    ax.set_xlabel(r"$a_{base} / a^*_{base}$")
-    ax.set_ylabel(r"resonant level $a / a^{noabs*}$")
+    ax.set_xlabel(LEVEL_LABEL)
+    ax.set_ylabel(f"resonant level {RESPONSE_LABEL}")
     ax.set_ylim(bottom=0)
-    ax.set_title(title, pad=28, fontsize=9)
+    ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
 
 
@@ -103,101 +191,112 @@ def draw_paper_landmarks(ax: Any) -> None:
     from matplotlib.patches import Rectangle
 
     ax.axvline(PAPER_OPTIMUM_LEVEL, color="k", lw=1, ls="-.", alpha=0.6,
-               label=f"paper's optimum ({PAPER_OPTIMUM_LEVEL:g}: mean /{PAPER_REDUCTION_MEAN:g}, "
-                     f"max /{PAPER_REDUCTION_MAX:g}, stars)")
+               label=f"paper's optimum at {PAPER_OPTIMUM_LEVEL:g} (stars): mean reduced {PAPER_REDUCTION_MEAN:g}-fold, "
+                     f"max {PAPER_REDUCTION_MAX:g}-fold")
     ax.plot([PAPER_OPTIMUM_LEVEL] * 2, [1 / PAPER_REDUCTION_MEAN, 1 / PAPER_REDUCTION_MAX], "k*", ms=8)
     ax.add_patch(Rectangle((7.2, PAPER_APR_LEVEL[0]), 0.4, PAPER_APR_LEVEL[1] - PAPER_APR_LEVEL[0],
-                           facecolor="0.6", alpha=0.5,
+                           facecolor="0.6", alpha=0.5, hatch="xx",
                            label=f"paper's almost periodic level at 7.4 ({PAPER_APR_LEVEL[0]:g}-"
                                  f"{PAPER_APR_LEVEL[1]:g}, App. B)"))
 
 
-def plot_overview(data: Mapping[str, Any], path: str | os.PathLike, title: str, *, paper_optimum: bool = False) -> None:
-    """Fig. 6, written to `path`."""
-    with plot_to(path, figsize=(6.5, 4.4)) as (fig, ax):
+def plot_overview(data: Mapping[str, Any], path: str | os.PathLike, title: str, *, paper_optimum: bool = False,
+                  mm_per_level: float | None = None) -> None:
+    """Fig. 6, written to `path`; the legend beside the axes states the factor to the tip amplitude in mm
+    (`tip_note`; from the data's sweeps when they carry a_noabs, m, else `mm_per_level`)."""
+    sweeps = data.get("sweeps") or []
+    if mm_per_level is None and sweeps and sweeps[0].get("a_noabs") and sweeps[0].get("level"):
+        mm_per_level = 1e3 * sweeps[0]["a_noabs"] / sweeps[0]["level"]  # a_noabs* grows with a_base (Sect. 5)
+    with plot_to(path, figsize=(9.5, 4.4)) as (fig, ax):
         draw_overview(ax, data, title, paper_optimum=paper_optimum)
-        ax.legend(fontsize=7, loc="upper left")  # the low SMR levels leave that corner free
+        legend_beside(ax, title=tip_note(mm_per_level))
 
 
 def plot_series(series: Sequence[tuple[str, Mapping[str, Any]]], path: str | os.PathLike, title: str,
-                paper_line: tuple[float, str] | None = None, *, paper_landmarks: bool = False) -> None:
+                paper_line: tuple[float, str] | None = None, *, paper_landmarks: bool = False,
+                mm_per_level: float | None = None) -> None:
     """Figs. 11 and C.1a: the resonant mean level against the excitation level, one curve per value of a series
     (`series`: [(label, `sim.stepped_sine.tables.overview_data` keys)]), each with the range of its runs as error bars;
     paper_line: (level, what the paper says there) marked as a vertical line; paper_landmarks: the paper's Fig. 6
-    landmarks (draw_paper_landmarks; `ies compare`)."""
+    landmarks (draw_paper_landmarks; `ies compare`); mm_per_level: the factor to the tip amplitude (`tip_note`)."""
     import numpy as np
 
-    many = len(series) > 6  # legend beside the axes; markers and line styles tell apart curves of one colour
-    with plot_to(path, figsize=(9.5, 4.4) if many else (6.5, 4.4)) as (fig, ax):
+    with plot_to(path, figsize=(9.5, 4.4)) as (fig, ax):
         for i, (label, data) in enumerate(series):
             levels = np.asarray(data["levels"], dtype=float)
             value = np.asarray(data["resonant_mean"], dtype=float)
             spread = [value - np.asarray(data["resonant_mean_lo"], dtype=float),
                       np.asarray(data["resonant_mean_hi"], dtype=float) - value]
-            fmt = "os^vD"[i // 10 % 5] + ("-", "--", ":")[i // 10 % 3]
-            ax.errorbar(levels, value, yerr=spread, fmt=fmt, ms=3, capsize=2, lw=1.2, label=label)
+            # markers and line styles tell apart curves of one colour (and in grayscale)
+            fmt = "osD^v<>ph*"[i % 10] + ("-", "--", ":", "-.")[i % 4]
+            ax.errorbar(levels, value, yerr=spread, fmt=fmt, ms=4, mfc="none" if i % 2 else None, capsize=2, lw=1.2,
+                        label=label)
         if paper_line is not None:
             ax.axvline(paper_line[0], color="k", lw=1, ls="-.", alpha=0.6, label=paper_line[1])
         if paper_landmarks:
             draw_paper_landmarks(ax)
             ax.set_ylim(bottom=0)
-        ax.set_xlabel("excitation level a_base / a_base*")
-        ax.set_ylabel("resonant mean a / a_noabs*")
-        ax.set_title(title, fontsize=8)
-        if many:
-            ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-        else:
-            ax.legend(fontsize=7, loc="upper left")
+        ax.set_xlabel(LEVEL_LABEL)
+        ax.set_ylabel(f"resonant mean {RESPONSE_LABEL}")
+        ax.set_title(title, fontsize=9)
+        ax.grid(alpha=0.3)
+        legend_beside(ax, title=tip_note(mm_per_level))
 
 
 def plot_scattering(overview: Mapping[str, Any], runs: Sequence[Mapping[str, Any]], path: str | os.PathLike,
                     title: str, figure: str) -> None:
-    """Fig. D.2 ("figD2": all and significant impacts per excitation period) or Fig. D.3 ("figD3": the modal
-    coefficient of restitution r, Eq. D.1, from the tip and from the wall, at the levels whose resonant response
-    is almost periodic) against the excitation level, at the resonant eta (`sim.stepped_sine.tables.overview_data` keys), each
-    with the range of the runs' own values as error bars (`runs`: rows with level and the measures; Appendix D)."""
+    """Fig. D.2 ("figD2": all and significant impacts per excitation period, the regimes shaded) or Fig. D.3
+    ("figD3": the modal coefficient of restitution r, Eq. D.1, from the tip and from the wall, at the levels whose
+    resonant response is almost periodic: separate points, no line between levels) against the excitation level,
+    at the resonant eta (`sim.stepped_sine.tables.overview_data` keys), each with the range of the runs' own values as error
+    bars (`runs`: rows with level and the measures; Appendix D)."""
     import numpy as np
 
     levels = np.asarray(overview["levels"], dtype=float)
     if figure == "figD2":
-        curves = (("impacts_per_period", "all contact onsets", "s--", "tab:gray"),
-                  ("significant_impacts_per_period", "significant impacts", "o-", "tab:blue"))
+        curves = (("impacts_per_period", "all contact onsets", "s--", "C3", "none"),
+                  ("significant_impacts_per_period", "significant impacts", "o-", "C0", None))
         ylabel = "impacts per excitation period"
         keep = np.ones(levels.size, dtype=bool)
     else:
-        curves = (("restitution", "r from the tip (Eq. D.1)", "o-", "tab:blue"),
-                  ("restitution_wall", "r from the wall", "s--", "tab:red"))
-        ylabel = "modal coefficient of restitution r"
+        curves = (("restitution", "$r$ from the tip (Eq. D.1)", "o", "C0", None),
+                  ("restitution_wall", "$r$ from the wall", "s", "C3", "none"))
+        ylabel = "modal coefficient of restitution $r$"
         keep = np.array([regime == "APR" for regime in overview["regime"]])
-    with plot_to(path, figsize=(6.5, 4.4)) as (fig, ax):
-        for key, label, style, color in curves:
+    step = float(np.min(np.diff(np.unique(levels)))) if np.unique(levels).size > 1 else 1.0
+    with plot_to(path, figsize=(9.0, 4.4)) as (fig, ax):
+        if figure == "figD2":
+            shade_regimes(ax, levels, overview["regime"])
+        for k, (key, label, style, color, face) in enumerate(curves):
             value = np.asarray(overview[key], dtype=float)[keep]
+            # figD3: the two estimates side by side at each level, so that neither hides the other's bar
+            x = levels[keep] + (0.06 * step * (2 * k - 1) if figure == "figD3" else 0.0)
             per_run = [[float(r[key]) for r in runs if float(r["level"]) == level and key in r]
                        for level in levels[keep]]
             lo = np.array([np.nanmin(v) if np.isfinite(v).any() else np.nan for v in map(np.asarray, per_run)])
             hi = np.array([np.nanmax(v) if np.isfinite(v).any() else np.nan for v in map(np.asarray, per_run)])
             spread = [np.clip(value - lo, 0, None), np.clip(hi - value, 0, None)]
             if runs and key in runs[0]:
-                ax.errorbar(levels[keep], value, yerr=spread, fmt=style, color=color, ms=4, capsize=2, lw=1.2,
-                            label=f"{label} (bars: range of the runs)")
+                ax.errorbar(x, value, yerr=np.nan_to_num(spread), fmt=style, color=color, mfc=face, ms=5, capsize=2,
+                            lw=1.2, label=f"{label} (bars: range of the runs)")
             else:
-                ax.plot(levels[keep], value, style, color=color, ms=4, lw=1.2, label=label)
+                ax.plot(x, value, style, color=color, mfc=face, ms=5, lw=1.2, label=label)
         if figure == "figD3":
-            ax.axhline(0.8, color="k", lw=1, ls="-.", alpha=0.6, label="paper: r ~ 0.8 (Fig. D.3)")
-            ax.axhline(1.0, color="k", lw=0.8, alpha=0.3)
+            ax.axhline(0.8, color="k", lw=1, ls="-.", alpha=0.6, label="paper: $r$ ~ 0.8 (Fig. D.3)")
+            ax.axhline(1.0, color="k", lw=0.8, alpha=0.3, label="$r$ = 1: elastic")
         else:
             ax.axhline(2.0, color="k", lw=1, ls="-.", alpha=0.6, label="paper: 2 per period in APR (Fig. D.2)")
-        ax.set_xlabel(r"$a_{base} / a^*_{base}$")
+        ax.set_xlabel(LEVEL_LABEL)
         ax.set_ylabel(ylabel)
         ax.set_ylim(bottom=0)
         ax.set_title(title, fontsize=9)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
+        legend_beside(ax)
 
 
 def sweep_title(data: Mapping[str, Any]) -> str:
     """The title of a frequency response's figure from its data (`SweepResult.to_dict`)."""
-    return (f"a_base/a_base* = {data['level']:g}, {data['n_samples']} samples "
+    return (f"$a_\\mathrm{{base}}/a_\\mathrm{{base}}^*$ = {data['level']:g}, {data['n_samples']} samples "
             f"({data['protocol']['integrator']})")
 
 
@@ -233,53 +332,71 @@ def redraw_overview(folder: Path, options: PlotOptions) -> list[Path]:
 
 def draw_tip_response(ax: Any, t: Sequence[float], q_tip: Sequence[float], data: Mapping[str, Any]) -> None:
     """Fig. 4 on `ax`: q_tip / a_noabs* against t, the per-period amplitudes a / a_noabs* (steps, +-), their
-    mean (solid) and max (dashed) lines."""
+    mean (solid) and max (dashed) lines with their values; a right-hand axis gives the tip displacement in mm
+    (a_noabs* = data["a_noabs"], m)."""
     import numpy as np
 
     T = 1.0 / data["excitation_hz"]
     a = np.asarray(data["amplitudes"])
     edges = np.arange(a.size + 1) * T
-    ax.plot(t, np.asarray(q_tip) / data["a_noabs"], color="0.3", lw=0.6, label=r"$q_{tip}$")
+    ax.plot(t, np.asarray(q_tip) / data["a_noabs"], color="0.45", lw=0.6, label=r"$q_\mathrm{tip}$")
     for sign in (1, -1):
-        ax.stairs(sign * a, edges, baseline=None, color="tab:orange", lw=0.9,
+        ax.stairs(sign * a, edges, baseline=None, color="C1", lw=1.0,
                   label="amplitude per period" if sign > 0 else None)
-        ax.axhline(sign * data["mean"], color="tab:blue", ls="-", lw=1.0, label="mean" if sign > 0 else None)
-        ax.axhline(sign * data["max"], color="tab:red", ls="--", lw=1.0, label="max" if sign > 0 else None)
-    ax.set_ylabel(r"$q_{tip} / a^{noabs*}$")
+        ax.axhline(sign * data["mean"], color="C0", ls="-", lw=1.2, label=f"mean {data['mean']:.3f}" if sign > 0 else None)
+        ax.axhline(sign * data["max"], color="C3", ls="--", lw=1.2, label=f"max {data['max']:.3f}" if sign > 0 else None)
+    ax.set_ylabel(r"$q_\mathrm{tip}/a_\mathrm{noabs}^*$")
     ax.grid(alpha=0.3)
+    secondary_mm(ax, data["a_noabs"], r"$q_\mathrm{tip}$ (mm)")
 
 
-def draw_tip_velocity(ax: Any, t: Sequence[float], v_tip: Sequence[float], data: Mapping[str, Any]) -> None:
-    """Fig. 9a on `ax`: q_tip' / (Omega a_noabs*) against t with the impacts marked at their walls."""
+def draw_tip_velocity(ax: Any, t: Sequence[float], v_tip: Sequence[float], data: Mapping[str, Any],
+                      strip: Any = None) -> None:
+    """Fig. 9a on `ax`: q_tip' / (Omega a_noabs*) against t; the impacts as one marker per impact on the axes
+    `strip` (a row per wall, `draw_impacts`), or along the top edge of `ax` when no strip is given."""
     import numpy as np
 
     scale = 2.0 * math.pi * data["excitation_hz"] * data["a_noabs"]
     ax.plot(t, np.asarray(v_tip) / scale, color="0.3", lw=0.6)
-    for wall, color in (("left", "tab:green"), ("right", "tab:purple")):
-        times = [impact["t"] for impact in data["impacts"] if impact["wall"] == wall]
-        if times:
-            ax.vlines(times, 0.0, 1.0, transform=ax.get_xaxis_transform(), color=color, lw=0.6, alpha=0.6,
-                      label=f"impact, {wall} wall")
-    ax.set_ylabel(r"$\dot q_{tip} / (\Omega a^{noabs*})$")
-    ax.set_xlabel("t (s)")
+    ax.set_ylabel(r"$\dot q_\mathrm{tip}/(\Omega a_\mathrm{noabs}^*)$")
     ax.grid(alpha=0.3)
+    if strip is None:
+        for wall, marker in (("left", 7), ("right", 6)):  # caret down / up on the top edge
+            times = [impact["t"] for impact in data["impacts"] if impact["wall"] == wall]
+            ax.plot(times, [1.0] * len(times), ls="none", marker=marker, ms=4, color="C3",
+                    transform=ax.get_xaxis_transform(), clip_on=False)
+        ax.set_xlabel("t (s)")
+    else:
+        draw_impacts(strip, data["impacts"])
+
+
+def draw_impacts(ax: Any, impacts: Sequence[Mapping[str, Any]]) -> None:
+    """The impacts of a time history as a strip: one short tick per contact onset, a row per wall (readable at any
+    number of impacts, unlike a full-height line each)."""
+    for row, (wall, color) in enumerate((("left", "C0"), ("right", "C3"))):
+        times = [impact["t"] for impact in impacts if impact["wall"] == wall]
+        ax.plot(times, [row] * len(times), ls="none", marker="|", ms=9, mew=1.0, color=color)
+    ax.set_ylim(-0.6, 1.6)
+    ax.set_yticks([0, 1], ["left wall", "right wall"], fontsize=8)
+    ax.set_ylabel("impacts", fontsize=8)
+    ax.grid(alpha=0.3, axis="x")
+    ax.set_xlabel("t (s)")
 
 
 def plot_trace(data: Mapping[str, Any], t: Sequence[float], q_tip: Sequence[float], v_tip: Sequence[float],
                path: str | os.PathLike) -> None:
-    """Figs. 4 (top: tip response, amplitudes, mean and max) and 9a (bottom: tip velocity and impacts) of one
-    time history, in one file with a shared time axis."""
+    """Figs. 4 (top: tip response, amplitudes, mean and max) and 9a (middle: tip velocity; bottom: the impacts
+    on each wall) of one time history, in one file with a shared time axis and the legend beside the axes."""
     from sim.common.files import pyplot
 
     plt = pyplot()
-    fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(7.0, 6.0))
+    fig, (top, middle, bottom) = plt.subplots(3, 1, sharex=True, figsize=(9.0, 6.6), layout="constrained",
+                                              gridspec_kw={"height_ratios": (3, 3, 1)})
     try:
         draw_tip_response(top, t, q_tip, data)
-        draw_tip_velocity(bottom, t, v_tip, data)
+        draw_tip_velocity(middle, t, v_tip, data, strip=bottom)
         top.set_title(trace_title(data), fontsize=9)
-        top.legend(fontsize=7, loc="upper right", ncols=4)
-        if bottom.get_legend_handles_labels()[0]:  # no impacts (e.g. a sphere at rest under friction): no legend
-            bottom.legend(fontsize=7, loc="upper right", ncols=2)
+        legend_beside(top, title=r"values: $a/a_\mathrm{noabs}^*$")
         save_figure(fig, path)
     finally:
         plt.close(fig)
@@ -289,21 +406,23 @@ def plot_motion(t: Sequence[float], signal: Mapping[str, Sequence[float]], path:
     """Fig. C.1b: the displacements of both walls and of the sphere relative to the base (mm) over a time history."""
     import numpy as np
 
-    with plot_to(path, figsize=(7.0, 3.6)) as (fig, ax):
+    with plot_to(path, figsize=(8.5, 3.6)) as (fig, ax):
         t = np.asarray(t)
-        for key, label, color in (("q_wall_left", "left wall", "tab:blue"), ("q_wall_right", "right wall", "tab:red"),
-                                  ("q_sphere", "sphere", "k")):
-            ax.plot(t, 1e3 * np.asarray(signal[key]), color=color, lw=0.9, label=label)
+        for key, label, color, style in (("q_wall_left", "left wall", "C0", "-"), ("q_wall_right", "right wall", "C3", "--"),
+                                         ("q_sphere", "sphere", "k", "-")):
+            ax.plot(t, 1e3 * np.asarray(signal[key]), color=color, ls=style, lw=0.9, label=label)
         ax.set_xlabel("t (s)")
         ax.set_ylabel("displacement relative to the base (mm)")
-        ax.set_title(title, fontsize=8)
-        ax.legend(fontsize=7, loc="upper right", ncols=3)
+        ax.set_title(title, fontsize=9)
+        ax.grid(alpha=0.3)
+        legend_beside(ax)
 
 
 def trace_title(data: Mapping[str, Any]) -> str:
     """The title of a time history's figure from its JSON data (`sim.analysis.trace.trace_data`)."""
-    return (f"a_base/a_base* = {data['level']:g}, eta = {data['eta_actual']:.4f}: {data['periods']} periods at "
-            f"{data['fs'] / 1e3:.2f} kHz, {data['impacts_per_period']:.2f} contact onsets per period ({data['integrator']})")
+    return (f"$a_\\mathrm{{base}}/a_\\mathrm{{base}}^*$ = {data['level']:g}, $\\eta$ = {data['eta_actual']:.4f}: "
+            f"{data['periods']} periods at {data['fs'] / 1e3:.2f} kHz, {data['impacts_per_period']:.2f} contact onsets "
+            f"per period ({data['integrator']})")
 
 
 @register("ies trace --out", lambda folder: (folder / "trace.json").is_file() and (folder / "trace.csv").is_file())

@@ -1,0 +1,538 @@
+"""Every figure the workbench draws, checked with matplotlib's own geometry (issue 25, item 3): no legend covers a
+data artist of any panel, no title or suptitle overlaps another, legends are readable (>= 7 pt), panels that
+compare the same plot share one y scale, and the grayscale style leaves nothing in colour.
+
+The figures are drawn by the real drawing functions from small fabricated results (the shapes of the paper's
+curves: SMR levels near 0.05 of a_noabs*, APR above 7), so the whole file runs in seconds. A legend is tested
+against the display coordinates of the data themselves (line vertices and the segments between them, filled
+areas, bars, error bars, images, annotations), not against the artists' bounding boxes, so a legend in an empty
+corner of the axes passes and one on a curve fails.
+"""
+from __future__ import annotations
+
+import csv
+import json
+from collections.abc import Callable
+from itertools import pairwise
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+import pytest
+from matplotlib.collections import LineCollection, PathCollection
+from matplotlib.colors import to_rgba
+from matplotlib.image import AxesImage
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+from matplotlib.text import Text
+
+import sim.plots.figures
+import sim.common.files
+import sim.analysis.modal_fit
+import uq.figures
+from sim.plots.redraw import PlotOptions, style
+
+LEVELS = [2.0, 4.0, 5.3, 6.7, 7.0, 7.4, 7.8, 9.0]
+REGIMES = ["SMR", "SMR", "SMR", "SMR", "APR", "APR", "APR", "APR"]
+MIN_LEGEND_PT = 7.0
+STEP_PX = 2.0  # spacing of the points sampled along drawn segments
+
+
+# --- the geometry check ------------------------------------------------------------------------------------------
+
+def _densify(xy: np.ndarray, step: float = STEP_PX) -> np.ndarray:
+    """Points every `step` px (at most 200 per segment) along the polyline `xy` (display coordinates), its
+    vertices included."""
+    xy = xy[np.isfinite(xy).all(axis=1)]
+    if len(xy) < 2:
+        return xy
+    a, d = xy[:-1], np.diff(xy, axis=0)
+    n = np.clip(np.ceil(np.hypot(d[:, 0], d[:, 1]) / step), 1, 200).astype(int)
+    segment = np.repeat(np.arange(len(a)), n)
+    fraction = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
+    return np.concatenate([a[segment] + d[segment] * fraction[:, None], xy[-1:]])
+
+
+def _grid(box: Any, n: int = 7) -> np.ndarray:
+    """n x n points spread over a bounding box (display coordinates), inset by 1 px."""
+    xs = np.linspace(box.x0 + 1, box.x1 - 1, n)
+    ys = np.linspace(box.y0 + 1, box.y1 - 1, n)
+    return np.array([(x, y) for x in xs for y in ys])
+
+
+def _inside(points: np.ndarray, box: Any, inset: float = 1.0) -> bool:
+    if not len(points):
+        return False
+    x, y = points[:, 0], points[:, 1]
+    return bool(np.any((x > box.x0 + inset) & (x < box.x1 - inset) & (y > box.y0 + inset) & (y < box.y1 - inset)))
+
+
+def _name(artist: Any) -> str:
+    label = artist.get_label() if hasattr(artist, "get_label") else ""
+    return f"{type(artist).__name__} {label!r}" if label and not label.startswith("_") else type(artist).__name__
+
+
+def _covers(box: Any, artist: Any, ax: Any, renderer: Any) -> bool:
+    """Whether the legend box `box` lies on a visible part of a data artist of `ax`."""
+    clip = ax.get_window_extent(renderer)
+    if isinstance(artist, Line2D):
+        xy = artist.get_transform().transform(np.asarray(artist.get_xydata(), dtype=float))
+        drawn = xy if artist.get_linestyle() in ("None", "none", "", " ") else _densify(xy)
+        drawn = drawn[(drawn[:, 0] >= clip.x0) & (drawn[:, 0] <= clip.x1) & (drawn[:, 1] >= clip.y0) & (drawn[:, 1] <= clip.y1)]
+        return _inside(drawn, box)
+    if isinstance(artist, PathCollection):  # scatter markers: their offsets
+        offsets = artist.get_offset_transform().transform(np.asarray(artist.get_offsets(), dtype=float))
+        return _inside(offsets, box)
+    if isinstance(artist, AxesImage):
+        return artist.get_window_extent(renderer).overlaps(box)
+    if isinstance(artist, Text):
+        return bool(artist.get_text().strip()) and artist.get_window_extent(renderer).overlaps(box)
+    paths = artist.get_paths() if hasattr(artist, "get_paths") else [artist.get_path()]
+    transform = artist.get_transform()
+    filled = not isinstance(artist, LineCollection) and (artist.get_fill() if isinstance(artist, Patch) else True)
+    probe = _grid(box.intersection(box, clip) or box)
+    for path in paths:
+        outline = _densify(transform.transform(path.vertices))
+        if _inside(outline, box):
+            return True
+        if filled and len(path.vertices) > 2 and transform.transform_path(path).contains_points(probe).any():
+            return True
+    return False
+
+
+def _data_artists(ax: Any) -> list[Any]:
+    return [a for a in [*ax.lines, *ax.collections, *ax.patches, *ax.images, *ax.texts] if a.get_visible()]
+
+
+def layout_problems(fig: Any) -> list[str]:
+    """What is wrong with a figure's layout: legends on data or on each other, legends set below 7 pt, curves cut
+    off by the axis limits, panels of the same plot (same x and y labels) on different y scales, titles (axes
+    titles and the suptitle) overlapping each other."""
+    if not hasattr(fig.canvas, "get_renderer"):  # a bare matplotlib.figure.Figure (scans.figures)
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        FigureCanvasAgg(fig)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    problems = []
+    legends = [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None] + list(fig.legends)
+    for legend in legends:
+        box = legend.get_window_extent(renderer)
+        first = legend.get_texts()[0].get_text() if legend.get_texts() else "?"
+        for text in legend.get_texts():
+            if text.get_fontsize() < MIN_LEGEND_PT:
+                problems.append(f"legend {first!r}: {text.get_fontsize():.1f} pt text")
+                break
+        for ax in fig.axes:
+            for artist in _data_artists(ax):
+                if _covers(box, artist, ax, renderer):
+                    problems.append(f"legend {first!r} covers {_name(artist)} of the axes {ax.get_title()!r}")
+        for other in legends:
+            if other is not legend and other.get_window_extent(renderer).overlaps(box):
+                problems.append(f"legend {first!r} overlaps another legend")
+    for ax in fig.axes:  # no curve cut off by the axis limits (a shared scale set from one panel only)
+        x0, x1 = sorted(ax.get_xlim())
+        y0, y1 = sorted(ax.get_ylim())
+        for line in ax.lines:
+            if line.get_transform() != ax.transData or not line.get_visible():
+                continue
+            xy = np.asarray(line.get_xydata(), dtype=float)
+            xy = xy[np.isfinite(xy).all(axis=1)]
+            slack = 1e-9 * max(abs(y1 - y0), 1e-300)
+            if len(xy) and ((xy[:, 1] > y1 + slack).any() or (xy[:, 1] < y0 - slack).any()
+                            or (xy[:, 0] > x1).any() or (xy[:, 0] < x0).any()):
+                problems.append(f"{_name(line)} of the axes {ax.get_title()!r} runs beyond the axis limits")
+    panels: dict[tuple[str, str], list[Any]] = {}
+    for ax in fig.axes:  # the same plot in several panels (Fig. 5's levels): compared on one y scale
+        if ax.get_visible() and ax.get_ylabel():
+            panels.setdefault((ax.get_xlabel(), ax.get_ylabel()), []).append(ax)
+    for (_, ylabel), group in panels.items():
+        ranges = {tuple(round(v, 12) for v in ax.get_ylim()) for ax in group}
+        if len(ranges) > 1:
+            problems.append(f"{len(group)} panels of {ylabel!r} on {len(ranges)} different y scales")
+    titles = [t for ax in fig.axes for t in (ax.title, ax._left_title, ax._right_title)]
+    if fig._suptitle is not None:
+        titles.append(fig._suptitle)
+    titles = [t for t in titles if t.get_visible() and t.get_text().strip()]
+    for i, a in enumerate(titles):
+        for b in titles[i + 1:]:
+            if a.get_window_extent(renderer).overlaps(b.get_window_extent(renderer)):
+                problems.append(f"title {a.get_text()!r} overlaps title {b.get_text()!r}")
+    return problems
+
+
+def colours(fig: Any) -> list[tuple[float, ...]]:
+    """The RGBA colours of every data artist's faces, edges and lines."""
+    out = []
+    for ax in fig.axes:
+        for artist in _data_artists(ax):
+            if isinstance(artist, Line2D):
+                out += [to_rgba(artist.get_color()), to_rgba(artist.get_markerfacecolor()),
+                        to_rgba(artist.get_markeredgecolor())]
+            elif isinstance(artist, (Patch,)):
+                out += [artist.get_facecolor(), artist.get_edgecolor()]
+            elif hasattr(artist, "get_facecolor"):
+                out += [tuple(c) for c in artist.get_facecolor()] + [tuple(c) for c in artist.get_edgecolor()]
+    return out
+
+
+@pytest.fixture
+def checked(monkeypatch, tmp_path):
+    """Run a drawing function; every figure it would save is checked instead (drawn once, not written: the files
+    are other tests' business) before it is closed. Returns {file name: {"problems", "colours", "legend" (the
+    legends' texts and titles), "ylim" (per axes)}}."""
+    found: dict[str, dict[str, Any]] = {}
+
+    def check_then_save(fig: Any, path: Any) -> Path:
+        legends = [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None] + list(fig.legends)
+        found[Path(path).name] = {"problems": layout_problems(fig), "colours": colours(fig),
+                                  "legend": [t.get_text() for lg in legends for t in [*lg.get_texts(), lg.get_title()]],
+                                  "ylim": [ax.get_ylim() for ax in fig.axes]}
+        return Path(path)
+
+    for module in (sim.common.files, sim.plots.figures, uq.figures, sim.analysis.modal_fit):
+        monkeypatch.setattr(module, "save_figure", check_then_save)
+
+    def run(draw: Callable[[Path], Any]) -> dict[str, dict[str, Any]]:
+        found.clear()
+        draw(tmp_path)
+        assert found, "nothing was drawn"
+        return dict(found)
+
+    return run
+
+
+# --- fabricated results ------------------------------------------------------------------------------------------
+
+def _write(path: Path, rows: list[dict]) -> None:
+    with open(path, "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def _resonant(level: float, regime: str) -> tuple[float, float]:
+    """A plausible resonant mean and max (a/a_noabs*) at a level: flat SMR, rising APR (Fig. 6's shape)."""
+    return (0.05 + 0.002 * level, 0.15 + 0.004 * level) if regime == "SMR" else (0.05 + 0.03 * (level - 6.8),
+                                                                                0.08 + 0.03 * (level - 6.8))
+
+
+def sweep_data(level: float, regime: str) -> dict[str, Any]:
+    eta = np.linspace(0.95, 1.05, 41)
+    mean, peak = _resonant(level, regime)
+    if regime == "APR":  # the almost periodic peak of a frequency response stands high above the SMR plateau
+        mean, peak = 4 * mean + 0.15, 4 * peak + 0.15
+    shape = 1.0 / (1.0 + ((eta - 0.99) / 0.02) ** 2)
+    m, x = 0.2 * mean + 0.8 * mean * shape, 0.3 * peak + 0.7 * peak * shape
+    return {"eta": eta.tolist(), "mean": m.tolist(), "mean_lo": (0.9 * m).tolist(), "mean_hi": (1.1 * m).tolist(),
+            "max": x.tolist(), "max_lo": (0.85 * x).tolist(), "max_hi": (1.15 * x).tolist(), "level": level,
+            "n_samples": 3, "protocol": {"integrator": "exact", "sequence": "down"}, "a_noabs": level * 3.2e-4,
+            "a_base": level * 1.0e-6}
+
+
+def overview(levels: list[float] = LEVELS, regimes: list[str] = REGIMES) -> dict[str, list]:
+    data: dict[str, list] = {k: [] for k in ("levels", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi",
+                                             "resonant_max", "resonant_max_lo", "resonant_max_hi", "regime",
+                                             "impacts_per_period", "significant_impacts_per_period", "restitution",
+                                             "restitution_wall", "eta_resonant_mean", "a_base_m")}
+    for level, regime in zip(levels, regimes):
+        mean, peak = _resonant(level, regime)
+        data["levels"].append(level)
+        data["regime"].append(regime)
+        for name, value in (("mean", mean), ("max", peak)):
+            data[f"resonant_{name}"].append(value)
+            data[f"resonant_{name}_lo"].append(0.9 * value)
+            data[f"resonant_{name}_hi"].append(1.12 * value)
+        data["impacts_per_period"].append(6.0 if regime == "SMR" else 2.4)
+        data["significant_impacts_per_period"].append(1.1 if regime == "SMR" else 2.0)
+        data["restitution"].append(0.84 + 0.002 * level if regime == "APR" else float("nan"))
+        data["restitution_wall"].append(0.86 + 0.002 * level if regime == "APR" else float("nan"))
+        data["eta_resonant_mean"].append(0.99)
+        data["a_base_m"].append(level * 1.0e-6)
+    return data
+
+
+def response_folder(folder: Path, figures: tuple[str, ...] = ("fig5", "fig6", "figD2", "figD3"),
+                    levels: list[float] = LEVELS, regimes: list[str] = REGIMES) -> Path:
+    """A response study's files (study.json, overview.csv, sweeps.csv, runs.csv) as `uq.execute` writes them."""
+    folder.mkdir(parents=True, exist_ok=True)
+    study = {"kind": "response", "model": "ies", "repetitions": 3, "levels": levels, "response": {"figures": list(figures)},
+             "contact_law": "hertz", "protocol_resolved": {"wait": 2.0, "hold": 1.0, "integrator": "exact",
+                                                            "sequence": "down"}}
+    (folder / "study.json").write_text(json.dumps({"study": study, "outputs": ["mean", "max"]}))
+    data = overview(levels, regimes)
+    _write(folder / "overview.csv", [{"level": lv, **{k: v[i] for k, v in data.items() if k != "levels"}}
+                                     for i, lv in enumerate(data["levels"])])
+    rows = []
+    for level, regime in zip(levels, regimes):
+        sweep = sweep_data(level, regime)
+        rows += [{"level": level, **{k: sweep[k][i] for k in ("eta", "mean", "mean_lo", "mean_hi", "max", "max_lo",
+                                                               "max_hi")}} for i in range(len(sweep["eta"]))]
+    _write(folder / "sweeps.csv", rows)
+    runs = []
+    for i, (level, regime) in enumerate(zip(levels, regimes)):
+        for rep, f in enumerate((0.97, 1.0, 1.04)):
+            runs.append({"level": level, "rep": rep, **{k: data[k][i] * f for k in (
+                "impacts_per_period", "significant_impacts_per_period", "restitution", "restitution_wall")}})
+    _write(folder / "runs.csv", runs)
+    return folder
+
+
+#: Table 2 (`uq.space.TABLE2`): g and k_H vary upwards from the nominal value, so a corner lies on the nominal curve
+PARAMETERS = {"D": {"nominal": 0.00085, "min": 0.00075, "max": 0.0009, "unit": "-", "label": "modal damping ratio D_1"},
+              "g": {"nominal": 0.00058, "min": 0.00058, "max": 0.000612, "unit": "m", "label": "clearance g"},
+              "k_H": {"nominal": 282e3 * 1e3**1.5, "min": 282e3 * 1e3**1.5, "max": 428e3 * 1e3**1.5,
+                      "unit": "N/m^1.5", "label": "Hertzian spring constant k_H"}}
+#: the response of each parameter's lower and upper corner relative to the nominal one
+CORNER_FACTORS = {"D": (1.15, 0.9), "g": (1.0, 1.06), "k_H": (1.0, 0.94)}
+
+
+def interval_folder(folder: Path, output: str = "mean", levels: list[float] = LEVELS,
+                    regimes: list[str] = REGIMES) -> Path:
+    """An interval study's files (study.json, points.csv, bands.csv): individual, joint and residual designs."""
+    folder.mkdir(parents=True, exist_ok=True)
+    outputs = ["mean", "max"] if output == "mean" else [output]
+    study = {"kind": "interval", "model": "ies", "repetitions": 3, "levels": levels, "parameters": PARAMETERS}
+    (folder / "study.json").write_text(json.dumps({"study": study, "outputs": outputs}))
+    points, bands = [], []
+    for level, regime in zip(levels, regimes):
+        for out in outputs:
+            mean, peak = _resonant(level, regime)
+            value = {"mean": mean, "max": peak}.get(out, 0.85 + 0.002 * level)
+            points.append({"design": "nominal", "point": "nominal", "role": "nominal", "level": level, "output": out,
+                           "mean": value, "se": 0.02 * value, "regime": regime})
+            for name, factors in CORNER_FACTORS.items():
+                design = f"individual:{name}"
+                for corner, factor in zip(("min", "max"), factors):
+                    points.append({"design": design, "point": f"{name}={PARAMETERS[name][corner]:.6g}",
+                                   "role": "corner", "level": level, "output": out, "mean": value * factor,
+                                   "se": 0.02 * value, "regime": regime})
+                bands.append(_band_row(design, out, level, value * min(factors), value * max(factors), value))
+            bands.append(_band_row("joint", out, level, 0.8 * value, 1.25 * value, value))
+            bands.append(_band_row("residual", out, level, 0.93 * value, 1.08 * value, value))
+    _write(folder / "points.csv", points)
+    _write(folder / "bands.csv", bands)
+    return folder
+
+
+def _band_row(design: str, output: str, level: float, lower: float, upper: float, nominal: float) -> dict:
+    return {"design": design, "output": output, "level": level, "lower": lower, "upper": upper,
+            "lower_se": 0.02 * lower, "upper_se": 0.02 * upper, "nominal": nominal, "nominal_se": 0.02 * nominal,
+            "flagged": 0, "tested": 1, "nominal_outside": 0 if design != "residual" else -1}
+
+
+def sobol_folder(folder: Path) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    study = {"kind": "sobol", "repetitions": 2, "levels": [5.3, 6.7, 7.4], "parameters": PARAMETERS,
+             "sobol": {"n": 64}}
+    (folder / "study.json").write_text(json.dumps({"study": study, "outputs": ["mean"]}))
+    rows, var = [], []
+    rng = np.random.default_rng(1)
+    for level in (5.3, 6.7, 7.4):
+        for name in PARAMETERS:
+            s1 = rng.uniform(-0.2, 0.8)
+            rows.append({"output": "mean", "level": level, "parameter": name, "S1": s1, "S1_conf": 0.6,
+                         "ST": s1 + 0.4, "ST_conf": 1.5})
+        var.append({"output": "mean", "level": level, "variance": 1e-4, "noise_variance": 3e-5, "noise_share": 0.3})
+    _write(folder / "sobol.csv", rows)
+    _write(folder / "variance.csv", var)
+    return folder
+
+
+def trace_data(periods: int = 80) -> tuple[dict, np.ndarray, np.ndarray, np.ndarray]:
+    """A time history in APR: two impacts per period (`periods` x 2 impact lines: the 'barcode')."""
+    f, fs = 114.6, 20e3
+    t = np.arange(int(periods / f * fs)) / fs
+    a_noabs = 7.4 * 3.2e-4
+    envelope = 0.12 + 0.04 * np.sin(2 * np.pi * t * 3.0)
+    q = a_noabs * envelope * np.sin(2 * np.pi * f * t)
+    v = np.gradient(q, t) + 0.02 * a_noabs * 2 * np.pi * f * np.sin(2 * np.pi * 1400 * t)
+    amplitudes = 0.12 + 0.04 * np.sin(2 * np.pi * (np.arange(periods) + 0.5) / f * 3.0)
+    impacts = [{"t": (k + 0.25) / f, "wall": "left"} for k in range(periods)] + \
+              [{"t": (k + 0.75) / f, "wall": "right"} for k in range(periods)]
+    data = {"excitation_hz": f, "amplitudes": amplitudes.tolist(), "a_noabs": a_noabs, "mean": float(amplitudes.mean()),
+            "max": float(amplitudes.max()), "impacts": impacts, "level": 7.4, "eta_actual": 0.9912, "periods": periods,
+            "fs": fs, "impacts_per_period": 2.0, "integrator": "exact"}
+    return data, t, q, v
+
+
+# --- the figures -------------------------------------------------------------------------------------------------
+
+def draw_response(tmp: Path) -> None:
+    uq.figures.response_figures(response_folder(tmp / "response"), PlotOptions(formats=(".png",)))
+
+
+def draw_sweep(tmp: Path) -> None:
+    sim.plots.figures.plot_sweep(sweep_data(7.4, "APR"), tmp / "fig5.png", sim.plots.figures.sweep_title(sweep_data(7.4, "APR")))
+
+
+def draw_overview_command(tmp: Path) -> None:
+    data = overview()
+    data.update(sweeps=[{"protocol": {"sequence": "down", "integrator": "exact"}}], reps=3)
+    sim.plots.figures.plot_overview(data, tmp / "fig6.png", sim.plots.figures.overview_title(data))
+
+
+def draw_interval(tmp: Path) -> None:
+    uq.figures.interval_figures(interval_folder(tmp / "fig7"), PlotOptions(formats=(".png",)))
+
+
+def draw_interval_restitution(tmp: Path) -> None:
+    apr = [i for i, r in enumerate(REGIMES) if r == "APR"][:3]
+    uq.figures.interval_figures(interval_folder(tmp / "figD3", "restitution", [LEVELS[i] for i in apr],
+                                                [REGIMES[i] for i in apr]), PlotOptions(formats=(".png",)))
+
+
+def draw_sobol(tmp: Path) -> None:
+    uq.figures.sobol_figure(sobol_folder(tmp / "sobol"), PlotOptions(formats=(".png",)))
+
+
+def draw_series(tmp: Path) -> None:
+    series = []
+    for k, g in enumerate((0.45, 0.5, 0.58, 0.65, 0.7, 0.8, 0.9, 1.0)):
+        data = overview()
+        for key in ("resonant_mean", "resonant_mean_lo", "resonant_mean_hi"):
+            data[key] = [v * (1 + 0.05 * k) for v in data[key]]
+        series.append((f"g={g}mm", data))
+    sim.plots.figures.plot_series(series, tmp / "fig11.png", "Resonant mean for each g (cf. Fig. 11)",
+                            uq.figures.SERIES_FIGURES["fig11"][1])
+    sim.plots.figures.plot_series(series[:3], tmp / "figC1.png", "Resonant mean for each g (cf. Fig. C.1)")
+    sim.plots.figures.plot_series(series[:2], tmp / "fig6-compare.png", "Resonant mean of each study", paper_landmarks=True)
+
+
+def draw_trace(tmp: Path) -> None:
+    data, t, q, v = trace_data()
+    sim.plots.figures.plot_trace(data, t, q, v, tmp / "trace.png")
+
+
+def draw_motion(tmp: Path) -> None:
+    _, t, q, _ = trace_data(20)
+    g = 0.58e-3
+    signal = {"q_wall_left": 0.3 * q + g / 2, "q_wall_right": 0.3 * q - g / 2,
+              "q_sphere": 0.3 * q + 0.45 * g * np.sign(np.sin(2 * np.pi * 114.6 * t + 0.3))}
+    sim.plots.figures.plot_motion(t, signal, tmp / "motion.png", "g=0.58mm: a_base/a_base* = 7.4, eta = 0.9912 "
+                            "(cf. Fig. C.1b), 20 periods")
+
+
+def draw_modal_fit(tmp: Path) -> None:
+    data, t, _, v = trace_data(12)
+    impacts = np.array(sorted(i["t"] for i in data["impacts"]))
+
+    class Signal:
+        def __init__(self) -> None:
+            self.t = t
+
+        def __getitem__(self, key: str) -> np.ndarray:
+            return v
+
+    windows = [SimpleNamespace(start=a, stop=b, well_posed=k % 5 != 3) for k, (a, b) in
+               enumerate(pairwise(impacts))]
+    fit = SimpleNamespace(signal=Signal(), impacts=impacts, windows=windows, excitation_hz=114.6,
+                          reconstruction=lambda s: np.interp(s, t, v) * 1.02)
+    sim.analysis.modal_fit.plot_modal_fit(fit, tmp / "fig9b.png", velocity_scale=2 * np.pi * 114.6 * data["a_noabs"])
+
+
+def draw_calibrate(tmp: Path) -> None:
+    from bem_contact.cli import plot
+
+    deltas = np.linspace(0.1e-6, 2e-6, 8)
+    k_H_star = 282e3 * 1e3**1.5
+    plot({"deltas": deltas, "forces": 0.97 * k_H_star * deltas**1.5, "k_H": 0.97 * k_H_star, "k_H_ratio": 0.97,
+          "k_H_star": k_H_star}, "ideal sphere on the flat wall", str(tmp / "calibrate.png"))
+
+
+def draw_scan_calibrate(tmp: Path) -> None:
+    from scans.figures import calibration_figure
+
+    n, pitch = 80, 5e-6
+    x = (np.arange(n) - n / 2) * pitch
+    r = np.hypot(*np.meshgrid(x, x))
+    height = -2e-6 * np.exp(-(r / 60e-6) ** 2) + 0.3e-6 * np.exp(-((r - 90e-6) / 20e-6) ** 2)
+    surface = SimpleNamespace(overview=height, x0=x[0], y0=x[0], pitch=pitch, source="crater.ply")
+    sphere = SimpleNamespace(describe=lambda: "brass sphere R = 1.5 mm with steel wall")
+    contact = SimpleNamespace(surface=surface, centre=(0.0, 0.0), side=0.2e-3, placement="deepest", sphere=sphere)
+    metrics = SimpleNamespace(diameter=0.15e-3, depth=2e-6, rim_height=0.3e-6)
+    deltas = np.linspace(0.1e-6, 2e-6, 8)
+    k_H_star = 282e3 * 1e3**1.5
+    fig = calibration_figure(contact, metrics, deltas, 0.97 * k_H_star * deltas**1.5, 0.97 * k_H_star, k_H_star)
+    sim.common.files.save_figure(fig, tmp / "scan-calibrate.png")
+
+
+FIGURES = {"response (fig5, fig6, figD2, figD3)": draw_response, "sweep": draw_sweep, "overview": draw_overview_command,
+           "interval (fig7, fig8, nominal-levels)": draw_interval, "interval of r (figD3)": draw_interval_restitution,
+           "sobol": draw_sobol, "series (fig11, figC1, compare)": draw_series, "trace": draw_trace,
+           "motion": draw_motion, "modal-fit (fig9b)": draw_modal_fit, "calibrate": draw_calibrate,
+           "calibrate a scan": draw_scan_calibrate}
+
+
+@pytest.mark.parametrize("look", [None, "classic"])  # the default style, and one a user may pick (ies plot --style)
+@pytest.mark.parametrize("name", FIGURES)
+def test_no_legend_on_data_and_no_title_on_a_title(checked, name, look):
+    with style(look):
+        drawn = checked(FIGURES[name])
+    problems = [f"{file}: {problem}" for file, found in drawn.items() for problem in found["problems"]]
+    if problems:
+        pytest.fail("\n".join(problems), pytrace=False)
+
+
+@pytest.mark.parametrize("name", ["response (fig5, fig6, figD2, figD3)", "interval (fig7, fig8, nominal-levels)",
+                                  "interval of r (figD3)", "sobol", "trace", "series (fig11, figC1, compare)"])
+def test_grayscale_leaves_nothing_in_colour(checked, name):
+    with style("grayscale"):
+        drawn = checked(FIGURES[name])
+    coloured = {file: sorted({tuple(round(c, 2) for c in rgba[:3]) for rgba in found["colours"]
+                              if rgba[3] > 0 and max(rgba[:3]) - min(rgba[:3]) > 0.02})
+                for file, found in drawn.items()}
+    assert not any(coloured.values()), coloured
+
+
+def test_the_check_sees_a_legend_on_a_curve_and_passes_one_in_an_empty_corner():
+    """The check itself: a legend on the rising curve fails, the same legend in the empty upper-left corner passes
+    (a bounding-box test of the line would fail both), and two titles on one another fail."""
+    import matplotlib.pyplot as plt
+
+    for loc, bad in (("lower right", True), ("upper left", False)):
+        fig, ax = plt.subplots(figsize=(5, 4))
+        x = np.linspace(0, 1, 50)
+        ax.plot(x, 0.03 + x**60, label="a curve")  # low across the width, rising at the right end
+        ax.set_ylim(0, 1.1)
+        ax.legend(loc=loc, fontsize=8)
+        problems = layout_problems(fig)
+        plt.close(fig)
+        assert bool(problems) == bad, (loc, problems)
+    fig, ax = plt.subplots()
+    ax.set_title("a panel's title")
+    fig.suptitle("a figure's title", y=0.89)
+    assert any("overlaps title" in p for p in layout_problems(fig))
+    plt.close(fig)
+
+
+@pytest.mark.parametrize("level", [1.26, 6.7, 7.4])
+def test_the_stated_factor_to_mm_is_a_noabs_star_of_the_level(level):
+    """The level plots' factor (Eq. B.1: (phi_tip/phi_c) g* per unit level) times the level is the resonant tip
+    amplitude without absorber of Sect. 5, phi_tip (phi^T M b) a_base / (2 D*), at a_base = level a_base*: the two
+    definitions agree, so a/a_noabs* x level x factor is the tip amplitude in mm."""
+    from sim.hosts.rig import seed_rig_model
+    from sim.model.system import a_base_star, a_noabs_star
+
+    model = seed_rig_model()
+    expected = 1e3 * a_noabs_star(model, level * a_base_star(model))
+    assert level * sim.plots.figures.tip_mm_per_level(model) == pytest.approx(expected, rel=1e-12)
+
+
+def test_legends_give_values_and_the_sobol_range_is_explained(checked):
+    """Fig. 7's legends name the corners' values in Table 2's units (g = 0.580 and 0.612 mm, not 'g min/max'), the
+    level plots state the factor to mm, and the Sobol' axis keeps to [-0.25, 1.25] and says why estimates run
+    beyond it (sampling error of a small n)."""
+    fig7 = checked(draw_interval)["fig7.png"]
+    assert {"$g$ = 0.580 mm", "$g$ = 0.612 mm", "$D$ = 0.075 %"} <= set(fig7["legend"])
+    assert not any(" min" in text or " max" in text for text in fig7["legend"])
+    fig6 = checked(draw_response)["fig6.png"]
+    assert any("0.557 mm (Eq. B.1)" in text for text in fig6["legend"])
+    sobol = checked(draw_sobol)["sobol.png"]
+    assert sobol["ylim"] == [(-0.25, 1.25)]
+    assert any("raise [sobol] n (now 64)" in text for text in sobol["legend"])
