@@ -15,7 +15,7 @@
 * `ies plot DIR`: redraw the figures of a result folder from its data (`sim.plots.redraw`), in other formats, another
   matplotlib style or for a subset of the levels, without recomputing.
 * `ies compare DIR DIR ... --out OUT`: the Fig. 6 landmarks of several response studies side by side with the
-  paper's (`uq.compare`; the README's fidelity table), a table and one figure.
+  paper's (`uq.compare`; the fidelity report's table), a table and one figure.
 
 `add_commands(subparsers, calibrate=...)` registers them with the front door (`uq.cli`), which hands over
 the calibration as a callable: this stage never imports the contact stage itself. Heavy imports stay

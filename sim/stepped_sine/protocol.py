@@ -32,7 +32,7 @@ Initial conditions (`SteppedSine.start`; the paper says only "homogeneous initia
   active" far from resonance; Figs. 5, 6 show impacting responses down to a_base/a_base* = 1.26).
 * ``"rest"``: y = 0, the sphere centred at rest. Far below resonance the walls never reach it; an up-sweep
   then stays on the linear branch up to eta ~ 1 - D_1 level and its largest "mean" is the last linear
-  point before the first impact (~1/level), not a resonant level of the IES (fidelity report, README).
+  point before the first impact (~1/level), not a resonant level of the IES (uq/studies/fidelity/README.md).
 Evidence for the default (updated rig model, exact integrator, 0.96:1.02:31, 3 s / 5 s, 3 runs):
 ``ies overview --sequence up --start base-velocity`` gives the paper's Fig. 6 shape (a flat SMR plateau,
 mean 0.04-0.06 and max 0.12-0.2 of a_noabs*, then a sharp switch to APR with mean rising with the level);
