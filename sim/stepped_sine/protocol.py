@@ -249,7 +249,9 @@ class SweepResult:
     def resonant_spread(self, output: str) -> tuple[float, float, float]:
         """(lo, hi, standard error) of the resonant level `output` ("mean" or "max"): the range of its repetition
         samples (all taken at its eta, so lo <= level <= hi) and the standard error of their average (NaN for a
-        single sample: no noise estimate)."""
+        single sample: no noise estimate). Each sample's own maximum over eta would not do: when the samples
+        peak at different eta it can lie above the maximum of the average (at level 4 a "lower" bound 0.0457
+        above the value 0.0452)."""
         samples = self.resonant_mean_samples if output == "mean" else self.resonant_max_samples
         level = self.resonant_mean if output == "mean" else self.resonant_max
         se = float(np.std(samples, ddof=1) / np.sqrt(samples.size)) if samples.size >= 2 else math.nan
