@@ -16,6 +16,11 @@ Gaussian filter (--denoise, default 90 um; 0 = the raw scan, whose noise peaks b
 `scans.contact`). The libraries (`scans`, `bem_contact.calibration.calibrate_k_H`) do the work; this
 module only chooses the gap map (see `gap_source`), prints and plots.
 
+`--json` prints one object in SI units (also `calibration.json` of `ies reproduce`): k_H, k_H_star (Eq. 8),
+k_H_ratio, k_H_error (N/m^1.5, |k_H(N) - k_H(N/2)|), fit_residual, crater_depth, rim_height, crater_diameter,
+clearance_min, clearance_max (m), grid, solver, sphere, placement, holes, warnings, the curve and its settings;
+with --tangential k_t and k_t_mindlin (N/m), contact_radius (m), normal_force and normal_force_for_paper (N).
+
 `add_commands(subparsers)` registers the command with the front door (`uq.cli`); `calibrate_default`
 gives `ies reproduce` the calibration in process. The scans stage is imported here because reading a scan
 and pressing on it is the pipeline's arrow scans -> bem_contact. Heavy imports stay inside the functions,

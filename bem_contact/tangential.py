@@ -7,6 +7,14 @@ Cerruti influence operator (`bem_contact.influence.TangentialOperator`, solved b
 gradients), and k_t = sum(q_x) dx^2 / u_x. For a circle of radius a this converges to Mindlin's
 k_t = 8 G* a (Johnson, Contact Mechanics, Eq. 7.41); Dundurs' normal-tangential coupling is
 neglected, as in Mindlin's solution.
+
+The paper's 22 kN/mm is not reproduced, and it stays the friction element's default with this caveat. Under the
+sphere's weight (N = m_a g = 0.174 N, a = 23.9 um) the stuck sphere on the flat gives 2.965 kN/mm (BEM, grid 96)
+and 2.962 kN/mm (Mindlin), 7.43x below it. No assumption found gives 22 kN/mm for a physical reason: Mindlin
+reaches it at N = 71 N (410x the weight); E* instead of G* gives 14.4 kN/mm (E*/G* = 4.86 for nu = 0.3); the
+groove's two edge contacts (30 deg from the vertical, 0.58 N each) give 4.9 kN/mm with G* (24.0 with E*, and an
+edge is not a Hertz contact); Mindlin's secant stiffness to full slip at mu = 0.07 is 2.0 kN/mm; the Hertz
+contact at the largest simulated indentation, 40 um, would give 69.6 kN/mm.
 """
 from __future__ import annotations
 

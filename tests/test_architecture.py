@@ -1,4 +1,4 @@
-"""The pipeline's import rules (README, "The pipeline"), read from the source with `ast`:
+"""The pipeline's import rules, read from the source with `ast`:
 
 * the stages import each other only along the pipeline: sim stands alone; scans may use sim (its file
   writer); bem_contact may use scans and sim; uq may use sim;

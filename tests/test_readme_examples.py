@@ -1,10 +1,12 @@
-"""The README's example outputs are what the commands print (scikit-fem's habit of testing its examples).
+"""The README's examples are what the commands do (scikit-fem's habit of testing its examples).
 
 Every ``$ ies ...`` line in a fenced block of README.md is run as written (in process, in a fresh folder) and
 its output compared with the lines below it: exactly for the deterministic examples, where ``...`` stands
 for any text within a line (an absolute path) and a line of only ``...`` for any number of lines. The sweep
 example is a chaotic response and is compared with tolerances (see `test_the_sweep_example`); its wall time is
-not compared.
+not compared. Every ``ies ...`` line of a ```bash block (studies that take minutes) is parsed by the real
+command line, and the shipped study files it names must exist. Every command of `ies` has an example, and the
+README stays a guide of at most 350 lines.
 """
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from uq.cli import main
+from uq.cli import build_parser, main
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 
@@ -70,6 +72,40 @@ def test_the_readme_has_the_examples_that_are_checked():
 def test_deterministic_example(command, expected, tmp_path, monkeypatch, capsys):
     out = run(command, tmp_path, monkeypatch, capsys)
     assert re.fullmatch(pattern(expected), out), "README:\n" + "\n".join(expected) + f"\nprinted:\n{out}"
+
+
+README_MAX_LINES = 350
+ROOT = README.parent
+
+
+def bash_commands() -> list[str]:
+    """Every `ies ...` line of a ```bash block of README.md, without its comment."""
+    commands = []
+    for block in re.findall(r"^```bash\n(.*?)^```", README.read_text(), flags=re.M | re.S):
+        commands += [line.split("  #")[0].strip() for line in block.splitlines() if line.startswith("ies ")]
+    return commands
+
+
+def test_the_readme_is_a_short_guide():
+    assert len(README.read_text().splitlines()) <= README_MAX_LINES
+
+
+@pytest.mark.parametrize("command", bash_commands())
+def test_a_readme_command_is_one_the_command_line_accepts(command, capsys):
+    try:
+        build_parser().parse_args(shlex.split(command)[1:])
+    except SystemExit:
+        pytest.fail(f"README: `{command}` is refused: {capsys.readouterr().err.strip()}")
+    for word in shlex.split(command):
+        if word.startswith("uq/studies/"):
+            assert (ROOT / word).is_file(), f"README: `{command}` names {word}, which is not shipped"
+
+
+def test_every_command_has_an_example():
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.dest == "command")  # noqa: SLF001 - argparse keeps no public list
+    shown = {shlex.split(c)[1] for c in [*(c for c, _ in EXAMPLES), *bash_commands()]}
+    assert set(sub.choices) <= shown, set(sub.choices) - shown
 
 
 def test_the_pattern_of_an_example():

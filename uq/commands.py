@@ -15,7 +15,7 @@
 * `ies plot DIR`: redraw the figures of a result folder from its data (`sim.plots.redraw`), in other formats, another
   matplotlib style or for a subset of the levels, without recomputing.
 * `ies compare DIR DIR ... --out OUT`: the Fig. 6 landmarks of several response studies side by side with the
-  paper's (`uq.compare`; the README's fidelity table), a table and one figure.
+  paper's (`uq.compare`; the fidelity report's table), a table and one figure.
 
 `add_commands(subparsers, calibrate=...)` registers them with the front door (`uq.cli`), which hands over
 the calibration as a callable: this stage never imports the contact stage itself. Heavy imports stay
@@ -307,45 +307,63 @@ def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
 def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list, client: Any,
                calibrate: Calibrate, calibration: dict | None) -> int:
     """Calibration (the given one, or run unless disabled) when an interval study needs it, then each figure's
-    study, its figures and its summary."""
+    study, its figures and its table; then OUT/summary.txt, each figure's table.txt and OUT/index.md
+    (`uq.reproduce_report`)."""
+    from sim.common.files import report_written
+    from uq.reproduce_report import captured_stdout, write_index, write_summary
+
+    calibrated = False
+    sections: list[tuple[str, str]] = []
+    for figure, study in zip(figures, studies):
+        with captured_stdout() as printed:
+            calibration, calibrated = _reproduce_figure(args, figure, study, client, calibrate, calibration,
+                                                        calibrated)
+        sections.append((figure, printed.copy.getvalue()))
+    command = " ".join(["ies reproduce", args.figure, *(["--quick"] if args.quick else []), "--out", str(args.out)])
+    report_written([*write_summary(args.out, command, sections), write_index(args.out)])
+    return 0
+
+
+def _reproduce_figure(args: argparse.Namespace, figure: str, study: Any, client: Any, calibrate: Calibrate,
+                      calibration: dict | None, calibrated: bool) -> tuple[dict | None, bool]:
+    """One figure of `ies reproduce`: the calibration first if its study varies k_H and none was made yet, then
+    the study, its figures and its table. Returns (the calibration, whether it was made)."""
     from uq.errors import StudyError
     from uq.execute import run_interval_study, run_response_study
     from uq.figures import interval_figures, response_figures
     from uq.space import K_H_STAR, calibrated_k_H
 
     out = args.out
-    calibrated = False
-    for figure, study in zip(figures, studies):
-        if study.kind == "interval" and "k_H" in [p.name for p in study.space.varied]:  # calibrated once, first
-            if not calibrated and calibration is None and not args.no_calibration:
-                calibration = run_calibration(calibrate, out)
-            if calibration is not None:
-                k_cal = calibrated_k_H(calibration)
-                if k_cal < K_H_STAR:
-                    raise StudyError(f"the calibrated k_H = {k_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; a "
-                                     "crater should stiffen the contact: check the calibration or use --no-calibration")
-                if not calibrated:
-                    print(f"calibrated k_H = {k_cal:.4g} N/m^1.5 = {k_cal / K_H_STAR:.3f} k_H* (upper bound of k_H)")
-                study = with_calibration(study, k_cal)
-            calibrated = True
-        folder = out / figure
-        print(f"{figure}: {study.source} -> {folder}/")
-        run, draw = ((run_response_study, response_figures) if study.kind == "response"
-                     else (run_interval_study, interval_figures))
-        result = run(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet)
-        paths = draw(result.folder)
-        if figure in TRACED:
-            from uq.execute import series_traces
+    if study.kind == "interval" and "k_H" in [p.name for p in study.space.varied]:  # calibrated once, first
+        if not calibrated and calibration is None and not args.no_calibration:
+            calibration = run_calibration(calibrate, out)
+        if calibration is not None:
+            k_cal = calibrated_k_H(calibration)
+            if k_cal < K_H_STAR:
+                raise StudyError(f"the calibrated k_H = {k_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; a "
+                                 "crater should stiffen the contact: check the calibration or use --no-calibration")
+            if not calibrated:
+                print(f"calibrated k_H = {k_cal:.4g} N/m^1.5 = {k_cal / K_H_STAR:.3f} k_H* (upper bound of k_H)")
+            study = with_calibration(study, k_cal)
+        calibrated = True
+    folder = out / figure
+    print(f"{figure}: {study.source} -> {folder}/")
+    run, draw = ((run_response_study, response_figures) if study.kind == "response"
+                 else (run_interval_study, interval_figures))
+    result = run(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet)
+    paths = draw(result.folder)
+    if figure in TRACED:
+        from uq.execute import series_traces
 
-            paths += series_traces(study, folder, TRACED[figure])
-        s = result.summary
-        print(f"{figure}: {s['tasks']} runs ({s['ran']} run now), {s['failed_runs']} failed, "
-              f"{s['wall_time_s']:.1f} s; figures: {', '.join(p.name for p in paths)}")
-        if study.kind == "response":
-            print_response_result(folder, figure)
-        else:
-            print_interval_result(folder, s, figure)
-    return 0
+        paths += series_traces(study, folder, TRACED[figure])
+    s = result.summary
+    print(f"{figure}: {s['tasks']} runs ({s['ran']} run now), {s['failed_runs']} failed, "
+          f"{s['wall_time_s']:.1f} s; figures: {', '.join(p.name for p in paths)}")
+    if study.kind == "response":
+        print_response_result(folder, figure)
+    else:
+        print_interval_result(folder, s, figure)
+    return calibration, calibrated
 
 
 # ---- ies plot -----------------------------------------------------------------------------------------------

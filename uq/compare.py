@@ -1,11 +1,11 @@
-"""`ies compare`: the Fig. 6 landmarks of several response studies side by side, next to the paper's (README,
-"Fidelity"): one row per study (the switch from SMR to APR, the optimum and its reductions, the resonant level
+"""`ies compare`: the Fig. 6 landmarks of several response studies side by side, next to the paper's (the
+fidelity report, uq/studies/fidelity/README.md): one row per study (the switch from SMR to APR, the optimum and its reductions, the resonant level
 with its repetition range and regime at 7.4 and 9, the impacts, significant impacts, restitution r (Eq. D.1)
 and share of modes 2..N after the impacts at 7.4), and one figure with every study's resonant mean against the
 excitation level and the paper's landmarks (Sect. 5.3, Appendices B and D).
 
-Only the data files of the folders are read (study.json, overview.csv), never the runs: the table of the README's
-fidelity study is `ies compare ies-out/fidelity/* --out ies-out/fidelity-compare`.
+Only the data files of the folders are read (study.json, overview.csv), never the runs: the fidelity report's
+table is `ies compare ies-out/fidelity/* --out ies-out/fidelity-compare`.
 """
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Sequence
 
+from sim.common.outputs import Column, OutputFile
 from sim.stepped_sine.measures import PAPER_APR_LEVEL, PAPER_IMPACTS_PER_PERIOD, PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, \
     PAPER_REDUCTION_MEAN
 from uq.errors import StudyError
@@ -23,11 +24,27 @@ from uq.errors import StudyError
 LANDMARK_LEVELS = (7.4, 9.0)
 #: measures of overview.csv reported at the first landmark level (the resonant eta there)
 SCATTERING_AT_7_4 = ("impacts_per_period", "significant_impacts_per_period", "restitution", "higher_mode_energy_share")
+COMPARE_CSV = OutputFile("compare.csv", "ies compare --out DIR", "One row per study folder and the paper's last "
+                         "(switch and optimum at 6.7 with 20x / 10x, APR level at 7.4 0.14-0.19 as resonant_mean_lo_7.4 "
+                         "and _hi_7.4, 2 significant impacts per period, r = 0.8, 15 % in modes 2-9; what it does not "
+                         "state is nan). compare.json (also --json) holds `studies` (these rows) and `paper`.", (
+    Column("study", "", "the study's name"),
+    Column("folder", "", "its folder"),
+    Column("last_smr", "a_base/a_base*", "the last level with a strongly modulated resonance (the switch's lower end)"),
+    Column("first_apr", "a_base/a_base*", "the first level from which the resonance is almost periodic"),
+    Column("optimum_level", "a_base/a_base*", "the level of the lowest resonant mean"),
+    Column("reduction_mean", "-", "1 / resonant mean at the optimum"),
+    Column("reduction_max", "-", "1 / resonant max at the optimum"),
+    *(Column(f"{key}_{level:g}", unit, f"{what} at level {level:g} (from overview.csv; nan or empty where missing)")
+      for level in LANDMARK_LEVELS
+      for key, unit, what in (("resonant_mean", "a/a_noabs*", "the resonant mean"),
+                              ("resonant_mean_lo", "a/a_noabs*", "its smallest repetition sample"),
+                              ("resonant_mean_hi", "a/a_noabs*", "its largest repetition sample"),
+                              ("regime", "", "the regime"))),
+    *(Column(f"{key}_7.4", "-", f"overview.csv's {key} at 7.4") for key in SCATTERING_AT_7_4),
+))
 #: compare.csv's columns, in order
-COMPARE_COLUMNS = ("study", "folder", "last_smr", "first_apr", "optimum_level", "reduction_mean", "reduction_max",
-                   *(f"{key}_{level:g}" for level in LANDMARK_LEVELS
-                     for key in ("resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "regime")),
-                   *(f"{key}_7.4" for key in SCATTERING_AT_7_4))
+COMPARE_COLUMNS = COMPARE_CSV.names
 #: the paper's row (Sect. 5.3, Fig. 6; Appendix B: the APR level at 7.4; Appendix D: two significant impacts per
 #: period, r ~ 0.8, 15 % of the energy in modes 2..9 after the impacts, simulated)
 PAPER_ROW = {"study": "paper", "folder": "", "last_smr": math.nan, "first_apr": PAPER_OPTIMUM_LEVEL,
@@ -104,7 +121,7 @@ def switch_text(row: dict[str, Any]) -> str:
 
 
 def compare_text(rows: Sequence[dict[str, Any]]) -> str:
-    """The rows as a text table (the README's fidelity table), the paper's row last."""
+    """The rows as a text table (the fidelity report's table), the paper's row last."""
     head = (f"{'study':<34} {'switch':>10} {'optimum':>14} {'level at 7.4 [range]':>28} {'level at 9 [range]':>28} "
             f"{'imp/T':>6} {'sig/T':>6} {'r':>5} {'E2..N':>6}")
     lines = [head]

@@ -16,10 +16,106 @@ from typing import Any, Sequence
 import numpy as np
 
 from sim.common.files import dumps, write_csv, write_text
+from sim.common.outputs import Column, OutputFile, header
 from uq.errors import StudyError
 from uq.interval import Band, Design, DesignPoint, axis_design, band, box_design
 from uq.runner import ResultStore, Task, dask_client, prepare_output, run_tasks
 from uq.study import Study
+
+
+_PARAMETERS = Column("<parameters>", "SI", "the run's parameters: D (damping ratio of mode 1, -), g_m (clearance, m), "
+                     "k_H_N_per_m1p5 (Hertzian spring constant, N/m^1.5); other models' parameters by their name; "
+                     "r_cont, friction, k_t_N_per_m when the study lists them")
+RUNS_CSV = OutputFile("runs.csv", "every study folder", "One row per stepped-sine run (task).", (
+    _PARAMETERS,
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("rep", "-", "repetition index (its random stream: seed and rep)"),
+    Column("<outputs>", "a/a_noabs*", "the run's own resonant levels `mean`, `max` and `apr` (1 when its resonant mean "
+           "is almost periodic); other models: `value`"),
+    Column("error", "", "empty, or why the run failed (it is left out of every statistic)"),
+))
+POINTS_CSV = OutputFile("points.csv", "ies interval", "The repetition statistics of every design point and level.", (
+    Column("design", "", "nominal, individual:NAME, joint or residual"),
+    Column("point", "", "the point's label"),
+    Column("role", "", "corner (an interval limit), interior (checks monotonicity) or nominal"),
+    _PARAMETERS,
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("output", "", "mean or max (or the model's output)"),
+    Column("mean", "a/a_noabs*", "the resonant level of the repetition-averaged response"),
+    Column("se", "a/a_noabs*", "its standard error (NaN for one sample)"),
+    Column("n_samples", "-", "the repetition samples"),
+    Column("regime", "", "where that point's resonant mean is reached (APR, SMR, linear)"),
+))
+BANDS_CSV = OutputFile("bands.csv", "ies interval", "One row per design, output and level.", (
+    Column("design", "", "individual:NAME, joint or residual"),
+    Column("output", "", "mean or max"),
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("lower", "a/a_noabs*", "lower edge of the band over the design's points: the corner band, widened to all "
+           "points where `flagged`"),
+    Column("upper", "a/a_noabs*", "upper edge of the band"),
+    Column("corner_lower", "a/a_noabs*", "the paper's vertex band: smallest value at the interval limits (corners) only"),
+    Column("corner_upper", "a/a_noabs*", "largest value at the corners"),
+    Column("flagged", "-", "1 where the monotonicity check failed (an interior point outside the corner band, or an "
+           "axis not monotone, beyond z = 2 combined standard errors)"),
+    Column("violation", "a/a_noabs*", "by how much beyond that tolerance (NaN where not tested)"),
+    Column("tested", "-", "1 where the check could be made, 0 without a noise estimate (one repetition)"),
+    Column("lower_se", "a/a_noabs*", "standard error of the point that gives the lower edge"),
+    Column("upper_se", "a/a_noabs*", "standard error of the point that gives the upper edge"),
+    Column("nominal", "a/a_noabs*", "the nominal point's value"),
+    Column("nominal_se", "a/a_noabs*", "its standard error"),
+    Column("nominal_outside", "-", "1 where the nominal lies outside the band beyond z combined standard errors, 0 where "
+           "not (or unknown noise), -1 where the nominal point is not in the design's box (residual)"),
+))
+SOBOL_CSV = OutputFile("sobol.csv", "ies sobol", "", (
+    Column("output", "", "mean or max"),
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("parameter", "", "the parameter's name"),
+    Column("S1", "-", "first-order Sobol' index (SALib)"),
+    Column("S1_conf", "-", "half-width of its confidence interval"),
+    Column("ST", "-", "total Sobol' index"),
+    Column("ST_conf", "-", "half-width of its confidence interval"),
+))
+VARIANCE_CSV = OutputFile("variance.csv", "ies sobol", "", (
+    Column("output", "", "mean or max"),
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("variance", "(a/a_noabs*)^2", "variance of the repetition-mean output over the sample"),
+    Column("noise_variance", "(a/a_noabs*)^2", "the part that is repetition noise (mean squared standard error)"),
+    Column("noise_share", "-", "noise_variance / variance"),
+    Column("failed_runs", "-", "runs that failed"),
+    Column("message", "", "why a level was not analysed (empty otherwise)"),
+))
+SWEEPS_CSV = OutputFile("sweeps.csv", "ies response", "The frequency response at every level: the level, then the "
+                        "columns of sweep.csv.", (
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("<sweep>", "", "the columns of sweep.csv"),
+))
+STUDY_JSON = OutputFile("study.json", "every study folder", "", (
+    Column("study", "", "the resolved study: name, kind, model, modal_model, seed, repetitions, output (the folder used), "
+           "source (the study file read), levels, protocol and protocol_resolved (as sweep.json's protocol), parameters "
+           "(per parameter nominal, min, max, unit, label; _extras: k_H_best_estimate, k_H_calibrated in N/m^1.5), "
+           "interval, sobol, response, contact_law, series"),
+    Column("series_folders", "", "a series study: its values' folders"),
+    Column("output_folder", "", "absolute path of the folder"),
+    Column("code_version", "", "hash of the simulator's source (part of every task key)"),
+    Column("outputs, warnings", "", "the banded outputs; every warning of the run"),
+    Column("summary", "", "tasks, ran, reused, failed_runs, wall_time_s (s), points; interval: monotone per "
+           "design/output, untested; Sobol': base_sample, per_level"),
+    Column("overview", "", "response studies: overview.csv's columns as lists"),
+    Column("landmarks", "", "response studies: last_smr and first_apr (the switch; null where none), optimum_level, "
+           "reduction_mean, reduction_max; resonant_mean, resonant_mean_lo, resonant_mean_hi and impacts_at_apr_eta "
+           "(contact onsets per period at eta = 0.976) at 7.4 and 9 as KEY_7.4, KEY_9"),
+))
+TASK_JSON = OutputFile("tasks/KEY.json", "every study folder", "One finished run; KEY is the SHA-256 of its "
+                       "parameters, level, repetition, protocol, seed, the simulator's source and the modal file. "
+                       "tasks/STUDY.txt names the study the folder belongs to.", (
+    Column("params", "SI", "the run's parameters"),
+    Column("level, rep", "a_base/a_base*, -", "excitation level and repetition"),
+    Column("outputs", "a/a_noabs*", "the run's outputs"),
+    Column("error", "", "null, or why it failed"),
+    Column("seconds", "s", "its wall time"),
+    Column("trace", "", "its per-point measures eta, eta_actual, leg, mean, max, min, std, impacts_per_period, "
+           "hold_periods, with a_base and a_noabs in m"),
+))
 
 
 @dataclass
@@ -187,10 +283,9 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
                                   int(bd.flagged[j]), bd.violation[j], int(bd.tested[j]), lower_se[j], upper_se[j],
                                   nominal_value[j], nominal_se[j], outside[j]])
     columns = parameter_columns(study.space)
-    result.files.append(write_csv(folder / "runs.csv", [*columns, "level", "rep", *model.outputs, "error"],
+    result.files.append(write_csv(folder / "runs.csv", header(RUNS_CSV, parameters=columns, outputs=model.outputs),
                                    _runs_rows(results, points, study, model.outputs, names)))
-    result.files.append(write_csv(folder / "points.csv", ["design", "point", "role", *columns, "level", "output",
-                                                           "mean", "se", "n_samples", "regime"], point_rows))
+    result.files.append(write_csv(folder / "points.csv", header(POINTS_CSV, parameters=columns), point_rows))
     result.files.append(write_csv(folder / "bands.csv", BAND_COLUMNS, band_rows))
     monotone = {f"{d}/{o}": bd.monotone for (d, o), bd in bands.items()}
     untested = [f"{d}/{o}" for (d, o), bd in bands.items() if not bd.fully_tested]
@@ -200,9 +295,8 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     return result
 
 
-#: the columns of bands.csv (README, "Output reference")
-BAND_COLUMNS = ("design", "output", "level", "lower", "upper", "corner_lower", "corner_upper", "flagged", "violation",
-                "tested", "lower_se", "upper_se", "nominal", "nominal_se", "nominal_outside")
+#: the columns of bands.csv
+BAND_COLUMNS = BANDS_CSV.names
 
 
 def _edge_errors(design: Design, mean: np.ndarray, se: np.ndarray, bd: Band) -> tuple[np.ndarray, np.ndarray]:
@@ -293,13 +387,11 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
             summary_rows.append([o, level, res.variance, res.noise_variance, res.noise_share, res.failed_runs,
                                  res.message])
             per_level[f"{o}@{level:g}"] = {"noise_share": res.noise_share, "failed_runs": res.failed_runs}
-    result.files.append(write_csv(folder / "runs.csv", [*parameter_columns(study.space), "level", "rep",
-                                                        *model.outputs, "error"],
+    result.files.append(write_csv(folder / "runs.csv", header(RUNS_CSV, parameters=parameter_columns(study.space),
+                                                               outputs=model.outputs),
                                    _runs_rows(results, points, study, model.outputs, names)))
-    result.files.append(write_csv(folder / "sobol.csv", ["output", "level", "parameter", "S1", "S1_conf", "ST",
-                                                          "ST_conf"], rows))
-    result.files.append(write_csv(folder / "variance.csv", ["output", "level", "variance", "noise_variance",
-                                                             "noise_share", "failed_runs", "message"], summary_rows))
+    result.files.append(write_csv(folder / "sobol.csv", SOBOL_CSV.names, rows))
+    result.files.append(write_csv(folder / "variance.csv", VARIANCE_CSV.names, summary_rows))
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
                       "base_sample": n, "points": len(points),
                       "wall_time_s": elapsed, "per_level": per_level}
@@ -338,10 +430,10 @@ def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     if not sweeps:
         raise StudyError("every run of the response study failed; see runs.csv")
     overview = overview_data(levels, sweeps)
-    result.files.append(write_csv(folder / "runs.csv", [*parameter_columns(study.space), "level", "rep",
-                                                        *model.outputs, "error"],
+    result.files.append(write_csv(folder / "runs.csv", header(RUNS_CSV, parameters=parameter_columns(study.space),
+                                                               outputs=model.outputs),
                                    _runs_rows(results, [point], study, model.outputs, study.space.names)))
-    result.files.append(write_csv(folder / "sweeps.csv", ["level", *SWEEP_COLUMNS],
+    result.files.append(write_csv(folder / "sweeps.csv", header(SWEEPS_CSV, sweep=SWEEP_COLUMNS),
                                    [[s.level, *row] for s in sweeps for row in sweep_rows(s)]))
     result.files.append(write_csv(folder / "overview.csv", OVERVIEW_COLUMNS, overview_rows(overview)))
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,

@@ -17,8 +17,8 @@ Layout (every table and key is optional except where noted; SI units)::
     contact_law = "hertz"        # model "ies": "hertz" (Eq. 4) or "hertz-damped" (Eq. 10, r_cont,diss from
                                  # [parameters.r_cont], default 0.99; a table there implies "hertz-damped")
 
-    [variant]                    # optional, model "ies": modelling choices the paper leaves open (README,
-    sphere_mass_factor = 1.537   # "Fidelity"): the sphere's effective mass in x over m_a (rolling: 1.4 on a
+    [variant]                    # optional, model "ies": modelling choices the paper leaves open
+    sphere_mass_factor = 1.537   # (uq/studies/fidelity/README.md): the sphere's effective mass in x over m_a (rolling: 1.4 on a
     higher_mode_damping = 0.001  # flat floor, 1.537 on the groove's edges); the damping ratio of modes 5..N
 
     [parameters.D]               # listed parameters are varied; unlisted ones stay nominal.

@@ -16,6 +16,7 @@ from typing import Any
 
 from sim.common.errors import SimulationInputError
 from sim.common.options import figure_file
+from sim.common.outputs import Column, OutputFile
 
 IMPACTS_HELP = ("impacts in wall accelerations: high-pass, envelope, threshold on the low-passed tip RMS, impacts "
                 "per period (Appendix D.1)")
@@ -26,6 +27,29 @@ MATCH_TOLERANCE = 2e-4
 FALSE_SHARE_WARNING = 0.05
 #: Warnings of the fit printed in the text output.
 MAX_WARNINGS_SHOWN = 5
+IMPACTS_JSON = OutputFile("impacts --json", "ies impacts SIGNAL.csv --json", "", (
+    Column("impacts", "", "one entry per detected impact: t (s), wall, peak (envelope, m/s^2), level (peak / "
+           "reference RMS)"),
+    Column("impacts_per_period, thresholds", "-", "one value per threshold"),
+    Column("fs", "Hz", "the signal's sampling rate"),
+    Column("reference_rms", "m/s^2", "RMS of the low-passed tip acceleration"),
+    Column("excitation_hz", "Hz", "given or estimated from the tip (excitation_estimated true)"),
+    Column("n_periods, duration", "-, s", "excitation periods and length of the signal"),
+    Column("highpass_hz, lowpass_hz", "Hz", "the filters' cut-offs"),
+    Column("min_separation", "s", "shortest time between two impacts"),
+    Column("simulator_check", "", "null for a measurement; for a trace contacts, detected, found_share, false_share, "
+           "tolerance_s, warning"),
+))
+MODAL_FIT_JSON = OutputFile("modal-fit --json", "ies modal-fit SIGNAL.csv --json", "", (
+    Column("higher_share", "-", "mean share of modes 2..N in the modal energy after the impacts"),
+    Column("energies", "J", "windows x modes"),
+    Column("windows", "", "per window impact, start and stop (s), energies, higher_share, the modes' displacement and "
+           "velocity at its start, base_acceleration (m/s^2), base_phase, A, B, alpha, beta (Eq. 9), condition, "
+           "residual, well_posed"),
+    Column("impacts, excitation_hz, excitation_estimated, guard", "-, Hz, -, s", "the impacts used and the settings"),
+    Column("n_modes, model, fs", "-, , Hz", "modes fitted, the modal model, the sampling rate"),
+    Column("warnings, simulator_check", "", "windows left out and why; the check against a trace's contacts"),
+))
 
 
 def add_detection_arguments(parser: argparse.ArgumentParser, *, threshold_default: str) -> None:

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from sim.common.errors import SimulationInputError
+from sim.common.outputs import Column, OutputFile
 from sim.integration.energy import Ledger
 from sim.stepped_sine.measures import SCATTERING_MEASURES, hold_measures, point_measures
 from sim.stepped_sine.protocol import SteppedSine, check_level, simulated_system, visit_points
@@ -30,13 +31,45 @@ from sim.model.system import Impactor, ModalModel, Nominal, a_base_star, a_noabs
 #: The paper's sampling rate (Sect. 5.5: 51.2 kHz).
 DEFAULT_FS = 51.2e3
 DEFAULT_PERIODS = 50
-#: The columns of the trace's CSV, in order (`sim.analysis.signals.simulated_signal`; t first).
-COLUMNS = ("t", "q_tip", "v_tip", "a_tip", "q_wall_left", "q_wall_right", "a_left", "a_right", "q_sphere",
-           "f_left", "f_right")
+TRACE_CSV = OutputFile("trace.csv", "ies trace --out DIR", "One row per sample, SI units; the columns of "
+                       "`sim.analysis.signals.simulated_signal`, t first.", (
+    Column("t", "s", "time from the start of the recorded stretch, at phase 0 of q_base = a_base cos(Omega t)"),
+    Column("q_tip", "m", "tip displacement relative to the base"),
+    Column("v_tip", "m/s", "tip velocity relative to the base"),
+    Column("a_tip", "m/s^2", "absolute tip acceleration"),
+    Column("q_wall_left", "m", "displacement of the left cavity wall relative to the base"),
+    Column("q_wall_right", "m", "displacement of the right cavity wall relative to the base"),
+    Column("a_left", "m/s^2", "absolute acceleration of the left wall (a sensor of Appendix D.1)"),
+    Column("a_right", "m/s^2", "absolute acceleration of the right wall"),
+    Column("q_sphere", "m", "sphere displacement relative to the base"),
+    Column("f_left", "N", "Hertz contact force on the sphere at the left wall (>= 0, Eq. 4)"),
+    Column("f_right", "N", "Hertz contact force on the sphere at the right wall (<= 0)"),
+))
+TRACE_JSON = OutputFile("trace.json", "ies trace --out DIR, also --json", "The command's settings (`integrator`, "
+                        "`seed`, `protocol` as in sweep.json, `impactor`, `model`, `D1`, `fs_requested`, ...) and:", (
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("a_base, a_noabs", "m", "base amplitude, linear resonant amplitude a_noabs*"),
+    Column("eta, eta_actual", "-", "the point's nominal and simulated Omega/omega*"),
+    Column("excitation_hz", "Hz", "the excitation frequency"),
+    Column("fs", "Hz", "the sampling rate used: samples_per_period x excitation_hz"),
+    Column("samples_per_period, periods, n_samples", "-", "M = round(fs/f_exc), recorded periods, rows of trace.csv"),
+    Column("amplitudes", "a/a_noabs*", "the amplitude of each recorded period (Fig. 4)"),
+    Column("mean, max", "a/a_noabs*", "their mean and largest value"),
+    Column("cv", "-", "std/mean of the per-period amplitudes"),
+    Column("impacts_per_period, onsets_per_period", "-", "contact onsets counted by the integrator (mean, per period)"),
+    Column("impacts", "", "one entry per contact: t (s, onset), wall; from the integrator's records also duration (s), "
+           "impulse (N s), approach_speed (m/s), the sphere's velocities before/after (m/s) and the modal energies at "
+           "onset and release (J)"),
+    Column("impacts_source", "", "integrator (exact records) or samples (ode3: contacts seen between samples)"),
+    Column("significant_impacts_per_period, restitution, ..., dissipation_friction", "",
+           "the stretch's scattering measures, as the columns of sweep.csv"),
+    Column("columns, units", "", "trace.csv's column names and their units"),
+    Column("wall_time_s", "s", "the command's wall time"),
+))
+#: The columns of the trace's CSV, in order
+COLUMNS = TRACE_CSV.names
 #: Units of the columns (SI).
-UNITS = {"t": "s", "q_tip": "m", "v_tip": "m/s", "a_tip": "m/s^2", "q_wall_left": "m", "q_wall_right": "m",
-         "a_left": "m/s^2", "a_right": "m/s^2", "q_sphere": "m", "f_left": "N", "f_right": "N"}
-
+UNITS = {c.name: c.unit for c in TRACE_CSV.columns}
 
 @dataclass(frozen=True)
 class Trace:

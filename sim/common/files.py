@@ -8,7 +8,7 @@ not a database; an interrupted write leaves a hidden ``.NAME.*`` temporary file 
 
 It lives in `sim` because `sim` stands alone (it imports no other stage): scans, bem_contact and uq may
 all import it without a cycle, while scans and sim must never import uq (the pipeline's arrows,
-README.md). JSON for machines (`dumps`: numpy values and NaN made plain), CSV tables (`write_csv`) and
+tests/test_architecture.py). JSON for machines (`dumps`: numpy values and NaN made plain), CSV tables (`write_csv`) and
 matplotlib figures (`save_figure`, `plot_to`, Agg back end) are written through it too.
 """
 from __future__ import annotations

@@ -842,7 +842,7 @@ UPDATING_BOUNDS = {
 UPDATING_WEIGHTS = (10.0, 1.0, 1.0, 1.0, 0.3)
 
 # Results of update_solid_geometry (coarse mesh, E = 207 GPa, clamp "block-faces", neck cut in y from the block's
-# top face; README "Fidelity of the host model"). Both optima are unique: other starts end on the same dimensions.
+# top face; uq/studies/README.md, the solid against the beam). Both optima are unique: other starts end on the same dimensions.
 # Neck length and y-width free, free length 400 mm: f1..f4 +0.01, -4.00, -2.72, -4.13 % (Table A.1), f9 = 19.69 kHz
 # (-0.6 %), beam 1.600 kg, m_a phi_c1^2 = 3.53 %, phi_tip/phi_c = 0.960. The neck cut in x as well does not help
 # (its x-width goes to the section's 28 mm), nor a rigid root instead of the block (-2.26, -0.47, -1.51 %, f9

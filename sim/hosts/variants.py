@@ -1,6 +1,6 @@
 """Fidelity of the rig model: the landmarks of the paper's Fig. 6 (Sect. 5.3, Appendices B, D) measured on an
 overview of resonant levels, and the physically motivated variants of the host and impactor model whose effect on
-them is studied (README, "Fidelity").
+them is studied (uq/studies/fidelity/README.md).
 
 Landmarks of the paper (Sect. 5.3, Fig. 6, Appendix B):
 * the switch from strongly modulated (SMR) to almost periodic response (APR), and with it the optimum, at
@@ -181,8 +181,8 @@ SOLID_VARIANTS: dict[str, SolidVariant] = {
                                         "sphere centre (no geometric reason: the sphere rests on the groove's edges)"),
     "updated-hertz-patch": SolidVariant(UPDATED_SOLID_GEOMETRY, 0.0, "the wall values averaged over the Hertz "
                                         "contact disc a = sqrt(R delta_max) = 0.45 mm of the strongest impact at "
-                                        "7.4 (approach speed 1.16 m/s, nominal k_H, the sphere's mass; README "
-                                        "\"Fidelity\")", HERTZ_PATCH_RADIUS),
+                                        "7.4 (approach speed 1.16 m/s, nominal k_H, the sphere's mass; "
+                                        "uq/studies/fidelity/README.md)", HERTZ_PATCH_RADIUS),
     "updated-patch-3mm": SolidVariant(UPDATED_SOLID_GEOMETRY, 0.0, "sensitivity: the wall values averaged over a "
                                       "3 mm disc (6.7 times the Hertz radius; no physical reason)", 0.003),
 }

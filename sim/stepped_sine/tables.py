@@ -1,26 +1,107 @@
 """Tables of stepped-sine results: a frequency response (Fig. 5, Sect. 5.2) and the resonant level against the
 excitation level (Fig. 6, Sect. 5.3), as `ies sweep`, `ies overview` and the uq response studies write and print
 them. Amplitudes are a / a_noabs* and levels a_base / a_base* (dimensionless, Sect. 5); a column with a unit
-says it in its name (a_base_m). The columns are documented in the README's output reference.
+says it in its name (a_base_m). Each file's columns and keys, with unit and meaning, are the `OutputFile`
+tables below (`sim.common.outputs`), from which the output reference uq/OUTPUTS.md is generated.
 """
 from __future__ import annotations
 
 from typing import Any, Sequence
 
-from sim.stepped_sine.measures import PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, PAPER_REDUCTION_MEAN, SCATTERING_MEASURES
+from sim.common.outputs import Column, OutputFile
+from sim.stepped_sine.measures import PAPER_OPTIMUM_LEVEL, PAPER_REDUCTION_MAX, PAPER_REDUCTION_MEAN
 from sim.stepped_sine.protocol import SweepResult, scattering_keys
 
-#: the columns of the energy scattering and impact measures (Sect. 5.5, Appendix D; `sim.stepped_sine.measures`), appended to
-#: both tables: the measure names, the input power with its unit (W) in the name
-SCATTERING_COLUMNS = tuple("input_power_W" if name == "input_power" else name for name in SCATTERING_MEASURES)
+#: the energy scattering and impact measures (Sect. 5.5, Appendix D; `sim.stepped_sine.measures`), appended to both
+#: tables: the measure names, the input power with its unit (W) in the name
+SCATTERING = (
+    Column("significant_impacts_per_period", "-", "impacts with impulse >= 0.1 of the hold's reference impulse, per "
+           "excitation period (`sim.stepped_sine.measures`)"),
+    Column("restitution", "-", "modal coefficient of restitution r of Eq. D.1 from the tip's fundamental harmonic (median "
+           "over the significant impacts of the last 50 periods; NaN without)"),
+    Column("restitution_wall", "-", "the same from the fundamental harmonic of the wall that is hit"),
+    Column("higher_mode_energy_share", "-", "share of the host's mechanical energy in modes 2..N at the release of the "
+           "significant impacts, averaged"),
+    Column("higher_mode_energy_share_mean", "-", "the same share of the time-averaged modal kinetic energies over the hold"),
+    Column("dissipation_fundamental", "-", "energy dissipated by mode 1's modal damping, as a share of the input work"),
+    Column("dissipation_higher_modes", "-", "energy dissipated by the modal damping of modes 2..N, share of the input"),
+    Column("dissipation_contact", "-", "energy dissipated in the contacts (Eq. 10; 0 for the elastic law), share of the input"),
+    Column("input_power_W", "W", "mean power of the base excitation over the hold (frame of Eq. 2)"),
+    Column("balance_error", "-", "(input - dissipated - change of stored energy) / input over the hold (largest magnitude "
+           "over the samples)"),
+    Column("dissipation_friction", "-", "energy dissipated by dry friction at the floor (Appendix C), share of the input"),
+)
+SCATTERING_COLUMNS = tuple(c.name for c in SCATTERING)
+SWEEP_CSV = OutputFile("sweep.csv", "ies sweep --out DIR", "One row per eta of the grid. Amplitudes are averaged over the "
+                       "samples (the repetitions); the scattering columns are NaN-aware averages.", (
+    Column("eta", "-", "eta = Omega/omega* of the grid point, the frequency the holds were measured at"),
+    Column("mean", "a/a_noabs*", "the samples' mean amplitude over the hold, averaged"),
+    Column("mean_lo", "a/a_noabs*", "the smallest sample of `mean`"),
+    Column("mean_hi", "a/a_noabs*", "the largest sample of `mean`"),
+    Column("max", "a/a_noabs*", "the largest amplitude of the hold, averaged over the samples"),
+    Column("max_lo", "a/a_noabs*", "the smallest sample of `max`"),
+    Column("max_hi", "a/a_noabs*", "the largest sample of `max`"),
+    Column("cv", "-", "std/mean of the per-period amplitudes over the hold, averaged (the regime measure)"),
+    Column("impacts_per_period", "-", "contact onsets at either wall per excitation period, averaged"),
+    Column("regime", "", "APR (cv <= 0.1), SMR (cv > 0.1) or linear (no contact)"),
+    *SCATTERING))
 #: sweep.csv: one row per eta of the grid (`SweepResult` arrays)
-SWEEP_COLUMNS = ("eta", "mean", "mean_lo", "mean_hi", "max", "max_lo", "max_hi", "cv", "impacts_per_period", "regime",
-                 *SCATTERING_COLUMNS)
+SWEEP_COLUMNS = SWEEP_CSV.names
+OVERVIEW_CSV = OutputFile("overview.csv", "ies overview --out DIR; response studies", "One row per excitation level; "
+                          "the scattering columns are taken at `eta_resonant_mean`.", (
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("resonant_mean", "a/a_noabs*", "the resonant level: the largest repetition-averaged mean amplitude over eta "
+           "(Sect. 5.3)"),
+    Column("resonant_mean_lo", "a/a_noabs*", "the smallest repetition sample at the resonant eta (lo <= value)"),
+    Column("resonant_mean_hi", "a/a_noabs*", "the largest repetition sample at the resonant eta (value <= hi)"),
+    Column("resonant_max", "a/a_noabs*", "the largest repetition-averaged max amplitude over eta"),
+    Column("resonant_max_lo", "a/a_noabs*", "the smallest sample at its eta"),
+    Column("resonant_max_hi", "a/a_noabs*", "the largest sample at its eta"),
+    Column("eta_resonant_mean", "-", "where the resonant mean is reached"),
+    Column("eta_resonant_max", "-", "where the resonant max is reached"),
+    Column("impacts_per_period", "-", "contact onsets per period at `eta_resonant_mean`"),
+    Column("regime", "", "the regime at `eta_resonant_mean` (APR, SMR, linear): Fig. 6's labels"),
+    Column("a_base_m", "m", "the base amplitude a_base"),
+    Column("resonant_mean_se", "a/a_noabs*", "standard error of the resonant mean (samples at its eta; NaN for one)"),
+    Column("resonant_max_se", "a/a_noabs*", "standard error of the resonant max"),
+    *SCATTERING))
 #: overview.csv: one row per excitation level (`overview_data`)
-OVERVIEW_COLUMNS = ("level", "resonant_mean", "resonant_mean_lo", "resonant_mean_hi", "resonant_max", "resonant_max_lo",
-                    "resonant_max_hi", "eta_resonant_mean", "eta_resonant_max", "impacts_per_period", "regime",
-                    "a_base_m", "resonant_mean_se", "resonant_max_se", *SCATTERING_COLUMNS)
-
+OVERVIEW_COLUMNS = OVERVIEW_CSV.names
+SWEEP_JSON = OutputFile("sweep.json", "ies sweep --out DIR, also --json", "The arrays of sweep.csv (over eta) and:", (
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("a_base", "m", "the base amplitude"),
+    Column("a_noabs", "m", "a_noabs*, the linear resonant amplitude at this excitation (nominal D*)"),
+    Column("mean_std, max_std", "a/a_noabs*", "standard deviation over the samples, per eta"),
+    Column("regime_per_eta", "", "the `regime` column"),
+    Column("resonant_mean, resonant_max", "a/a_noabs*", "the largest mean and max over eta"),
+    Column("eta_resonant_mean, eta_resonant_max", "-", "where they are reached"),
+    Column("regime", "", "the regime at `eta_resonant_mean`"),
+    Column("resonant_mean_samples, resonant_max_samples", "a/a_noabs*", "the samples at the resonant eta (their "
+           "average is the resonant level)"),
+    Column("mean_samples, max_samples, cv_samples, impacts_samples", "", "samples x eta"),
+    Column("n_samples, n_runs", "-", "repetition samples and runs"),
+    Column("wall_time_s", "s", "wall time"),
+    Column("protocol", "", "eta_start, eta_stop, n_eta, sequence, wait and hold (s), perturbation (relative "
+           "half-width), perturb, repetition, integrator, dt_scale, start"),
+    Column("regime_cv_threshold", "-", "0.1"),
+    Column("seed, reps", "-", "the random seed and the number of runs"),
+    Column("model", "", "the modal model's source"),
+    Column("impactor", "", "mass_kg, g_m, k_H_N_per_m1p5, contact_law (hertz or hertz-damped), r_cont, friction (mu), "
+           "k_t_N_per_m; null without impactor"),
+    Column("D1", "-", "damping ratio of mode 1"),
+    Column("significant_impacts_per_period, restitution, restitution_wall, higher_mode_energy_share, "
+           "higher_mode_energy_share_mean", "-", "arrays over eta, as in sweep.csv"),
+    Column("dissipation", "", "fundamental, higher_modes, contact, friction (shares of the input), input (W), "
+           "balance_error; arrays over eta"),
+))
+OVERVIEW_JSON = OutputFile("overview.json", "ies overview --out DIR, also --json", "", (
+    Column("levels", "a_base/a_base*", "the `level` column; the other columns of overview.csv as lists"),
+    Column("dissipation", "", "as in sweep.json, per level"),
+    Column("sweeps", "", "each level's sweep.json object"),
+    Column("reps, seed", "-", "runs per level, random seed"),
+    Column("model", "", "the modal model's source"),
+    Column("wall_time_s", "s", "wall time"),
+))
 
 def _scattering_column(column: str) -> str:
     """The `sim.stepped_sine.measures.SCATTERING_MEASURES` name of a SCATTERING_COLUMNS column."""

@@ -76,6 +76,21 @@ def test_reproduce_all_runs_figures_5_to_8(tmp_path, monkeypatch, capsys):
     assert (out / "fig6" / "fig6.png").is_file() and (out / "fig7" / "fig7.png").is_file()
     assert (out / "fig7" / "nominal-levels.png").is_file() and not (out / "fig7" / "fig6.png").exists()
     assert "optimum: a_base/a_base* = " in text and "lower +- SE" in text
+    # what a reader finds beside the data: the printed tables with the paper's statements, and an index
+    from uq.reproduce_report import PAPER, UNDESCRIBED
+
+    summary = (out / "summary.txt").read_text()
+    assert summary.startswith(f"$ ies reproduce all --out {out}\n")
+    for figure in ("fig5", "fig6", "fig7", "fig8"):
+        table = (out / figure / "table.txt").read_text()
+        assert table in summary and f"{figure}: {PAPER[figure]}" in summary, figure
+        assert table.startswith(f"{figure}: ") and table in text
+    index = (out / "index.md").read_text()
+    for name in ("fig6/", "fig7/", "`fig6.png|pdf`", "`nominal-levels.png|pdf`", "`bands.csv`", "`overview.csv`",
+                 "`summary.txt`", "`table.txt`"):
+        assert name in index, name
+    assert UNDESCRIBED not in index and "tasks" not in index
+    assert f"wrote {out / 'summary.txt'}" in text and f"wrote {out / 'index.md'}" in text
 
 
 def test_regime_labels_come_from_the_simulator(tmp_path, capsys):
