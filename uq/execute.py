@@ -262,19 +262,26 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                     scheduler: str | None = None, resume: bool = False, progress: bool = True,
                     client: Any = None) -> StudyResult:
     """Sobol' study: S1, ST (bootstrap CI) of the repetition-mean resonant levels per excitation level,
-    with the share of their variance that is repetition noise."""
+    with the share of their variance that is repetition noise; from Saltelli's sample of n (k + 2) points
+    (`uq.sobol`), or with [sobol] method = "pce" from a polynomial-chaos surrogate of a Latin hypercube's points
+    (`uq.surrogate`; its fit and smoothness verdict in surrogate.csv)."""
     from uq.sobol import sobol_indices, sobol_sample
+    from uq.surrogate import pce_indices, pce_sample
 
     model = _checked_model(study)
-    n = study.sobol_n if n is None else n
-    X = sobol_sample(study.space, n, seed=study.seed)
+    pce = study.sobol_method == "pce"
+    if pce:
+        X = pce_sample(study.space, study.surrogate_points, seed=study.seed)
+    else:
+        n = study.sobol_n if n is None else n
+        X = sobol_sample(study.space, n, seed=study.seed)
     points = [study.space.from_values(x) for x in X]
     model, result, results, ran, elapsed = _run_points(study, model, points, out, resume, jobs, scheduler, progress,
                                                        client)
     folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
-    rows, summary_rows, per_level = [], [], {}
-    stats, _ = statistics(model, results, points, study)
+    rows, summary_rows, per_level, fit_rows = [], [], {}, []
+    stats, regimes = statistics(model, results, points, study)
     n_failed = sum(1 for rec in results.values() if rec["error"])
     if n_failed:
         _warn(result, f"{n_failed} of {len(results)} runs failed (see the 'error' column of runs.csv); points "
@@ -282,8 +289,13 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     for o in outputs:
         value, se, _ = stats[o]
         for j, level in enumerate(study.levels):
-            res = sobol_indices(study.space, X, value[:, j], num_resamples=study.bootstrap,
-                                confidence=study.confidence, seed=study.seed, noise=se[:, j] ** 2)
+            if pce:
+                res = pce_indices(study.space, X, value[:, j], degree=study.surrogate_degree, noise=se[:, j] ** 2,
+                                  regimes=list(regimes[:, j]), num_resamples=study.bootstrap,
+                                  confidence=study.confidence, seed=study.seed, max_misfit=study.max_misfit)
+            else:
+                res = sobol_indices(study.space, X, value[:, j], num_resamples=study.bootstrap,
+                                    confidence=study.confidence, seed=study.seed, noise=se[:, j] ** 2)
             for note in res.notes:
                 _warn(result, f"{o} at level {level:g}: {note}")
             if res.message:
@@ -293,6 +305,14 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
             summary_rows.append([o, level, res.variance, res.noise_variance, res.noise_share, res.failed_runs,
                                  res.message])
             per_level[f"{o}@{level:g}"] = {"noise_share": res.noise_share, "failed_runs": res.failed_runs}
+            if pce:
+                if not res.message and not res.smooth:
+                    _warn(result, f"{o} at level {level:g}: NOT SMOOTH: {res.rough}; the surrogate's indices are not "
+                                  "reliable there: use method = \"saltelli\"")
+                fit_rows.append([o, level, res.points, res.degree, res.terms, res.cv_error, res.noise_floor,
+                                 int(res.smooth) if not res.message else "", " ".join(res.regimes), res.rough])
+                per_level[f"{o}@{level:g}"].update(cv_error=res.cv_error, noise_floor=res.noise_floor,
+                                                   smooth=bool(res.smooth and not res.message))
     result.files.append(write_csv(folder / "runs.csv", [*parameter_columns(study.space), "level", "rep",
                                                         *model.outputs, "error"],
                                    _runs_rows(results, points, study, model.outputs, names)))
@@ -300,11 +320,23 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                                                           "ST_conf"], rows))
     result.files.append(write_csv(folder / "variance.csv", ["output", "level", "variance", "noise_variance",
                                                              "noise_share", "failed_runs", "message"], summary_rows))
+    if pce:
+        result.files.append(write_csv(folder / "surrogate.csv", SURROGATE_COLUMNS, fit_rows))
+        sample = {"method": "pce", "design_points": study.surrogate_points, "degree": study.surrogate_degree,
+                  "smooth": all(v["smooth"] for v in per_level.values())}
+    else:
+        sample = {"base_sample": n}
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
-                      "base_sample": n, "points": len(points),
-                      "wall_time_s": elapsed, "per_level": per_level}
+                      **sample, "points": len(points), "wall_time_s": elapsed, "per_level": per_level}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
     return result
+
+
+#: the columns of surrogate.csv (method "pce", `uq.surrogate.PCEResult`): design points, degree, polynomial terms
+#: kept, cross-validated error and the part of it the repetition noise explains (shares of the variance), 1 where
+#: the response is smooth (0 not, empty: not analysed), the regimes of the points, why it is not smooth
+SURROGATE_COLUMNS = ("output", "level", "points", "degree", "terms", "cv_error", "noise_floor", "smooth", "regimes",
+                     "rough")
 
 
 def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, scheduler: str | None = None,
