@@ -192,12 +192,31 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     result.files.append(write_csv(folder / "points.csv", ["design", "point", "role", *columns, "level", "output",
                                                            "mean", "se", "n_samples", "regime"], point_rows))
     result.files.append(write_csv(folder / "bands.csv", BAND_COLUMNS, band_rows))
+    members = [[d.name, p.label, p.role, index[p.key()]] for d in [Design("nominal", "box", (nominal,))] + designs
+               for p in d.points]
+    result.files.append(_interval_netcdf(study, model, folder, points, results, stats, regimes, members, band_rows))
     monotone = {f"{d}/{o}": bd.monotone for (d, o), bd in bands.items()}
     untested = [f"{d}/{o}" for (d, o), bd in bands.items() if not bd.fully_tested]
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
                       "wall_time_s": elapsed, "monotone": monotone, "untested": untested, "points": len(points)}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
     return result
+
+
+def _interval_netcdf(study: Study, model: Any, folder: Path, points: list[dict], results: dict, stats: dict,
+                     regimes: np.ndarray, members: list[list], band_rows: list[list]) -> Path:
+    """results.nc of an interval study (`uq.netcdf`): the runs and repetition statistics per point, each design's
+    members (design_point: design, label, role, point_index) and the bands per design and level."""
+    import xarray as xr
+
+    from uq.netcdf import base_dataset, finish, table_variables
+
+    ds = base_dataset(study, model, points, results, stats, regimes)
+    member = table_variables(["design_point", "design", "label", "role", "point_index"],
+                             [[i, *m] for i, m in enumerate(members)], {"design_point": "design_point"})
+    bands = table_variables(list(BAND_COLUMNS), band_rows, {"design": "design", "level": "level"}, split="output")
+    return finish(xr.merge([ds, xr.Dataset(member), xr.Dataset(bands)], combine_attrs="override"), study, model,
+                  folder)
 
 
 #: the columns of bands.csv (README, "Output reference")
@@ -320,6 +339,8 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                                                           "ST_conf"], rows))
     result.files.append(write_csv(folder / "variance.csv", ["output", "level", "variance", "noise_variance",
                                                              "noise_share", "failed_runs", "message"], summary_rows))
+    result.files.append(_sobol_netcdf(study, model, folder, points, results, stats, regimes, rows, summary_rows,
+                                      fit_rows if pce else None))
     if pce:
         result.files.append(write_csv(folder / "surrogate.csv", SURROGATE_COLUMNS, fit_rows))
         sample = {"method": "pce", "design_points": study.surrogate_points, "degree": study.surrogate_degree,
@@ -330,6 +351,25 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                       **sample, "points": len(points), "wall_time_s": elapsed, "per_level": per_level}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
     return result
+
+
+def _sobol_netcdf(study: Study, model: Any, folder: Path, points: list[dict], results: dict, stats: dict,
+                  regimes: np.ndarray, rows: list[list], summary_rows: list[list], fit_rows: list[list] | None) -> Path:
+    """results.nc of a Sobol' study (`uq.netcdf`): the runs and repetition statistics per sample point, the indices
+    per parameter and level (OUTPUT_S1, ...), the variance and noise per level, and the surrogate's fit (pce)."""
+    import xarray as xr
+
+    from uq.netcdf import base_dataset, finish, table_variables
+
+    parts = [base_dataset(study, model, points, results, stats, regimes),
+             xr.Dataset(table_variables(["output", "level", "parameter", "S1", "S1_conf", "ST", "ST_conf"], rows,
+                                        {"parameter": "parameter", "level": "level"}, split="output")),
+             xr.Dataset(table_variables(["output", "level", "variance", "noise_variance", "noise_share", "failed_runs",
+                                         "message"], summary_rows, {"level": "level"}, split="output"))]
+    if fit_rows is not None:
+        parts.append(xr.Dataset(table_variables(list(SURROGATE_COLUMNS), fit_rows, {"level": "level"}, split="output")))
+    method = {"sobol_method": study.sobol_method}
+    return finish(xr.merge(parts, combine_attrs="override"), study, model, folder, method)
 
 
 #: the columns of surrogate.csv (method "pce", `uq.surrogate.PCEResult`): design points, degree, polynomial terms
@@ -376,11 +416,30 @@ def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     result.files.append(write_csv(folder / "sweeps.csv", ["level", *SWEEP_COLUMNS],
                                    [[s.level, *row] for s in sweeps for row in sweep_rows(s)]))
     result.files.append(write_csv(folder / "overview.csv", OVERVIEW_COLUMNS, overview_rows(overview)))
+    result.files.append(_response_netcdf(study, model, folder, point, results, sweeps, overview))
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
                       "wall_time_s": elapsed, "points": 1}
     result.files.append(_metadata(study, model, result, {"summary": result.summary, "overview": overview,
                                                          "landmarks": landmarks(sweeps).summary()}))
     return result
+
+
+def _response_netcdf(study: Study, model: Any, folder: Path, point: dict, results: dict, sweeps: list,
+                     overview: dict) -> Path:
+    """results.nc of a response study (`uq.netcdf`): the runs on level x repetition (the one point's parameters as
+    scalar coordinates), the frequency responses on level x eta (sweep_COLUMN) and the resonant levels per level
+    (overview_COLUMN)."""
+    import xarray as xr
+
+    from sim.tables import OVERVIEW_COLUMNS, SWEEP_COLUMNS, overview_rows, sweep_rows
+    from uq.netcdf import base_dataset, finish, table_variables
+
+    ds = base_dataset(study, model, [point], results).isel(point=0).drop_vars("point")
+    sweep = table_variables(["level", *SWEEP_COLUMNS], [[s.level, *row] for s in sweeps for row in sweep_rows(s)],
+                            {"level": "level", "eta": "eta"}, prefix="sweep_")
+    over = table_variables(list(OVERVIEW_COLUMNS), overview_rows(overview), {"level": "level"}, prefix="overview_")
+    return finish(xr.merge([ds, xr.Dataset(sweep), xr.Dataset(over)], combine_attrs="override"), study, model,
+                  folder)
 
 
 def _run_response_series(study: Study, *, out: Path | None, jobs: int, scheduler: str | None, resume: bool,
@@ -400,8 +459,22 @@ def _run_response_series(study: Study, *, out: Path | None, jobs: int, scheduler
             totals[key] += part.summary[key]
         parts.append(sub)
     result.summary = totals
+    result.files.append(_series_netcdf(study, folder, parts))
     result.files.append(_metadata(study, study.make_model(), result, {"summary": totals, "series_folders": parts}))
     return result
+
+
+def _series_netcdf(study: Study, folder: Path, parts: list[str]) -> Path:
+    """OUT/results.nc of a response series: the series' studies' datasets along a dimension named after the series'
+    parameter (its values the coordinate)."""
+    import xarray as xr
+
+    from uq.netcdf import finish, open_results
+
+    name, _ = study.series
+    ds = xr.concat([open_results(folder / sub) for sub in parts], dim=name, data_vars="all", coords="different",
+                   compat="equals", join="outer", combine_attrs="drop_conflicts")
+    return finish(ds, study, study.make_model(), folder, {"series_folders": " ".join(parts)})
 
 
 def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: int = 20) -> list[Path]:
