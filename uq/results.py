@@ -201,3 +201,24 @@ def sobol_table(folder: str | Path) -> str:
                          "levels away from the switch between the strongly modulated and the almost periodic response, "
                          "where the response is chaotic.")
     return "\n".join(lines)
+
+
+def open_study(folder: str | Path) -> "xarray.Dataset":  # noqa: F821 - xarray is imported on use
+    """A finished study's results as an xarray Dataset (its results.nc, `uq.netcdf`), read into memory.
+
+    Dimensions as the study has them: ``point`` (with each parameter as a coordinate along it), ``level``
+    (a_base / a_base*), ``repetition``; ``design``/``design_point`` (interval), ``parameter`` (Sobol'), ``eta``
+    (response; a series adds a dimension named after its parameter). Every variable has CF ``units`` and
+    ``long_name``; ``ds.attrs["study"]`` is the resolved study (JSON) and ``ds.attrs["code_version"]`` the
+    simulator's code version. Example, in Python or a notebook::
+
+        >>> from uq.results import open_study
+        >>> ds = open_study("ies-out/sobol")                    # doctest: +SKIP
+        >>> ds["mean_ST"].sel(level=6.7).to_series()            # doctest: +SKIP
+        >>> ds["mean"].mean("repetition").plot.scatter(x="g")   # doctest: +SKIP
+
+    A folder without results.nc (not a study's output) is a one-line `StudyError`.
+    """
+    from uq.netcdf import open_results
+
+    return open_results(folder)
