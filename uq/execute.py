@@ -206,13 +206,14 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
 def _interval_netcdf(study: Study, model: Any, folder: Path, points: list[dict], results: dict, stats: dict,
                      regimes: np.ndarray, members: list[list], band_rows: list[list]) -> Path:
     """results.nc of an interval study (`uq.netcdf`): the runs and repetition statistics per point, each design's
-    members (design_point: design, label, role, point_index) and the bands per design and level."""
+    members (on design_point: member_design, member_label, member_role and member_point, the index along point; the
+    rows of points.csv) and the bands per design and level."""
     import xarray as xr
 
     from uq.netcdf import base_dataset, finish, table_variables
 
     ds = base_dataset(study, model, points, results, stats, regimes)
-    member = table_variables(["design_point", "design", "label", "role", "point_index"],
+    member = table_variables(["design_point", "member_design", "member_label", "member_role", "member_point"],
                              [[i, *m] for i, m in enumerate(members)], {"design_point": "design_point"})
     bands = table_variables(list(BAND_COLUMNS), band_rows, {"design": "design", "level": "level"}, split="output")
     return finish(xr.merge([ds, xr.Dataset(member), xr.Dataset(bands)], combine_attrs="override"), study, model,

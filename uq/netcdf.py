@@ -6,7 +6,7 @@ the tools that analyse many-dimensional data (xarray, netCDF4, Panoply, ...): ev
 * ``point`` (the study's parameter points: vertices and interior points of an interval study, the sample of a
   Sobol' study) with each parameter as a coordinate along it (absent from a response study, whose one point's
   parameters are scalar coordinates), ``level`` (a_base / a_base*), ``repetition``, ``eta`` (Omega / omega_1*,
-  response studies), ``design`` and ``design_point`` (interval studies), ``parameter`` (Sobol' studies);
+  response studies), ``design`` and ``design_point`` (interval studies: the bands per design, each design's member points), ``parameter`` (Sobol' studies);
 * one variable per model output and table column, named ``OUTPUT_COLUMN`` where a CSV table has an ``output``
   column (e.g. ``mean_lower`` of bands.csv, ``max_S1`` of sobol.csv), else as the column (``mean`` of runs.csv:
   one run's resonant mean);
@@ -46,10 +46,10 @@ COLUMN_META: dict[str, tuple[str, str]] = {
     "rep_mean": ("", "repetition mean"), "rep_se": ("", "standard error of the repetition mean"),
     "n_samples": ("1", "number of finite repetition samples"),
     "regime": ("1", "regime at the resonant level: APR almost periodic, SMR strongly modulated, linear"),
-    "point_index": ("1", "index along the point dimension"),
-    "design": ("1", "design name"), "design_point": ("1", "index of a design's member point"),
-    "parameter": ("1", "varied parameter"), "label": ("1", "point label in its design"), "role": ("1", "point role"),
-    "lower": ("", "band lower edge"), "upper": ("", "band upper edge"),
+    "member_point": ("1", "the member's index along the point dimension"), "member_design": ("1", "design name"),
+    "member_label": ("1", "the member's label in its design"), "member_role": ("1", "the member's role"),
+    "design": ("1", "design name"), "design_point": ("1", "a point of a design (a row of points.csv per level)"),
+    "parameter": ("1", "varied parameter"),     "lower": ("", "band lower edge"), "upper": ("", "band upper edge"),
     "corner_lower": ("", "lowest vertex value"), "corner_upper": ("", "highest vertex value"),
     "flagged": ("1", "1 where the monotonicity check failed and the band was widened"),
     "violation": ("", "largest monotonicity violation"), "tested": ("1", "1 where monotonicity was tested"),
