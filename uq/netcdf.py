@@ -19,9 +19,9 @@ compression, which scipy's NetCDF-3 writer lacks. The file is written under a te
 """
 from __future__ import annotations
 
-import json
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 

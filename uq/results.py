@@ -13,8 +13,12 @@ import csv
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:  # imported on use: reading a study's CSV tables needs no xarray
+    import xarray
 
 
 @dataclass(frozen=True)
@@ -203,7 +207,7 @@ def sobol_table(folder: str | Path) -> str:
     return "\n".join(lines)
 
 
-def open_study(folder: str | Path) -> "xarray.Dataset":  # noqa: F821 - xarray is imported on use
+def open_study(folder: str | Path) -> xarray.Dataset:
     """A finished study's results as an xarray Dataset (its results.nc, `uq.netcdf`), read into memory.
 
     Dimensions as the study has them: ``point`` (with each parameter as a coordinate along it), ``level``

@@ -10,7 +10,7 @@ from uq.cli import main
 from uq.space import Parameter, ParameterSpace
 
 pytest.importorskip("openturns")
-from uq.surrogate import basis_size, pce_indices, pce_sample  # noqa: E402
+from uq.surrogate import basis_size, pce_indices, pce_sample
 
 A, B = 7.0, 0.1
 AB = """
