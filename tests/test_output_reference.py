@@ -10,7 +10,7 @@ from sim.common.outputs import Column, OutputFile, describe, header
 from uq.output_reference import PAGE, SECTIONS, render
 
 UNITS = {"", "-", "m", "m/s", "m/s^2", "N", "W", "s", "Hz", "J", "SI", "a/a_noabs*", "a_base/a_base*", "(a/a_noabs*)^2",
-         "-, s", "-, Hz, -, s", "-, , Hz", "a_base/a_base*, -"}
+         "-, s", "-, Hz, -, s", "-, , Hz", "a_base/a_base*, -", "kg", "N/m^1.5"}
 
 
 def documented(output: OutputFile) -> set[str]:

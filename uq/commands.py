@@ -2,7 +2,8 @@
 (seed paper Sects. 5.2-5.4, Figs. 5-8), `plot` and `compare`.
 
 * `ies interval STUDY.toml`: interval (vertex) bands of the resonant response, Figs. 7 and 8.
-* `ies sobol STUDY.toml [--n N]`: Sobol' indices (S1, ST) of the resonant response levels.
+* `ies sobol STUDY.toml [--n N | --method pce [--points N] [--degree P]]`: Sobol' indices (S1, ST) of the
+  resonant response levels, from Saltelli's sampling or a polynomial-chaos surrogate (`uq.surrogate`).
 * `ies response STUDY.toml`: the nominal point's frequency responses and resonant levels over the excitation
   levels through the task store (resumable, parallel, on a cluster), Figs. 5 and 6.
 * `ies reproduce fig5|fig6|fig7|fig8|figD2|figD3|all [--quick] [--out DIR]`: the paper's figures, run from the
@@ -33,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 from sim.common.options import figure_formats, level_list, positive_int
+from uq.errors import StudyError
 
 #: the calibration `ies reproduce` runs: no arguments, returns the JSON object of `ies calibrate --json`
 Calibrate = Callable[[], dict]
@@ -94,7 +96,14 @@ def add_interval_arguments(parser: argparse.ArgumentParser) -> None:
 def add_sobol_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies sobol`."""
     parser.add_argument("study", type=Path, metavar="STUDY.toml", help="study file ([study] kind = \"sobol\")")
-    parser.add_argument("--n", type=positive_int, metavar="N", help="base sample size, a power of two (default: [sobol] n)")
+    parser.add_argument("--n", type=positive_int, metavar="N",
+                        help="Saltelli's base sample size, a power of two (default: [sobol] n)")
+    parser.add_argument("--method", choices=("saltelli", "pce"),
+                        help="Saltelli's sampling (the reference) or a polynomial-chaos surrogate (default: [sobol] method)")
+    parser.add_argument("--points", type=positive_int, metavar="N",
+                        help="pce: design points of the surrogate (default: [sobol] points, else 3 per polynomial term)")
+    parser.add_argument("--degree", type=positive_int, metavar="P",
+                        help="pce: total polynomial degree (default: [sobol] degree, else 2)")
     add_run_arguments(parser)
 
 
@@ -118,12 +127,16 @@ def interval_command(args: argparse.Namespace) -> int:
 
 
 def sobol_command(args: argparse.Namespace) -> int:
-    """`ies sobol`: the study's Sobol' indices (SALib), then their figure; prints the indices and the noise."""
+    """`ies sobol`: the study's Sobol' indices (SALib, or a PCE surrogate), then their figure; prints the indices and
+    the noise (and the surrogate's fit)."""
     from uq.execute import run_sobol_study
     from uq.figures import sobol_figure
     from uq.results import sobol_table
+    from uq.study import with_sobol_method
 
-    study = _load_study(args.study, "sobol")
+    study = with_sobol_method(_load_study(args.study, "sobol"), args.method, args.points, args.degree)
+    if study.sobol_method == "pce" and args.n is not None:
+        raise StudyError("--n is Saltelli's base sample size; the surrogate's design size is --points")
     result = run_sobol_study(study, out=args.out, n=args.n, jobs=args.jobs, scheduler=args.scheduler,
                              resume=args.resume, progress=not args.quiet)
     _report(result, [] if args.no_figures else sobol_figure(result.folder))

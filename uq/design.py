@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from sim.common.outputs import Column, OutputFile
 from uq.errors import StudyError
 
 #: Table 2's intervals as the default uncertainty box: D_1, the clearance's tolerance above its nominal value
@@ -52,8 +53,21 @@ RESTITUTION = 0.86
 PROTOCOL = {"eta_start": 0.96, "eta_stop": 1.01, "n_eta": 26, "wait": 2.0, "hold": 3.0, "sequence": "up",
             "start": "base-velocity", "repetition": "run", "integrator": "exact"}
 OBJECTIVES = ("mean", "max")
-#: every key of design.json (the output reference, `uq/OUTPUTS.md`)
-DESIGN_KEYS = ("settings", "host", "screening", "verified", "recommendation", "baseline", "no_absorber", "notes")
+DESIGN_JSON = OutputFile("design.json", "ies design", "The design's settings, host and result.", (
+    Column("settings", "", "the design problem (SI units: excitation, clearances, radii in m; D, tolerance and k_H "
+                           "factor intervals; objective, candidates, repetitions, restitution, protocol)"),
+    Column("host", "", "the host's mode 1 as the slow flow uses it (omega_1 rad/s, D_1, phi_c, phi_tip, participation) "
+                       "and the operating levels a_base/a_base*"),
+    Column("screening", "", "designs screened, how many fit the cavity, seconds, the restitution r used"),
+    Column("verified", "", "every verified design: its variables, worst_m (m), runs, per level low_m, high_m, "
+                           "nominal_m (m), apr_fraction, the levels where the monotonicity check failed"),
+    Column("recommendation", "", "the best verified design (as in verified), its sentence and "
+                                 "reduction_vs_no_absorber (-)"),
+    Column("baseline", "", "the baseline's verification and ratio_to_recommendation (-); null without --baseline"),
+    Column("no_absorber", "", "the structure without IES: D_1 and tip_m (m) per level"),
+    Column("notes", "", "what the design neglects"),
+))
+DESIGN_KEYS = DESIGN_JSON.names
 
 
 @dataclass(frozen=True)
@@ -465,38 +479,37 @@ def design_key(problem: DesignProblem, model: Any) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-#: design.csv: one row per evaluated design (column, unit, meaning)
-DESIGN_COLUMNS = (
-    ("status", "-", "verified, baseline (verified) or screened"),
-    ("material", "-", "sphere material (sim.model.materials)"),
-    ("clearance_m", "m", "clearance g"),
-    ("radius_m", "m", "sphere radius R"),
-    ("mass_kg", "kg", "sphere mass m_a from R and the density"),
-    ("k_H_N_per_m1p5", "N/m^1.5", "Eq. 8's k_H against the host's steel wall"),
-    ("cavity_m", "m", "cavity width 2R + 2g"),
-    ("fits", "-", "1 if the cavity leaves walls of the minimum thickness"),
-    ("predicted_worst_m", "m", "slow-flow worst case over levels and the D, tolerance ends"),
-    ("predicted_switch_m", "m", "slow-flow base amplitude of the switch to the almost periodic response"),
-    ("worst_m", "m", "verified worst case over levels, uncertainty corners and the nominal point (empty if screened)"),
-    ("worst_level_m", "m", "base amplitude a_base where the verified worst case occurs"),
-    ("regimes", "-", ("per operating level: A (almost periodic in most runs), S (strongly modulated), L (no impacts "
+DESIGN_CSV = OutputFile("design.csv", "ies design", "One row per evaluated design (verified first, best first; then the "
+                        "screened ones).", (
+    Column("status", "-", "verified, baseline (verified) or screened"),
+    Column("material", "-", "sphere material (sim.model.materials)"),
+    Column("clearance_m", "m", "clearance g"),
+    Column("radius_m", "m", "sphere radius R"),
+    Column("mass_kg", "kg", "sphere mass m_a from R and the density"),
+    Column("k_H_N_per_m1p5", "N/m^1.5", "Eq. 8's k_H against the host's steel wall"),
+    Column("cavity_m", "m", "cavity width 2R + 2g"),
+    Column("fits", "-", "1 if the cavity leaves walls of the minimum thickness"),
+    Column("predicted_worst_m", "m", "slow-flow worst case over levels and the D, tolerance ends"),
+    Column("predicted_switch_m", "m", "slow-flow base amplitude of the switch to the almost periodic response"),
+    Column("worst_m", "m", "verified worst case over levels, uncertainty corners and the nominal point (empty if screened)"),
+    Column("worst_level_m", "m", "base amplitude a_base where the verified worst case occurs"),
+    Column("regimes", "-", ("per operating level: A (almost periodic in most runs), S (strongly modulated), L (no impacts "
                       "predicted); verified designs from the runs, screened ones from the slow flow")),
-)
-#: design-levels.csv: one row per verified design and operating level
-LEVEL_COLUMNS = (
-    ("material", "-", "sphere material"),
-    ("clearance_m", "m", "clearance g"),
-    ("radius_m", "m", "sphere radius R"),
-    ("a_base_m", "m", "operating base amplitude"),
-    ("level", "-", "a_base / a_base* (a_base* of the paper's nominal D*, g*)"),
-    ("low_m", "m", "lowest resonant tip amplitude over the uncertainty corners (mean of the repetitions)"),
-    ("high_m", "m", "highest resonant tip amplitude over the uncertainty corners"),
-    ("nominal_m", "m", "resonant tip amplitude at the box's centre"),
-    ("outside", "-", "1 if the centre left the corners' band beyond 2 standard errors (monotonicity check failed)"),
-    ("apr_fraction", "-", "fraction of runs in the almost periodic regime"),
-    ("predicted_m", "m", "slow-flow prediction (worst over the D and tolerance ends)"),
-    ("no_absorber_m", "m", "the structure without IES at the lower end of D"),
-)
+))
+DESIGN_LEVELS_CSV = OutputFile("design-levels.csv", "ies design", "One row per verified design and operating level.", (
+    Column("material", "-", "sphere material"),
+    Column("clearance_m", "m", "clearance g"),
+    Column("radius_m", "m", "sphere radius R"),
+    Column("a_base_m", "m", "operating base amplitude"),
+    Column("level", "-", "a_base / a_base* (a_base* of the paper's nominal D*, g*)"),
+    Column("low_m", "m", "lowest resonant tip amplitude over the uncertainty corners (mean of the repetitions)"),
+    Column("high_m", "m", "highest resonant tip amplitude over the uncertainty corners"),
+    Column("nominal_m", "m", "resonant tip amplitude at the box's centre"),
+    Column("outside", "-", "1 if the centre left the corners' band beyond 2 standard errors (monotonicity check failed)"),
+    Column("apr_fraction", "-", "fraction of runs in the almost periodic regime"),
+    Column("predicted_m", "m", "slow-flow prediction (worst over the D and tolerance ends)"),
+    Column("no_absorber_m", "m", "the structure without IES at the lower end of D"),
+))
 
 
 def _regime_letters(values: Sequence[Any]) -> str:
@@ -528,8 +541,8 @@ def write_design(result: DesignResult, mode: Any) -> list[Any]:
                                v.low[k], v.high[k], v.nominal[k], int(v.outside[k]), v.apr[k],
                                s.tip[i, k] if i is not None else None, result.no_absorber[k]])
     folder = result.folder
-    files = [write_csv(folder / "design.csv", [c[0] for c in DESIGN_COLUMNS], rows),
-             write_csv(folder / "design-levels.csv", [c[0] for c in LEVEL_COLUMNS], level_rows)]
+    files = [write_csv(folder / "design.csv", DESIGN_CSV.names, rows),
+             write_csv(folder / "design-levels.csv", DESIGN_LEVELS_CSV.names, level_rows)]
 
     def verified_data(v: Verified) -> dict[str, Any]:
         return {**v.sphere.describe(), "worst_m": v.worst, "runs": v.runs, "low_m": v.low, "high_m": v.high,
@@ -556,7 +569,56 @@ def write_design(result: DesignResult, mode: Any) -> list[Any]:
                   "dry friction is not modelled in the design (it would break the similarity law)"],
     }
     files.append(write_text(folder / "design.json", dumps(data) + "\n"))
+    files.append(write_design_netcdf(result, data))
     return files
+
+
+def write_design_netcdf(result: DesignResult, data: Mapping[str, Any]) -> Any:
+    """results.nc of a design (`uq.netcdf` conventions): the verified designs x operating levels (band, centre, APR
+    fraction, slow-flow prediction) and every screened design's variables and predicted worst case, with units."""
+    from pathlib import Path
+
+    import xarray as xr
+
+    from sim.common.files import atomic_path, dumps
+    from uq.netcdf import ENGINE
+
+    p, s = result.problem, result.screened
+    v = result.verified
+    index = {d: i for i, d in enumerate(s.designs)}
+    nan_row = np.full(len(p.excitation), np.nan)
+
+    def design_coords(spheres: Sequence[Sphere], dim: str) -> dict[str, Any]:
+        return {f"{dim}_clearance": (dim, [x.clearance for x in spheres], {"units": "m", "long_name": "clearance g"}),
+                f"{dim}_radius": (dim, [x.radius for x in spheres], {"units": "m", "long_name": "sphere radius R"}),
+                f"{dim}_material": (dim, [x.material for x in spheres], {"long_name": "sphere material"}),
+                f"{dim}_mass": (dim, [x.mass for x in spheres], {"units": "kg", "long_name": "sphere mass m_a"})}
+
+    metres = {"units": "m"}
+    ds = xr.Dataset(
+        {"low": (("design", "level"), [x.low for x in v], {**metres, "long_name": "lowest resonant tip amplitude "
+                                                                                "over the uncertainty corners"}),
+         "high": (("design", "level"), [x.high for x in v], {**metres, "long_name": "highest resonant tip amplitude "
+                                                                                  "over the uncertainty corners"}),
+         "nominal": (("design", "level"), [x.nominal for x in v], {**metres, "long_name": "resonant tip amplitude at "
+                                                                                        "the box's centre"}),
+         "apr_fraction": (("design", "level"), [x.apr for x in v], {"units": "1", "long_name": "fraction of runs in "
+                                                                                              "the APR regime"}),
+         "predicted": (("design", "level"), [s.tip[index[x.sphere]] if x.sphere in index else nan_row for x in v],
+                       {**metres, "long_name": "slow-flow resonant tip amplitude (worst over the D, tolerance ends)"}),
+         "worst": ("design", [x.worst for x in v], {**metres, "long_name": "verified worst case"}),
+         "no_absorber": ("level", result.no_absorber, {**metres, "long_name": "resonant tip amplitude without IES"}),
+         "screened_worst": ("screened", np.where(np.isfinite(s.worst), s.worst, np.nan),
+                            {**metres, "long_name": "slow-flow worst case (NaN: the cavity does not fit)"})},
+        coords={"level": ("level", result.levels, {"units": "1", "long_name": "excitation level a_base/a_base*"}),
+                "a_base": ("level", np.asarray(p.excitation), {**metres, "long_name": "operating base amplitude"}),
+                **design_coords([x.sphere for x in v], "design"), **design_coords(s.designs, "screened")},
+        attrs={"Conventions": "CF-1.10", "title": "ies-workbench design", "kind": "design",
+               "recommendation": data["recommendation"]["sentence"], "settings": dumps(data["settings"])})
+    path = Path(result.folder) / "results.nc"
+    with atomic_path(path) as tmp:
+        ds.to_netcdf(tmp, engine=ENGINE)
+    return path
 
 
 def design_table(result: DesignResult) -> str:

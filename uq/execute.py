@@ -287,12 +287,32 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
                                    _runs_rows(results, points, study, model.outputs, names)))
     result.files.append(write_csv(folder / "points.csv", header(POINTS_CSV, parameters=columns), point_rows))
     result.files.append(write_csv(folder / "bands.csv", BAND_COLUMNS, band_rows))
+    members = [[d.name, p.label, p.role, index[p.key()]] for d in [Design("nominal", "box", (nominal,))] + designs
+               for p in d.points]
+    result.files.append(_interval_netcdf(study, model, folder, points, results, stats, regimes, members, band_rows))
     monotone = {f"{d}/{o}": bd.monotone for (d, o), bd in bands.items()}
     untested = [f"{d}/{o}" for (d, o), bd in bands.items() if not bd.fully_tested]
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
                       "wall_time_s": elapsed, "monotone": monotone, "untested": untested, "points": len(points)}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
     return result
+
+
+def _interval_netcdf(study: Study, model: Any, folder: Path, points: list[dict], results: dict, stats: dict,
+                     regimes: np.ndarray, members: list[list], band_rows: list[list]) -> Path:
+    """results.nc of an interval study (`uq.netcdf`): the runs and repetition statistics per point, each design's
+    members (on design_point: member_design, member_label, member_role and member_point, the index along point; the
+    rows of points.csv) and the bands per design and level."""
+    import xarray as xr
+
+    from uq.netcdf import base_dataset, finish, table_variables
+
+    ds = base_dataset(study, model, points, results, stats, regimes)
+    member = table_variables(["design_point", "member_design", "member_label", "member_role", "member_point"],
+                             [[i, *m] for i, m in enumerate(members)], {"design_point": "design_point"})
+    bands = table_variables(list(BAND_COLUMNS), band_rows, {"design": "design", "level": "level"}, split="output")
+    return finish(xr.merge([ds, xr.Dataset(member), xr.Dataset(bands)], combine_attrs="override"), study, model,
+                  folder)
 
 
 #: the columns of bands.csv
@@ -356,19 +376,26 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                     scheduler: str | None = None, resume: bool = False, progress: bool = True,
                     client: Any = None) -> StudyResult:
     """Sobol' study: S1, ST (bootstrap CI) of the repetition-mean resonant levels per excitation level,
-    with the share of their variance that is repetition noise."""
+    with the share of their variance that is repetition noise; from Saltelli's sample of n (k + 2) points
+    (`uq.sobol`), or with [sobol] method = "pce" from a polynomial-chaos surrogate of a Latin hypercube's points
+    (`uq.surrogate`; its fit and smoothness verdict in surrogate.csv)."""
     from uq.sobol import sobol_indices, sobol_sample
+    from uq.surrogate import pce_indices, pce_sample
 
     model = _checked_model(study)
-    n = study.sobol_n if n is None else n
-    X = sobol_sample(study.space, n, seed=study.seed)
+    pce = study.sobol_method == "pce"
+    if pce:
+        X = pce_sample(study.space, study.surrogate_points, seed=study.seed)
+    else:
+        n = study.sobol_n if n is None else n
+        X = sobol_sample(study.space, n, seed=study.seed)
     points = [study.space.from_values(x) for x in X]
     model, result, results, ran, elapsed = _run_points(study, model, points, out, resume, jobs, scheduler, progress,
                                                        client)
     folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
-    rows, summary_rows, per_level = [], [], {}
-    stats, _ = statistics(model, results, points, study)
+    rows, summary_rows, per_level, fit_rows = [], [], {}, []
+    stats, regimes = statistics(model, results, points, study)
     n_failed = sum(1 for rec in results.values() if rec["error"])
     if n_failed:
         _warn(result, f"{n_failed} of {len(results)} runs failed (see the 'error' column of runs.csv); points "
@@ -376,8 +403,13 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     for o in outputs:
         value, se, _ = stats[o]
         for j, level in enumerate(study.levels):
-            res = sobol_indices(study.space, X, value[:, j], num_resamples=study.bootstrap,
-                                confidence=study.confidence, seed=study.seed, noise=se[:, j] ** 2)
+            if pce:
+                res = pce_indices(study.space, X, value[:, j], degree=study.surrogate_degree, noise=se[:, j] ** 2,
+                                  regimes=list(regimes[:, j]), num_resamples=study.bootstrap,
+                                  confidence=study.confidence, seed=study.seed, max_misfit=study.max_misfit)
+            else:
+                res = sobol_indices(study.space, X, value[:, j], num_resamples=study.bootstrap,
+                                    confidence=study.confidence, seed=study.seed, noise=se[:, j] ** 2)
             for note in res.notes:
                 _warn(result, f"{o} at level {level:g}: {note}")
             if res.message:
@@ -387,16 +419,75 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
             summary_rows.append([o, level, res.variance, res.noise_variance, res.noise_share, res.failed_runs,
                                  res.message])
             per_level[f"{o}@{level:g}"] = {"noise_share": res.noise_share, "failed_runs": res.failed_runs}
+            if pce:
+                if not res.message and not res.smooth:
+                    _warn(result, f"{o} at level {level:g}: NOT SMOOTH: {res.rough}; the surrogate's indices are not "
+                                  "reliable there: use method = \"saltelli\"")
+                fit_rows.append([o, level, res.points, res.degree, res.terms, res.cv_error, res.noise_floor,
+                                 int(res.smooth) if not res.message else "", " ".join(res.regimes), res.rough])
+                per_level[f"{o}@{level:g}"].update(cv_error=res.cv_error, noise_floor=res.noise_floor,
+                                                   smooth=bool(res.smooth and not res.message))
     result.files.append(write_csv(folder / "runs.csv", header(RUNS_CSV, parameters=parameter_columns(study.space),
                                                                outputs=model.outputs),
                                    _runs_rows(results, points, study, model.outputs, names)))
     result.files.append(write_csv(folder / "sobol.csv", SOBOL_CSV.names, rows))
     result.files.append(write_csv(folder / "variance.csv", VARIANCE_CSV.names, summary_rows))
+    result.files.append(_sobol_netcdf(study, model, folder, points, results, stats, regimes, rows, summary_rows,
+                                      fit_rows if pce else None))
+    if pce:
+        result.files.append(write_csv(folder / "surrogate.csv", SURROGATE_COLUMNS, fit_rows))
+        sample = {"method": "pce", "design_points": study.surrogate_points, "degree": study.surrogate_degree,
+                  "smooth": all(v["smooth"] for v in per_level.values())}
+    else:
+        sample = {"base_sample": n}
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
-                      "base_sample": n, "points": len(points),
-                      "wall_time_s": elapsed, "per_level": per_level}
+                      **sample, "points": len(points), "wall_time_s": elapsed, "per_level": per_level}
     result.files.append(_metadata(study, model, result, {"summary": result.summary}))
     return result
+
+
+def _sobol_netcdf(study: Study, model: Any, folder: Path, points: list[dict], results: dict, stats: dict,
+                  regimes: np.ndarray, rows: list[list], summary_rows: list[list], fit_rows: list[list] | None) -> Path:
+    """results.nc of a Sobol' study (`uq.netcdf`): the runs and repetition statistics per sample point, the indices
+    per parameter and level (OUTPUT_S1, ...), the variance and noise per level, and the surrogate's fit (pce)."""
+    import xarray as xr
+
+    from uq.netcdf import base_dataset, finish, table_variables
+
+    parts = [base_dataset(study, model, points, results, stats, regimes),
+             xr.Dataset(table_variables(["output", "level", "parameter", "S1", "S1_conf", "ST", "ST_conf"], rows,
+                                        {"parameter": "parameter", "level": "level"}, split="output")),
+             xr.Dataset(table_variables(["output", "level", "variance", "noise_variance", "noise_share", "failed_runs",
+                                         "message"], summary_rows, {"level": "level"}, split="output"))]
+    if fit_rows is not None:
+        parts.append(xr.Dataset(table_variables(list(SURROGATE_COLUMNS), fit_rows, {"level": "level"}, split="output")))
+    method = {"sobol_method": study.sobol_method}
+    return finish(xr.merge(parts, combine_attrs="override"), study, model, folder, method)
+
+
+SURROGATE_CSV = OutputFile("surrogate.csv", "ies sobol, method pce", "The polynomial-chaos surrogate's fit per "
+                           "output and level (`uq.surrogate`).", (
+    Column("output", "", "mean or max"),
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("points", "-", "the design's points (Latin hypercube)"),
+    Column("degree", "-", "the basis' total degree"),
+    Column("terms", "-", "the polynomial terms LARS kept"),
+    Column("cv_error", "-", "10-fold cross-validated error, a share of the output variance"),
+    Column("noise_floor", "-", "the part of cv_error the repetition noise explains"),
+    Column("smooth", "-", "1 where the response is smooth, 0 not (NOT SMOOTH: indices unreliable), empty: not analysed"),
+    Column("regimes", "", "the regimes the design points fall into"),
+    Column("rough", "", "why it is not smooth"),
+))
+SURROGATE_COLUMNS = SURROGATE_CSV.names
+RESULTS_NC = OutputFile("results.nc", "every study folder, ies design", "Every number of the CSV tables as one xarray "
+                        "Dataset (NetCDF 4, h5netcdf) on named dimensions, with CF `units` and `long_name` on every "
+                        "variable and the resolved study and code version as attributes; open it with "
+                        "`uq.results.open_study(DIR)` (`uq.netcdf`).", (
+    Column("point", "-", "dimension: the parameter points (the parameters as coordinates along it)"),
+    Column("level", "a_base/a_base*", "dimension: the excitation levels"),
+    Column("repetition", "-", "dimension: the repetitions"),
+    Column("design, parameter, eta", "-", "dimensions of the bands, the indices and the frequency responses"),
+))
 
 
 def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, scheduler: str | None = None,
@@ -436,11 +527,30 @@ def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     result.files.append(write_csv(folder / "sweeps.csv", header(SWEEPS_CSV, sweep=SWEEP_COLUMNS),
                                    [[s.level, *row] for s in sweeps for row in sweep_rows(s)]))
     result.files.append(write_csv(folder / "overview.csv", OVERVIEW_COLUMNS, overview_rows(overview)))
+    result.files.append(_response_netcdf(study, model, folder, point, results, sweeps, overview))
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
                       "wall_time_s": elapsed, "points": 1}
     result.files.append(_metadata(study, model, result, {"summary": result.summary, "overview": overview,
                                                          "landmarks": landmarks(sweeps).summary()}))
     return result
+
+
+def _response_netcdf(study: Study, model: Any, folder: Path, point: dict, results: dict, sweeps: list,
+                     overview: dict) -> Path:
+    """results.nc of a response study (`uq.netcdf`): the runs on level x repetition (the one point's parameters as
+    scalar coordinates), the frequency responses on level x eta (sweep_COLUMN) and the resonant levels per level
+    (overview_COLUMN)."""
+    import xarray as xr
+
+    from sim.stepped_sine.tables import OVERVIEW_COLUMNS, SWEEP_COLUMNS, overview_rows, sweep_rows
+    from uq.netcdf import base_dataset, finish, table_variables
+
+    ds = base_dataset(study, model, [point], results).isel(point=0).drop_vars("point")
+    sweep = table_variables(["level", *SWEEP_COLUMNS], [[s.level, *row] for s in sweeps for row in sweep_rows(s)],
+                            {"level": "level", "eta": "eta"}, prefix="sweep_")
+    over = table_variables(list(OVERVIEW_COLUMNS), overview_rows(overview), {"level": "level"}, prefix="overview_")
+    return finish(xr.merge([ds, xr.Dataset(sweep), xr.Dataset(over)], combine_attrs="override"), study, model,
+                  folder)
 
 
 def _run_response_series(study: Study, *, out: Path | None, jobs: int, scheduler: str | None, resume: bool,
@@ -460,8 +570,22 @@ def _run_response_series(study: Study, *, out: Path | None, jobs: int, scheduler
             totals[key] += part.summary[key]
         parts.append(sub)
     result.summary = totals
+    result.files.append(_series_netcdf(study, folder, parts))
     result.files.append(_metadata(study, study.make_model(), result, {"summary": totals, "series_folders": parts}))
     return result
+
+
+def _series_netcdf(study: Study, folder: Path, parts: list[str]) -> Path:
+    """OUT/results.nc of a response series: the series' studies' datasets along a dimension named after the series'
+    parameter (its values the coordinate)."""
+    import xarray as xr
+
+    from uq.netcdf import finish, open_results
+
+    name, _ = study.series
+    ds = xr.concat([open_results(folder / sub) for sub in parts], dim=name, data_vars="all", coords="different",
+                   compat="equals", join="outer", combine_attrs="drop_conflicts")
+    return finish(ds, study, study.make_model(), folder, {"series_folders": " ".join(parts)})
 
 
 def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: int = 20) -> list[Path]:

@@ -11,7 +11,19 @@ from sim.analysis.trace import TRACE_CSV, TRACE_JSON
 from sim.common.outputs import OutputFile, describe
 from sim.stepped_sine.tables import OVERVIEW_CSV, OVERVIEW_JSON, SWEEP_CSV, SWEEP_JSON
 from uq.compare import COMPARE_CSV
-from uq.execute import BANDS_CSV, POINTS_CSV, RUNS_CSV, SOBOL_CSV, STUDY_JSON, SWEEPS_CSV, TASK_JSON, VARIANCE_CSV
+from uq.design import DESIGN_CSV, DESIGN_JSON, DESIGN_LEVELS_CSV
+from uq.execute import (
+    BANDS_CSV,
+    POINTS_CSV,
+    RESULTS_NC,
+    RUNS_CSV,
+    SOBOL_CSV,
+    STUDY_JSON,
+    SURROGATE_CSV,
+    SWEEPS_CSV,
+    TASK_JSON,
+    VARIANCE_CSV,
+)
 from uq.reproduce_report import FILES
 
 PAGE = Path(__file__).with_name("OUTPUTS.md")
@@ -23,8 +35,10 @@ SECTIONS: tuple[tuple[str, tuple[OutputFile, ...]], ...] = (
                                                                                          IMPACTS_JSON, MODAL_FIT_JSON)),
     ("Study folders (`ies interval`, `ies sobol`, `ies response`, `ies reproduce`)", (RUNS_CSV, POINTS_CSV, BANDS_CSV,
                                                                                      SOBOL_CSV, VARIANCE_CSV,
-                                                                                     SWEEPS_CSV, STUDY_JSON, TASK_JSON)),
+                                                                                     SURROGATE_CSV, SWEEPS_CSV, STUDY_JSON,
+                                                                                     TASK_JSON, RESULTS_NC)),
     ("Several response studies side by side (`ies compare`)", (COMPARE_CSV,)),
+    ("Designs (`ies design`)", (DESIGN_CSV, DESIGN_LEVELS_CSV, DESIGN_JSON)),
 )
 
 INTRO = """# Output reference

@@ -13,8 +13,12 @@ import csv
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:  # imported on use: reading a study's CSV tables needs no xarray
+    import xarray
 
 
 @dataclass(frozen=True)
@@ -172,16 +176,28 @@ def sobol_table(folder: str | Path) -> str:
     confidence = meta["study"]["sobol"]["confidence"]
     repetitions = meta["study"]["repetitions"]
     rows, variance = _rows(folder / "sobol.csv"), _rows(folder / "variance.csv")
-    lines = [f"Sobol' indices ({confidence:.0%} confidence intervals; S1 first order, ST total):"]
+    fits = {(f["output"], float(f["level"])): f for f in _rows(folder / "surrogate.csv")} \
+        if (folder / "surrogate.csv").is_file() else None
+    how = "" if fits is None else ", from a polynomial-chaos surrogate"
+    lines = [f"Sobol' indices ({confidence:.0%} confidence intervals; S1 first order, ST total{how}):"]
     for v in variance:
         o, level = v["output"], float(v["level"])
         share = float(v["noise_share"])
         noise = "unknown (one repetition)" if not np.isfinite(share) else f"{share:.0%}"
         lines.append(f"{o} at level {level:g}: repetition noise {noise} of the variance"
                      + (f"; not analysed: {v['message']}" if v["message"] else ""))
+        fit = (fits or {}).get((o, level))
+        rough = fit is not None and fit["smooth"] == "0"
+        if fit is not None and fit["smooth"] != "":
+            lines.append(f"  surrogate: degree {fit['degree']}, {fit['terms']} terms from {fit['points']} points; "
+                         f"cross-validated error {float(fit['cv_error']):.0%} of the variance (the noise explains "
+                         f"{float(fit['noise_floor']):.0%})")
         for r in (r for r in rows if r["output"] == o and float(r["level"]) == level):
             lines.append(f"  {r['parameter']:>6}  S1 {float(r['S1']):6.3f} +- {float(r['S1_conf']):5.3f}   "
-                         f"ST {float(r['ST']):6.3f} +- {float(r['ST_conf']):5.3f}")
+                         f"ST {float(r['ST']):6.3f} +- {float(r['ST_conf']):5.3f}" + ("   unreliable" if rough else ""))
+        if rough:
+            lines.append(f"  -> NOT SMOOTH: {fit['rough']}; a polynomial smears the jump over every term, so these "
+                         "indices are unreliable: run this study with method = \"saltelli\".")
         if np.isfinite(share) and share >= NOISE_DOMINATES:
             lines.append(f"  -> the repetition noise dominates ({share:.0%} of the variance; 100 % or more: no parameter "
                          "effect is resolved): these indices mostly describe noise. The noise variance falls as "
@@ -189,3 +205,25 @@ def sobol_table(folder: str | Path) -> str:
                          "levels away from the switch between the strongly modulated and the almost periodic response, "
                          "where the response is chaotic.")
     return "\n".join(lines)
+
+
+def open_study(folder: str | Path) -> xarray.Dataset:
+    """A finished study's results as an xarray Dataset (its results.nc, `uq.netcdf`), read into memory.
+
+    Dimensions as the study has them: ``point`` (with each parameter as a coordinate along it), ``level``
+    (a_base / a_base*), ``repetition``; ``design``/``design_point`` (interval), ``parameter`` (Sobol'), ``eta``
+    (response; a series adds a dimension named after its parameter); ``design`` x ``level`` and ``screened`` for
+    `ies design` (`uq.design.write_design_netcdf`). Every variable has CF ``units`` and
+    ``long_name``; ``ds.attrs["study"]`` is the resolved study (JSON) and ``ds.attrs["code_version"]`` the
+    simulator's code version. Example, in Python or a notebook::
+
+        >>> from uq.results import open_study
+        >>> ds = open_study("ies-out/sobol")                    # doctest: +SKIP
+        >>> ds["mean_ST"].sel(level=6.7).to_series()            # doctest: +SKIP
+        >>> ds["mean"].mean("repetition").plot.scatter(x="g")   # doctest: +SKIP
+
+    A folder without results.nc (not a study's output) is a one-line `StudyError`.
+    """
+    from uq.netcdf import open_results
+
+    return open_results(folder)

@@ -52,9 +52,15 @@ Layout (every table and key is optional except where noted; SI units)::
     fix = { k_H = "best_estimate" }   # parameters held fixed in the residual band
 
     [sobol]
-    n = 64                       # base sample size (power of two); n (k + 2) points
+    method = "saltelli"          # "saltelli" (SALib's sampling, the reference) or "pce" (a polynomial-chaos
+                                 # surrogate, uq.surrogate: far fewer runs for a smooth response)
+    n = 64                       # saltelli: base sample size (power of two); n (k + 2) points
     bootstrap = 200
     confidence = 0.95
+    points = 30                  # pce: design points (a Latin hypercube; default 3 per polynomial term)
+    degree = 2                   # pce: total degree of the polynomials (points >= C(k + degree, degree))
+    max_misfit = 0.1             # pce: cross-validated error beyond the noise (share of the variance) above
+                                 # which the response is flagged not smooth
 
     [response]                   # kind "response": the frequency responses and resonant levels of the nominal
     figures = ["fig5", "fig6"]   # point (the parameters' nominal values) at every level, as Figs. 5 and 6, and
@@ -91,7 +97,7 @@ _KEYS = {
     "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "perturb", "repetition",
                    "start", "dt_scale"},
     "interval": {"designs", "interior", "z", "fix"},
-    "sobol": {"n", "bootstrap", "confidence"},
+    "sobol": {"n", "bootstrap", "confidence", "method", "points", "degree", "max_misfit"},
     "response": {"figures", "series"},
 }
 _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
@@ -124,6 +130,10 @@ class Study:
     outputs: tuple[str, ...] = ()
     contact_law: str = "hertz"
     series: tuple[str, tuple[float, ...]] | None = None
+    sobol_method: str = "saltelli"
+    surrogate_points: int = 0
+    surrogate_degree: int = 2
+    max_misfit: float = 0.1
 
     def make_model(self) -> Any:
         return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
@@ -138,7 +148,9 @@ class Study:
             "repetitions": self.repetitions, "output": str(self.output), "source": self.source,
             "levels": list(self.levels), "protocol": dict(self.protocol), "parameters": self.space.to_dict(),
             "interval": {"designs": list(self.designs), "interior": self.interior, "z": self.z, "fix": dict(self.fix)},
-            "sobol": {"n": self.sobol_n, "bootstrap": self.bootstrap, "confidence": self.confidence},
+            "sobol": {"n": self.sobol_n, "bootstrap": self.bootstrap, "confidence": self.confidence,
+                      **({"method": "pce", "points": self.surrogate_points, "degree": self.surrogate_degree,
+                          "max_misfit": self.max_misfit} if self.sobol_method == "pce" else {})},
             "response": {"figures": list(self.figures)}, "variant": dict(self.variant),
             "outputs": list(self.outputs), "contact_law": self.contact_law,
             **({"series": {self.series[0]: list(self.series[1])}} if self.series else {}),
@@ -263,6 +275,7 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError(f"[sobol] confidence must lie in (0, 1), got {confidence}")
     if kind == "sobol" and not space.varied:
         raise StudyError("no parameter is varied; give at least one [parameters.NAME] with min < max")
+    method, points, degree, max_misfit = _parse_surrogate(sb, kind, space)
     figures = data.get("response", {}).get("figures", list(RESPONSE_FIGURES))
     if not isinstance(figures, list) or not figures or any(f not in RESPONSE_FIGURES for f in figures):
         raise StudyError(f"[response] figures must be a list from {', '.join(RESPONSE_FIGURES)}, got {figures!r}")
@@ -276,7 +289,7 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
     series = _parse_series(data.get("response", {}).get("series"), kind, space)
     study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
                   sobol_n, bootstrap, confidence, source, modal_model, tuple(figures), variant, tuple(outputs),
-                  contact_law, series)
+                  contact_law, series, method, points, degree, max_misfit)
     for _, one in study.series_studies():
         _parse_contact_law({"contact_law": contact_law}, one.space)  # every value in range
     model = study.make_model()  # unknown model -> one line now
@@ -287,6 +300,61 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         for mu in (space["friction"].min, space["friction"].max, *(study.series[1] if study.series else ())):
             model.check_physics({"friction": mu, "k_t": k_t})
     return study
+
+
+def _parse_surrogate(sb: Mapping[str, Any], kind: str, space: ParameterSpace) -> tuple[str, int, int, float]:
+    """[sobol] method, points, degree, max_misfit (`uq.surrogate`): (method, design points, degree, allowed misfit)."""
+    from uq.surrogate import MAX_MISFIT, METHODS
+
+    method = sb.get("method", "saltelli")
+    if method not in METHODS:
+        raise StudyError(f"[sobol] method must be one of {', '.join(METHODS)}, got {method!r}")
+    own = sorted({"points", "degree", "max_misfit"} & set(sb))
+    if method != "pce" and own:
+        raise StudyError(f"[sobol] {', '.join(own)} only appl{'ies' if len(own) == 1 else 'y'} to method = \"pce\"")
+    degree = int(_number("sobol", "degree", sb.get("degree", 2), integer=True))
+    points = int(_number("sobol", "points", sb["points"], integer=True)) if "points" in sb else 0
+    max_misfit = float(_number("sobol", "max_misfit", sb.get("max_misfit", MAX_MISFIT)))
+    if method == "pce":
+        return surrogate_settings(kind, len(space.varied), points, degree) + (max_misfit,)
+    return method, points, degree, max_misfit
+
+
+def surrogate_settings(kind: str, k: int, points: int, degree: int) -> tuple[str, int, int]:
+    """("pce", design points, degree) checked for a study of `kind` with `k` varied parameters (`points` 0: the
+    default of `uq.surrogate.default_points`); a one-line StudyError for a kind without a surrogate, too few
+    points for the degree, or OpenTURNS missing."""
+    from uq.surrogate import check_design, default_points, openturns
+
+    if kind != "sobol":
+        raise StudyError(f"method \"pce\" (a surrogate of the Sobol' indices) applies to kind = \"sobol\" only; "
+                         f"a{'n' if kind[0] in 'aeiou' else ''} {kind} study has no surrogate")
+    points = points or default_points(k, degree)
+    check_design(k, points, degree)
+    openturns()
+    return "pce", points, degree
+
+
+def with_sobol_method(study: Study, method: str | None = None, points: int | None = None,
+                      degree: int | None = None) -> Study:
+    """The study with the command line's `--method`, `--points`, `--degree` (None: the study file's), checked as
+    the study file's keys are (one-line StudyError)."""
+    from dataclasses import replace
+
+    from uq.surrogate import METHODS
+
+    method = method or study.sobol_method
+    if method not in METHODS:
+        raise StudyError(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
+    if method != "pce":
+        if points is not None or degree is not None:
+            raise StudyError("--points and --degree apply to --method pce only")
+        return replace(study, sobol_method=method)
+    keep = study.sobol_method == "pce"
+    points = points if points is not None else (study.surrogate_points if keep else 0)
+    degree = degree if degree is not None else study.surrogate_degree
+    _, points, degree = surrogate_settings(study.kind, len(study.space.varied), points, degree)
+    return replace(study, sobol_method="pce", surrogate_points=points, surrogate_degree=degree)
 
 
 def _parse_series(table: Any, kind: str, space: ParameterSpace) -> tuple[str, tuple[float, ...]] | None:

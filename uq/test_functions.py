@@ -8,6 +8,8 @@ failed-run reporting without the simulator.
   noise variance of an r-repetition mean is SIGMA^2 / r against Var(a + 2 b) = 5/12 of uniform a, b.
 * `pure_noise`: seeded Gaussian noise of standard deviation SIGMA whatever a and b: every index it gets
   describes noise (its noise share of the variance is about 1).
+* `step`: a + 2 b + 3 H(a - 0.5) (H the unit step): a jump across the box, as a regime switch makes; a smooth
+  surrogate cannot follow it and must say so.
 * `failing`: a + b, except that it diverges (`sim.common.errors.SimulationDiverged`) for a > 0.9 in repetition 0 and
   returns NaN for b > 0.95: every run there is a failed run that a study must report, not hide.
 """
@@ -42,3 +44,8 @@ def failing(params: Mapping[str, float], level: float, rep: int, seed: int) -> f
     if params["b"] > 0.95:
         return math.nan
     return params["a"] + params["b"]
+
+
+def step(params: Mapping[str, float], level: float, rep: int, seed: int) -> float:
+    """a + 2 b + 3 H(a - 0.5): linear with a jump of 3 at a = 0.5 (deterministic)."""
+    return params["a"] + 2.0 * params["b"] + (3.0 if params["a"] > 0.5 else 0.0)

@@ -48,7 +48,8 @@ def test_a_tiny_design_end_to_end_resumes_and_is_the_same_in_parallel(tmp_path, 
     printed = capsys.readouterr().out
     out = tmp_path / "out"
     assert {p.name for p in out.iterdir()} >= {"design.csv", "design.json", "design-levels.csv", "design-map.png",
-                                               "design-map.pdf", "design-curves.png", "design-curves.pdf", "tasks"}
+                                               "design-map.pdf", "design-curves.png", "design-curves.pdf", "tasks",
+                                               "results.nc"}
     data = json.loads((out / "design.json").read_text())
     assert set(data) == set(d.DESIGN_KEYS)
     best = data["recommendation"]
@@ -60,10 +61,18 @@ def test_a_tiny_design_end_to_end_resumes_and_is_the_same_in_parallel(tmp_path, 
     assert data["baseline"]["clearance_m"] == pytest.approx(0.58e-3)
     with open(out / "design.csv") as f:
         rows = list(csv.DictReader(f))
-    assert list(rows[0]) == [c[0] for c in d.DESIGN_COLUMNS]
+    assert list(rows[0]) == list(d.DESIGN_CSV.names)
     assert sum(r["status"] != "screened" for r in rows) == len(data["verified"])
     assert all(float(r["cavity_m"]) == pytest.approx(2 * (float(r["radius_m"]) + float(r["clearance_m"])))
                for r in rows)
+    # results.nc holds the same numbers as design-levels.csv
+    from uq.results import open_study
+
+    ds = open_study(out)
+    with open(out / "design-levels.csv") as f:
+        levels = list(csv.DictReader(f))
+    assert ds["high"].values.ravel().tolist() == pytest.approx([float(r["high_m"]) for r in levels], rel=1e-12)
+    assert ds["high"].attrs["units"] == "m" and ds.attrs["recommendation"] == best["sentence"]
     # every verified design: 8 corners + the centre, at 2 levels, 1 repetition
     assert all(v["runs"] == 9 * 2 for v in data["verified"])
     # the worst case is in metres: below the structure without IES at the top of the range
