@@ -96,7 +96,7 @@ def study_key(study: Study, model: Any) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, resume: bool, jobs: int,
+def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, *, resume: bool, jobs: int,
                 scheduler: str | None, progress: bool, client: Any) -> tuple[Any, StudyResult, dict, int, float]:
     """Connect to the cluster once (if any), then prepare the output folder and run every task of `points`.
 
@@ -151,8 +151,8 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
             unique.setdefault(p.key(), dict(p.values))
     points = list(unique.values())
     index = {key: i for i, key in enumerate(unique)}
-    model, result, results, ran, elapsed = _run_points(study, model, points, out, resume, jobs, scheduler, progress,
-                                                       client)
+    model, result, results, ran, elapsed = _run_points(study, model, points, out, resume=resume, jobs=jobs,
+                                                       scheduler=scheduler, progress=progress, client=client)
     folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
     level_labels = [f"level {lv:g}" for lv in study.levels]
@@ -254,8 +254,9 @@ def _band_with_failures(design: Design, mean: np.ndarray, se: np.ndarray, z: flo
     cat = lambda attr: np.concatenate([getattr(b, attr) for b in parts])  # noqa: E731
     for b in parts:
         notes.extend(b.notes)
-    return Band(design.name, cat("lower"), cat("upper"), cat("corner_lower"), cat("corner_upper"), cat("flagged"),
-                cat("violation"), cat("tested"), notes)
+    return Band(design=design.name, lower=cat("lower"), upper=cat("upper"), corner_lower=cat("corner_lower"),
+                corner_upper=cat("corner_upper"), flagged=cat("flagged"), violation=cat("violation"),
+                tested=cat("tested"), notes=notes)
 
 
 def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = None, jobs: int = 1,
@@ -269,8 +270,8 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     n = study.sobol_n if n is None else n
     X = sobol_sample(study.space, n, seed=study.seed)
     points = [study.space.from_values(x) for x in X]
-    model, result, results, ran, elapsed = _run_points(study, model, points, out, resume, jobs, scheduler, progress,
-                                                       client)
+    model, result, results, ran, elapsed = _run_points(study, model, points, out, resume=resume, jobs=jobs,
+                                                       scheduler=scheduler, progress=progress, client=client)
     folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
     rows, summary_rows, per_level = [], [], {}
@@ -320,8 +321,8 @@ def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
                                     client=client)
     model = _checked_model(study)
     point = study.space.nominal()
-    model, result, results, ran, elapsed = _run_points(study, model, [point], out, resume, jobs, scheduler, progress,
-                                                       client)
+    model, result, results, ran, elapsed = _run_points(study, model, [point], out, resume=resume, jobs=jobs,
+                                                       scheduler=scheduler, progress=progress, client=client)
     folder = result.folder
     n_failed = sum(1 for rec in results.values() if rec["error"])
     if n_failed:

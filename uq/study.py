@@ -97,9 +97,9 @@ _KEYS = {
 _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Study:
-    """A resolved, validated study (see the module docstring for the file layout)."""
+    """A resolved, validated study (see the module docstring for the file layout); built with named fields."""
 
     name: str
     kind: str
@@ -274,9 +274,11 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError(f"[study] outputs must be a list of distinct output names, e.g. [\"mean\", \"restitution\"], got {outputs!r}")
     contact_law = _parse_contact_law(head, space)
     series = _parse_series(data.get("response", {}).get("series"), kind, space)
-    study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
-                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures), variant, tuple(outputs),
-                  contact_law, series)
+    study = Study(name=name, kind=kind, model=model_spec, space=space, levels=levels, repetitions=reps, seed=seed,
+                  output=output, protocol=protocol, designs=designs, interior=interior, z=z, fix=fix,
+                  sobol_n=sobol_n, bootstrap=bootstrap, confidence=confidence, source=source,
+                  modal_model=modal_model, figures=tuple(figures), variant=variant, outputs=tuple(outputs),
+                  contact_law=contact_law, series=series)
     for _, one in study.series_studies():
         _parse_contact_law({"contact_law": contact_law}, one.space)  # every value in range
     model = study.make_model()  # unknown model -> one line now

@@ -214,10 +214,12 @@ def damping_factor(model: ModalModel, impactor: Impactor) -> float:
 def system_arrays(model: ModalModel, impactor: Impactor) -> SystemArrays:
     """Pack a modal model and an impactor for the kernels (contiguous float64 copies)."""
     as_f8 = lambda a: np.ascontiguousarray(a, dtype=np.float64).copy()  # noqa: E731
+    phi_f, k_t, slip_force, slider = friction_arrays(model, impactor)
     return SystemArrays(
-        as_f8(model.omega), as_f8(model.damping_ratios), as_f8(model.phi_wall_left), as_f8(model.phi_wall_right),
-        as_f8(model.phi_tip), as_f8(model.participation), float(impactor.mass), float(impactor.k_H),
-        float(impactor.clearance), damping_factor(model, impactor), *friction_arrays(model, impactor),
+        omega=as_f8(model.omega), D=as_f8(model.damping_ratios), phi_l=as_f8(model.phi_wall_left),
+        phi_r=as_f8(model.phi_wall_right), phi_tip=as_f8(model.phi_tip), gamma=as_f8(model.participation),
+        m_a=float(impactor.mass), k_H=float(impactor.k_H), g=float(impactor.clearance),
+        c_damp=damping_factor(model, impactor), phi_f=phi_f, k_t=k_t, slip_force=slip_force, slider=slider,
     )
 
 
