@@ -22,7 +22,7 @@ from typing import Any, Iterator, Sequence
 
 from sim.analysis import cli as signal_cli
 from sim.common.errors import SimulationInputError
-from sim.common.options import clearance, figure_file, friction_coefficient, hertz_constant, positive_int, tangential_stiffness
+from sim.common.options import figure_file, positive_int
 
 MODES_HELP = "modal model of the host structure: frequencies, damping, mode values, participation (built-in rig or file)"
 SWEEP_HELP = "stepped-sine frequency response (mean and max amplitude per eta, spread over repetitions; Fig. 5)"
@@ -281,28 +281,22 @@ def modes_command(args: argparse.Namespace) -> int:
 # ---- the system and the protocol, shared by ies sweep and ies overview ---------------------------------------
 
 def add_system_arguments(parser: argparse.ArgumentParser) -> None:
-    """Model and impactor options (Table 2 parameters)."""
+    """Model and impactor options: --model, --no-impactor, --contact-law and one option per parameter of
+    `sim.model.parameters.PARAMETERS` that has one (Table 2's D, g, k_H; r_cont, friction, k_t)."""
+    from sim.model.contact_law import CONTACT_LAWS
+    from sim.model.parameters import PARAMETERS
+
     parser.add_argument("--model", metavar="FILE", help="modal-model file (default: the built-in model of the seed rig)")
-    parser.add_argument("--D", type=float, metavar="D1", help="modal damping ratio of mode 1 (-), default the model's (0.00085)")
-    parser.add_argument("--g", type=clearance, metavar="G",
-                        help="clearance g in m, or with a unit: 0.58mm, 580um (default 0.58 mm)")
-    parser.add_argument("--k-H", dest="k_H", type=hertz_constant, metavar="K_H",
-                        help="Hertz constant k_H in N/m^1.5, or with a unit: 282e3N/mm^1.5 (default 282e3 N/mm^1.5 = "
-                             "8.918e9 N/m^1.5)")
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
-    parser.add_argument("--contact-law", dest="contact_law", choices=("hertz", "hertz-damped"), default=None,  # sim.model.contact_law.CONTACT_LAWS
+    parser.add_argument("--contact-law", dest="contact_law", choices=CONTACT_LAWS, default=None,
                         help="normal contact law at both walls: hertz (Eq. 4, elastic, default) or hertz-damped (Eq. 10; "
                              "needs the model's beam mass; the exact integrator then takes every contact by "
                              "Dormand-Prince)")
-    parser.add_argument("--r-cont", dest="r_cont", type=float, default=None, metavar="R",
-                        help="r_cont,diss of Eq. 10 in (0, 1]: the coefficient of restitution the damped law is designed "
-                             "for (1 = elastic, bit for bit); implies --contact-law hertz-damped (default there 0.99)")
-    parser.add_argument("--friction", type=friction_coefficient, default=0.0, metavar="MU",
-                        help="Coulomb coefficient of dry friction between the sphere and the cavity floor (Appendix C; "
-                             "0 = off, the default; the paper: 0.07); needs --integrator ode3 and the model's phi_floor")
-    parser.add_argument("--k-t", dest="k_t", type=tangential_stiffness, default=22e6, metavar="K_T",
-                        help="tangential stiffness of the floor contact in N/m, or with a unit: 22kN/mm (default, "
-                             "Appendix C)")
+    for name, parameter in PARAMETERS.items():
+        option = parameter.option
+        if option is not None:
+            parser.add_argument(option.flag, dest=name, type=option.parse, default=None, metavar=option.metavar,
+                                help=option.help)
 
 
 def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int) -> None:
@@ -399,31 +393,20 @@ def model_file(path: str) -> Any:
 
 
 def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
-    """(modal model, impactor or None) of the system and impactor options (Eqs. 3-7, Table 2)."""
+    """(modal model, impactor or None) of the system and impactor options (Eqs. 3-7, Table 2), built and checked by
+    `sim.model.system.build_system` from the options of `sim.model.parameters.PARAMETERS`."""
     from sim.hosts.rig import seed_rig_model
-    from sim.model.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor, system_arrays
+    from sim.model.parameters import PARAMETERS, SystemSettings, system_settings
+    from sim.model.system import build_impactor
+    from sim.model.system import build_system as build
 
     model = model_file(args.model) if args.model else seed_rig_model(n_modes=9)
-    if args.D is not None:
-        model = model.with_damping(args.D)
-    clearance = CLEARANCE_NOMINAL if args.g is None else args.g
-    k_H = K_H_NOMINAL if args.k_H is None else args.k_H
-    impactor = Impactor(SPHERE_MASS, clearance, k_H, contact_law(args), args.friction, args.k_t)  # validated even
-    if not args.no_impactor:                                                                    # with --no-impactor
-        system_arrays(model, impactor)  # Eq. 10 needs the beam mass, friction phi_floor: fail before any work
-        if impactor.friction > 0 and args.integrator != "ode3":
-            raise SimulationInputError(f"dry friction (--friction {args.friction:g}, Appendix C) is in the ode3 integrator "
-                                       f"only; add --integrator ode3")
-    return model, (None if args.no_impactor else impactor)
-
-
-def contact_law(args: argparse.Namespace) -> Any:
-    """The `sim.model.contact_law.ContactLaw` of --contact-law and --r-cont (--r-cont alone implies the damped law)."""
-    from sim.model.contact_law import DEFAULT_R_CONT, ContactLaw
-
-    name = args.contact_law or ("hertz-damped" if args.r_cont is not None else "hertz")
-    r_cont = args.r_cont if args.r_cont is not None else (DEFAULT_R_CONT if name == "hertz-damped" else 1.0)
-    return ContactLaw(name, r_cont)
+    values = {name: getattr(args, name, None) for name in PARAMETERS}
+    settings = system_settings(values, SystemSettings(contact_law=args.contact_law))
+    if args.no_impactor:  # the impactor's values are checked all the same
+        build_impactor(settings)
+        return (model if settings.D1 is None else model.with_damping(settings.D1)), None
+    return build(model, settings, integrator=args.integrator)
 
 
 def system_data(model: Any, impactor: Any) -> dict:

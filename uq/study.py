@@ -76,8 +76,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+from sim.model.parameters import PARAMETERS
 from uq.errors import StudyError
-from uq.models import make_model
+from uq.models import ResponseModel, make_model
 from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_H, resolve_value
 
 KINDS = ("interval", "sobol", "response")
@@ -125,7 +126,8 @@ class Study:
     contact_law: str = "hertz"
     series: tuple[str, tuple[float, ...]] | None = None
 
-    def make_model(self) -> Any:
+    def make_model(self) -> ResponseModel:
+        """The study's response model (`uq.models.make_model`)."""
         return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
                           modal_model=self.modal_model, variant=self.variant, outputs=self.outputs,
                           contact_law=self.contact_law)
@@ -404,7 +406,7 @@ def _parse_fix(fix: Any, space: ParameterSpace, base_dir: Path, source: str) -> 
             if f"{pname}_best_estimate" not in space.extras:
                 raise StudyError(f"[interval] fix: '{pname}' has no best estimate; give a number")
             value = space.extras[f"{pname}_best_estimate"]
-        elif pname in ("k_H", "g"):
+        elif pname in PARAMETERS and PARAMETERS[pname].quantity is not None:  # k_H, g, k_t: also with a unit
             value = resolve_value(pname, raw, base_dir=base_dir)
             _warn_implausible(source, f"[interval] fix.{pname}", pname, value)
         else:
