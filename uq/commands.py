@@ -45,13 +45,6 @@ REPRODUCE_HELP = ("reproduce the paper's Figs. 5 and 6 (nominal response), 7 and
 PLOT_HELP = "redraw a result folder's figures from its saved data (formats, style, levels) without recomputing"
 COMPARE_HELP = ("the Fig. 6 landmarks of several response studies side by side with the paper's: switch, optimum, "
                 "levels at 7.4 and 9, impacts, r and energy share at 7.4 (table and figure)")
-#: the paper's figures that `ies reproduce` runs, in the order of `all`
-FIGURES = ("fig5", "fig6", "fig7", "fig8", "figD2", "figD3")
-#: figures `ies reproduce` runs when named, not in `all` (five contact laws, friction: minutes even when quick)
-EXTRA_FIGURES = ("fig11", "figC1")
-#: the levels whose time histories a figure traces (Fig. C.1b: 1.26 and 5.3, with friction)
-TRACED = {"figC1": (1.26, 5.3)}
-
 
 def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
     """Register `interval`, `sobol`, `response`, `reproduce`, `plot` and `compare` on the front door's subparsers (argparse);
@@ -166,58 +159,33 @@ def _report(result: Any, figures: list[Path]) -> None:
 
 
 def print_interval_result(folder: Path, summary: dict, name: str) -> None:
-    """The bands with their noise and checks, and for an individual variation the trends (Figs. 7, 8)."""
-    from uq.results import band_table, influence_line, trend_table
+    """The bands with their noise and checks, and for an individual variation the trends (Figs. 7, 8;
+    `uq.paper_figures.interval_table`)."""
+    from uq.paper_figures import interval_table
 
-    for key in summary["untested"]:
-        print(f"{name}: monotonicity could not be tested for {key} (one repetition: no noise estimate)")
-    if any(key.startswith("individual:") for key in summary["monotone"]):
-        print(f"{name}: change of the resonant level from each parameter's min to its max:")
-        print(trend_table(folder))
-        print(f"{name}: {influence_line(folder)}")
-    print(f"{name}: bands (lower, nominal, upper +- standard error) and their checks:")
-    print(band_table(folder))
+    interval_table(folder, summary, name)
 
 
 def print_response_result(folder: Path, name: str) -> None:
-    """The resonant levels per excitation level and the optimum (Fig. 6); for Figs. D.2, D.3 the impacts and
-    scattering measures at the resonant eta."""
-    import json
+    """The table a response study prints: that of the figure it is named after when it has one
+    (`uq.paper_figures.PaperFigure.response_table`: Figs. D.2, D.3 the impacts and scattering measures), else the
+    resonant levels and the optimum (Fig. 6)."""
+    from uq.paper_figures import PAPER_FIGURES, response_table
 
-    from sim.stepped_sine.tables import optimum_line, overview_text, scattering_text
-
-    from sim.hosts.variants import switch_line
-
-    data = json.loads((folder / "study.json").read_text())
-    if "series_folders" in data:
-        from uq.figures import series_overviews
-        from sim.stepped_sine.tables import series_text
-
-        print(f"{name}: resonant mean (a / a_noabs*) and the input's dissipation shares at the resonant eta "
-              f"(contact / friction / mode 1 / modes 2..N) for each value:")
-        print(series_text(series_overviews(folder)))
-        return
-    overview = data["overview"]
-    if name in ("figD2", "figD3"):
-        print(f"{name}: impacts, restitution and energy scattering at the resonant eta of the nominal point:")
-        print(scattering_text(overview))
-        return
-    print(f"{name}: resonant levels (a / a_noabs*) of the nominal point:")
-    print(overview_text(overview))
-    print(f"{name}: {optimum_line(overview)}")
-    if "landmarks" in data:
-        print(f"{name}: {switch_line(data['landmarks'])}")
+    row = PAPER_FIGURES.get(name)
+    (response_table if row is None else row.response_table)(folder, {}, name)
 
 
 # ---- ies reproduce ------------------------------------------------------------------------------------------
 
 def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies reproduce`."""
-    parser.add_argument("figure", choices=(*FIGURES, *EXTRA_FIGURES, "all"),
-                        help="which figure(s): fig5 (frequency responses), fig6 (resonant level vs excitation level), "
-                             "fig7 and fig8 (uncertainty of D, g, k_H), figD2 and figD3 (impacts per period and "
-                             "restitution vs excitation level), fig11 (damped contact law, Eq. 10) and figC1 (dry friction, "
-                             "Appendix C; both not in all), all")
+    from uq.paper_figures import PAPER_FIGURES
+
+    rows = PAPER_FIGURES.values()
+    parser.add_argument("figure", choices=(*PAPER_FIGURES, "all"),
+                        help="which figure(s): " + ", ".join(f"{row.name} ({row.help}{'' if row.in_all else '; not in all'})"
+                                                             for row in rows) + ", all")
     parser.add_argument("--quick", action="store_true",
                         help="reduced protocol (fewer levels, frequencies, repetitions, shorter holds); same trends")
     parser.add_argument("--out", type=Path, default=Path("ies-out/reproduce"), metavar="DIR",
@@ -238,10 +206,10 @@ def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def study_file(figure: str, quick: bool) -> Path:
-    """The shipped study file of a figure."""
-    from importlib.resources import files
+    """The study file of a figure (`uq.paper_figures.PaperFigure.study_file`)."""
+    from uq.paper_figures import PAPER_FIGURES
 
-    return Path(str(files("uq") / "studies" / f"{figure}{'-quick' if quick else ''}.toml"))
+    return PAPER_FIGURES[figure].study_file(quick)
 
 
 def run_calibration(calibrate: Calibrate, out: Path) -> dict | None:
@@ -261,21 +229,6 @@ def run_calibration(calibrate: Calibrate, out: Path) -> dict | None:
     return data
 
 
-def with_calibration(study: Any, k_H_cal: float) -> Any:
-    """The study with k_H's upper bound at the calibrated value (and the best estimate kept below it)."""
-    from uq.space import K_H_STAR, ParameterSpace
-
-    space = study.space
-    k = space["k_H"]
-    best = space.extras.get("k_H_best_estimate", 1.25 * K_H_STAR)
-    if best > k_H_cal:
-        best = 0.5 * (k.min + k_H_cal)
-    params = tuple(replace(p, max=max(k_H_cal, p.min)) if p.name == "k_H" else p for p in space.parameters)
-    new_space = ParameterSpace(params, {**space.extras, "k_H_best_estimate": best, "k_H_calibrated": k_H_cal})
-    fix = {**study.fix, "k_H": best} if "k_H" in study.fix else dict(study.fix)
-    return replace(study, space=new_space, fix=fix)
-
-
 def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
     """`ies reproduce`: check every study first, connect to the cluster once, then calibrate (for Figs. 7-8, with
     `calibrate` unless --calibration FILE or --no-calibration) and run."""
@@ -283,7 +236,9 @@ def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
     from uq.space import calibrated_k_H
     from uq.study import load_study
 
-    figures = FIGURES if args.figure == "all" else (args.figure,)
+    from uq.paper_figures import figures_of_all
+
+    figures = figures_of_all() if args.figure == "all" else (args.figure,)
     studies = [load_study(study_file(f, args.quick)) for f in figures]
     if args.integrator:
         studies = [replace(s, protocol={**s.protocol, "integrator": args.integrator}) for s in studies]
@@ -303,43 +258,37 @@ def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list
                calibrate: Calibrate, calibration: dict | None) -> int:
     """Calibration (the given one, or run unless disabled) when an interval study needs it, then each figure's
     study, its figures and its summary."""
-    from uq.errors import StudyError
     from uq.execute import run_interval_study, run_response_study
-    from uq.figures import interval_figures, response_figures
+    from uq.paper_figures import PAPER_FIGURES
     from uq.space import K_H_STAR, calibrated_k_H
+    from uq.study import with_calibration
 
     out = args.out
     calibrated = False
     for figure, study in zip(figures, studies):
+        row = PAPER_FIGURES[figure]
         if study.kind == "interval" and "k_H" in [p.name for p in study.space.varied]:  # calibrated once, first
             if not calibrated and calibration is None and not args.no_calibration:
                 calibration = run_calibration(calibrate, out)
             if calibration is not None:
                 k_cal = calibrated_k_H(calibration)
-                if k_cal < K_H_STAR:
-                    raise StudyError(f"the calibrated k_H = {k_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; a "
-                                     "crater should stiffen the contact: check the calibration or use --no-calibration")
+                study = with_calibration(study, k_cal)  # one line if k_cal < k_H*
                 if not calibrated:
                     print(f"calibrated k_H = {k_cal:.4g} N/m^1.5 = {k_cal / K_H_STAR:.3f} k_H* (upper bound of k_H)")
-                study = with_calibration(study, k_cal)
             calibrated = True
         folder = out / figure
         print(f"{figure}: {study.source} -> {folder}/")
-        run, draw = ((run_response_study, response_figures) if study.kind == "response"
-                     else (run_interval_study, interval_figures))
+        run = run_response_study if study.kind == "response" else run_interval_study
         result = run(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet)
-        paths = draw(result.folder)
-        if figure in TRACED:
+        paths = row.draw(result.folder)
+        if row.traced:
             from uq.execute import series_traces
 
-            paths += series_traces(study, folder, TRACED[figure])
+            paths += series_traces(study, folder, row.traced)
         s = result.summary
         print(f"{figure}: {s['tasks']} runs ({s['ran']} run now), {s['failed_runs']} failed, "
               f"{s['wall_time_s']:.1f} s; figures: {', '.join(p.name for p in paths)}")
-        if study.kind == "response":
-            print_response_result(folder, figure)
-        else:
-            print_interval_result(folder, s, figure)
+        row.table(folder, s, figure)
     return 0
 
 

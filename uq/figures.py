@@ -19,6 +19,7 @@ from __future__ import annotations
 import csv
 import json
 from collections import defaultdict
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -136,14 +137,11 @@ def _marks(ax: Any, band: dict, prefix: str = "") -> None:
                 label=f"{prefix}monotonicity not tested (no noise estimate)")
 
 
-#: the joint band's figure per banded output: file stem and title (Fig. 8 for the response level, Fig. D.3 for r)
-_BOX_FIGURES = {"mean": ("fig8", "Joint variation (cf. Fig. 8)"),
-                "restitution": ("figD3", "Modal coefficient of restitution from the tip, joint variation (cf. Fig. D.3)"),
-                "restitution_wall": ("figD3", "Modal coefficient of restitution from the wall, joint variation (cf. Fig. D.3)")}
-
-
 def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
-    """Draw Figs. 7 and 8 (as far as the study has the designs) and the nominal levels from folder/*.csv."""
+    """Draw Figs. 7 and 8 (as far as the study has the designs; the joint band under the name of the row of
+    `uq.paper_figures.PAPER_FIGURES` that shows the output) and the nominal levels from folder/*.csv."""
+    from uq.paper_figures import INDIVIDUAL_FIGURE, box_figure
+
     folder = Path(folder)
     options = options or PlotOptions()
     plt = pyplot()
@@ -180,7 +178,7 @@ def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> 
         fig.suptitle(f"Individual variation (cf. Fig. 7); {nominal_text}", fontsize=9)
         fig.text(0.5, 0.005, note, ha="center", fontsize=7)
         fig.tight_layout(rect=(0, 0.03, 1, 1))
-        paths += _save(fig, folder, "fig7", options)
+        paths += _save(fig, folder, INDIVIDUAL_FIGURE, options)
         plt.close(fig)
 
     box = [d for d in designs if d in ("joint", "residual")]
@@ -194,9 +192,10 @@ def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> 
             _band_with_noise(ax, band, color, alpha, f"{label} (+- SE of its edges)")
             _marks(ax, band, prefix=f"{d}: ")
         _errorbar(ax, *nominal, "k.--", label=nominal_text)
-        stem, title = _BOX_FIGURES.get(output, _BOX_FIGURES["mean"])
-        if stem == "figD3":
-            ax.axhline(0.8, color="k", lw=1, ls="-.", alpha=0.6, label="paper: r ~ 0.8 (Fig. D.3)")
+        row = box_figure(output)  # Fig. 8 for the resonant level, Fig. D.3 for r (uq.paper_figures)
+        stem, title = row.name, row.box_titles.get(output) or next(iter(row.box_titles.values()))
+        if row.reference is not None:
+            ax.axhline(row.reference[0], color="k", lw=1, ls="-.", alpha=0.6, label=row.reference[1])
         ax.set_xlabel(_LEVEL)
         ax.set_ylabel(_YLABEL.get(output, output))
         ax.set_title(title, fontsize=10)
@@ -281,48 +280,87 @@ def read_overview(folder: Path, options: PlotOptions | None = None) -> dict[str,
     return dict(data)
 
 
+@dataclass(frozen=True)
+class ResponseData:
+    """What a response study's figures are drawn from: its folder, study.json (`meta`), overview.csv for the
+    chosen levels (`read_overview`), the plot options and the line of run settings every title carries."""
+
+    folder: Path
+    meta: dict
+    overview: dict[str, list]
+    options: PlotOptions
+    runs: str
+
+
 def response_figures(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
-    """Fig. 5 (the frequency response at every level, a panel each) and Fig. 6 (resonant levels against the
-    excitation level, the paper's optimum marked), as the study's [response] figures ask, from sweeps.csv and
-    overview.csv."""
-    from sim.plots.figures import plot_overview, plot_sweeps
+    """The figures a response study's [response] figures ask for, each drawn by its row of
+    `uq.paper_figures.PAPER_FIGURES` (Figs. 5, 6, D.2, D.3 from sweeps.csv, overview.csv and runs.csv; a series
+    study's Fig. 11 or C.1 from each value's overview.csv)."""
+    from uq.paper_figures import PAPER_FIGURES
 
     folder = Path(folder)
     options = options or PlotOptions()
     meta = _study(folder)
+    protocol = meta["study"]["protocol_resolved"]
     if "series_folders" in meta:
-        return _series_figure(folder, meta, options)
+        runs = (f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold, "
+                f"{protocol['integrator']}")
+        row = PAPER_FIGURES[meta["study"]["response"]["figures"][0]]
+        return row.series_panel(ResponseData(folder, meta, {}, options, runs), row.name) if row.series_panel else []
     overview = read_overview(folder, options)
     selected([float(r["level"]) for r in _rows(folder / "overview.csv")], options, folder)
-    protocol = meta["study"]["protocol_resolved"]
     runs = f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold"
+    data = ResponseData(folder, meta, overview, options, runs)
     paths: list[Path] = []
-    if "fig5" in meta["study"]["response"]["figures"]:
-        by_level: dict[float, dict[str, list]] = defaultdict(lambda: defaultdict(list))
-        for r in _rows(folder / "sweeps.csv", options):
-            for key, value in r.items():
-                by_level[float(r["level"])][key].append(value if key == "regime" else float(value))
-        regime = dict(zip(overview["levels"], overview["regime"]))
-        panels = [(data, f"a_base/a_base* = {level:g} (resonance: {regime.get(level, '?')})")
-                  for level, data in sorted(by_level.items())]
-        paths += options.paths(folder, "fig5")
-        for path in options.paths(folder, "fig5"):
-            plot_sweeps(panels, path, f"Frequency responses (cf. Fig. 5), nominal parameters, {runs}; bands: "
-                                      "range of the runs")
-    for figure in ("figD2", "figD3"):
-        if figure in meta["study"]["response"]["figures"]:
-            from sim.plots.figures import plot_scattering
+    listed = set(meta["study"]["response"]["figures"])
+    for row in PAPER_FIGURES.values():
+        if row.name in listed and row.response_panel is not None:
+            paths += row.response_panel(data, row.name)
+    return paths
 
-            what = "impacts per period (cf. Fig. D.2)" if figure == "figD2" else "restitution, APR levels (cf. Fig. D.3)"
-            runs_rows = _rows(folder / "runs.csv", options)
-            for path in options.paths(folder, figure):
-                plot_scattering(overview, runs_rows, path, f"{what} at the resonant eta, nominal parameters, {runs}", figure)
-            paths += options.paths(folder, figure)
-    if "fig6" in meta["study"]["response"]["figures"]:
-        paths += options.paths(folder, "fig6")
-        for path in options.paths(folder, "fig6"):
-            plot_overview(overview, path, f"Resonant level vs excitation level (cf. Fig. 6), nominal parameters, {runs}",
-                          paper_optimum=True)
+
+def frequency_responses(data: ResponseData, stem: str) -> list[Path]:
+    """Fig. 5: the frequency response at every level, a panel each, from sweeps.csv."""
+    from sim.plots.figures import plot_sweeps
+
+    by_level: dict[float, dict[str, list]] = defaultdict(lambda: defaultdict(list))
+    for r in _rows(data.folder / "sweeps.csv", data.options):
+        for key, value in r.items():
+            by_level[float(r["level"])][key].append(value if key == "regime" else float(value))
+    regime = dict(zip(data.overview["levels"], data.overview["regime"]))
+    panels = [(values, f"a_base/a_base* = {level:g} (resonance: {regime.get(level, '?')})")
+              for level, values in sorted(by_level.items())]
+    paths = data.options.paths(data.folder, stem)
+    for path in paths:
+        plot_sweeps(panels, path, f"Frequency responses (cf. Fig. 5), nominal parameters, {data.runs}; bands: "
+                                  "range of the runs")
+    return paths
+
+
+def scattering_figure(measure: str, what: str):
+    """A drawer of Fig. D.2 (`measure` "impacts") or D.3 ("restitution") at the resonant eta from overview.csv
+    and runs.csv (`sim.plots.figures.plot_scattering`); `what` begins its title."""
+    def draw(data: ResponseData, stem: str) -> list[Path]:
+        from sim.plots.figures import plot_scattering
+
+        runs_rows = _rows(data.folder / "runs.csv", data.options)
+        paths = data.options.paths(data.folder, stem)
+        for path in paths:
+            plot_scattering(data.overview, runs_rows, path, f"{what} at the resonant eta, nominal parameters, {data.runs}",
+                            measure)
+        return paths
+
+    return draw
+
+
+def resonant_levels(data: ResponseData, stem: str) -> list[Path]:
+    """Fig. 6: resonant levels against the excitation level, the paper's optimum marked, from overview.csv."""
+    from sim.plots.figures import plot_overview
+
+    paths = data.options.paths(data.folder, stem)
+    for path in paths:
+        plot_overview(data.overview, path, f"Resonant level vs excitation level (cf. Fig. 6), nominal parameters, "
+                                           f"{data.runs}", paper_optimum=True)
     return paths
 
 
@@ -332,31 +370,25 @@ def series_overviews(folder: Path, options: PlotOptions | None = None) -> list[t
     return [(sub, read_overview(folder / sub, options)) for sub in meta["series_folders"]]
 
 
-def _series_figure(folder: Path, meta: dict, options: PlotOptions) -> list[Path]:
-    """Fig. 11: the resonant mean against the excitation level for each value of the series."""
-    from sim.plots.figures import plot_series
+def series_figure(caption: str, paper_line: tuple[float, str] | None = None):
+    """A drawer of a series study's figure (Fig. 11, C.1): the resonant mean against the excitation level for each
+    value of the series; `caption` ("cf. Fig. 11") and the paper's level to mark (`paper_line`) go on it."""
+    def draw(data: ResponseData, stem: str) -> list[Path]:
+        from sim.plots.figures import plot_series
 
-    protocol = meta["study"]["protocol_resolved"]
-    name = next(iter(meta["study"]["series"]))
-    figure = meta["study"]["response"]["figures"][0]
-    runs = (f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold, "
-            f"{protocol['integrator']}")
-    paper = SERIES_FIGURES.get(figure, ("", None))
-    paths = options.paths(folder, figure)
-    for path in paths:
-        plot_series(series_overviews(folder, options), path, f"Resonant mean for each {name} ({paper[0]}), contact law "
-                    f"{meta['study']['contact_law']}, {runs}", paper[1])
-    return paths
+        name = next(iter(data.meta["study"]["series"]))
+        paths = data.options.paths(data.folder, stem)
+        for path in paths:
+            plot_series(series_overviews(data.folder, data.options), path, f"Resonant mean for each {name} ({caption}), "
+                        f"contact law {data.meta['study']['contact_law']}, {data.runs}", paper_line)
+        return paths
 
-
-#: the paper's figure of a series study and what the paper says (a level marked on it)
-SERIES_FIGURES = {"fig11": ("cf. Fig. 11", (7.5, "paper: contact dissipation matters above 7.5")),
-                  "figC1": ("cf. Fig. C.1 and the low end of Fig. 6", None)}
+    return draw
 
 
 register("ies interval", _kind_is("interval"))(interval_figures)
 register("ies sobol", _kind_is("sobol"))(sobol_figure)
-register("response study (ies reproduce fig5, fig6, figD2, figD3)", _kind_is("response"))(response_figures)
+register("response study (ies response, ies reproduce of a response figure)", _kind_is("response"))(response_figures)
 
 
 def _result_children(folder: Path) -> list[Path]:

@@ -82,8 +82,6 @@ from uq.models import ResponseModel, make_model
 from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_H, resolve_value
 
 KINDS = ("interval", "sobol", "response")
-#: the figures a response study draws (Figs. 5 and 6 of the seed paper)
-RESPONSE_FIGURES = ("fig5", "fig6", "figD2", "figD3", "fig11", "figC1")
 DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
     "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output", "outputs", "contact_law"},
@@ -96,6 +94,14 @@ _KEYS = {
     "response": {"figures", "series"},
 }
 _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
+
+
+def _response_figure_names() -> tuple[str, ...]:
+    """The figures a response study may draw: the response rows of `uq.paper_figures.PAPER_FIGURES` (imported here:
+    it brings the figure code)."""
+    from uq.paper_figures import response_figure_names
+
+    return response_figure_names()
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -120,7 +126,7 @@ class Study:
     confidence: float = 0.95
     source: str = ""
     modal_model: Path | None = None
-    figures: tuple[str, ...] = RESPONSE_FIGURES
+    figures: tuple[str, ...] = field(default_factory=lambda: _response_figure_names())
     variant: Mapping[str, float] = field(default_factory=dict)
     outputs: tuple[str, ...] = ()
     contact_law: str = "hertz"
@@ -159,6 +165,29 @@ class Study:
             space = ParameterSpace(params, self.space.extras)
             out.append((f"{name}={value:g}", replace(self, space=space, series=None, name=f"{self.name} {name}={value:g}")))
         return out
+
+
+def with_calibration(study: Study, k_H_cal: float) -> Study:
+    """The study with k_H's upper bound at a calibrated k_H (N/m^1.5; `ies calibrate`), as the paper does with its BEM
+    result 1.52 k_H* (Sect. 4.1): the best estimate stays (1.25 k_H* by default) unless the calibration falls below
+    it, then it is the midpoint of k_H's lower bound and the calibrated value. A calibrated k_H below k_H* (Eq. 8)
+    is refused with one line: a crater stiffens the contact."""
+    from dataclasses import replace
+
+    from uq.space import K_H_BEST_ESTIMATE, K_H_STAR
+
+    if k_H_cal < K_H_STAR:
+        raise StudyError(f"the calibrated k_H = {k_H_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; a crater should "
+                         "stiffen the contact: check the calibration or use --no-calibration")
+    space = study.space
+    k = space["k_H"]
+    best = space.extras.get("k_H_best_estimate", K_H_BEST_ESTIMATE)
+    if best > k_H_cal:
+        best = 0.5 * (k.min + k_H_cal)
+    params = tuple(replace(p, max=max(k_H_cal, p.min)) if p.name == "k_H" else p for p in space.parameters)
+    new_space = ParameterSpace(params, {**space.extras, "k_H_best_estimate": best, "k_H_calibrated": k_H_cal})
+    fix = {**study.fix, "k_H": best} if "k_H" in study.fix else dict(study.fix)
+    return replace(study, space=new_space, fix=fix)
 
 
 def load_study(path: str | Path) -> Study:
@@ -265,9 +294,10 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError(f"[sobol] confidence must lie in (0, 1), got {confidence}")
     if kind == "sobol" and not space.varied:
         raise StudyError("no parameter is varied; give at least one [parameters.NAME] with min < max")
-    figures = data.get("response", {}).get("figures", list(RESPONSE_FIGURES))
-    if not isinstance(figures, list) or not figures or any(f not in RESPONSE_FIGURES for f in figures):
-        raise StudyError(f"[response] figures must be a list from {', '.join(RESPONSE_FIGURES)}, got {figures!r}")
+    known = _response_figure_names()
+    figures = data.get("response", {}).get("figures", list(known))
+    if not isinstance(figures, list) or not figures or any(f not in known for f in figures):
+        raise StudyError(f"[response] figures must be a list from {', '.join(known)}, got {figures!r}")
     if kind == "response" and model_spec != "ies":
         raise StudyError("a response study runs the simulator: model = \"ies\"")
 

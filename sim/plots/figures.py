@@ -150,16 +150,22 @@ def plot_series(series: Sequence[tuple[str, Mapping[str, Any]]], path: str | os.
             ax.legend(fontsize=7, loc="upper left")
 
 
+#: what `plot_scattering` draws: impacts per period (Fig. D.2) or the coefficient of restitution (Fig. D.3)
+SCATTERING_PLOTS = ("impacts", "restitution")
+
+
 def plot_scattering(overview: Mapping[str, Any], runs: Sequence[Mapping[str, Any]], path: str | os.PathLike,
-                    title: str, figure: str) -> None:
-    """Fig. D.2 ("figD2": all and significant impacts per excitation period) or Fig. D.3 ("figD3": the modal
+                    title: str, measure: str) -> None:
+    """Fig. D.2 (`measure` "impacts": all and significant impacts per excitation period) or Fig. D.3 ("restitution": the modal
     coefficient of restitution r, Eq. D.1, from the tip and from the wall, at the levels whose resonant response
     is almost periodic) against the excitation level, at the resonant eta (`sim.stepped_sine.tables.overview_data` keys), each
     with the range of the runs' own values as error bars (`runs`: rows with level and the measures; Appendix D)."""
     import numpy as np
 
     levels = np.asarray(overview["levels"], dtype=float)
-    if figure == "figD2":
+    if measure not in SCATTERING_PLOTS:
+        raise ValueError(f"plot_scattering: measure {measure!r} is not one of {', '.join(SCATTERING_PLOTS)}")
+    if measure == "impacts":
         curves = (("impacts_per_period", "all contact onsets", "s--", "tab:gray"),
                   ("significant_impacts_per_period", "significant impacts", "o-", "tab:blue"))
         ylabel = "impacts per excitation period"
@@ -182,7 +188,7 @@ def plot_scattering(overview: Mapping[str, Any], runs: Sequence[Mapping[str, Any
                             label=f"{label} (bars: range of the runs)")
             else:
                 ax.plot(levels[keep], value, style, color=color, ms=4, lw=1.2, label=label)
-        if figure == "figD3":
+        if measure == "restitution":
             ax.axhline(0.8, color="k", lw=1, ls="-.", alpha=0.6, label="paper: r ~ 0.8 (Fig. D.3)")
             ax.axhline(1.0, color="k", lw=0.8, alpha=0.3)
         else:

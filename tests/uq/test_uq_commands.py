@@ -99,7 +99,8 @@ def test_reproduce_rejects_bad_calibration(tmp_path, capsys):
 
 
 def test_calibrated_k_H_becomes_the_upper_bound():
-    from uq.commands import study_file, with_calibration
+    from uq.commands import study_file
+    from uq.study import with_calibration
     from uq.space import K_H_STAR
     from uq.study import load_study
 
