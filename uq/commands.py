@@ -5,13 +5,12 @@
 * `ies sobol STUDY.toml [--n N]`: Sobol' indices (S1, ST) of the resonant response levels.
 * `ies response STUDY.toml`: the nominal point's frequency responses and resonant levels over the excitation
   levels through the task store (resumable, parallel, on a cluster), Figs. 5 and 6.
-* `ies reproduce fig5|fig6|fig7|fig8|figD2|figD3|all [--quick] [--out DIR]`: the paper's figures, run from the
-  shipped study files (uq/studies/fig5.toml ... figD3.toml, or their -quick variants) into DIR/fig5 ... DIR/figD3.
-  Before Figs. 7 and 8 it calibrates k_H on the shipped crater (the calibration `ies calibrate --json` prints,
-  kept in DIR/calibration.json) and uses the calibrated k_H as the upper bound of k_H, as the paper does with
-  its BEM result 1.52 k_H* (Sect. 4.1); the best estimate stays 1.25 k_H* unless the calibration falls below
-  it (then the midpoint of k_H* and the calibrated value). A failed calibration is one warning line, and
-  Table 2's bounds are kept.
+* `ies reproduce NAME|all [--quick] [--out DIR]`: the paper's figures of `uq.paper_figures.PAPER_FIGURES` (fig5,
+  fig6, fig7, fig8, figD2, figD3 in `all`; fig11, figC1 when named), each run from its study file (uq/studies/NAME.toml,
+  or its -quick variant) into DIR/NAME, drawn and printed by its row. Before a study that varies k_H it calibrates
+  k_H on the shipped crater (the calibration `ies calibrate --json` prints, kept in DIR/calibration.json) and
+  uses the calibrated k_H as the upper bound of k_H (`uq.study.with_calibration`, Sect. 4.1). A failed
+  calibration is one warning line, and Table 2's bounds are kept.
 * `ies plot DIR`: redraw the figures of a result folder from its data (`sim.plots.redraw`), in other formats, another
   matplotlib style or for a subset of the levels, without recomputing.
 * `ies compare DIR DIR ... --out OUT`: the Fig. 6 landmarks of several response studies side by side with the
