@@ -97,7 +97,7 @@ def add_response_arguments(parser: argparse.ArgumentParser) -> None:
 def interval_command(args: argparse.Namespace) -> int:
     """`ies interval`: the study's interval bands (Sect. 5.4), then Figs. 7-8; prints the bands."""
     from uq.execute import run_interval_study
-    from uq.figures import interval_figures
+    from uq.paper_figures import interval_figures
 
     study = _load_study(args.study, "interval")
     result = run_interval_study(study, out=args.out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
@@ -124,7 +124,7 @@ def sobol_command(args: argparse.Namespace) -> int:
 def response_command(args: argparse.Namespace) -> int:
     """`ies response`: the study's frequency responses and resonant levels (Sects. 5.2-5.3), then Figs. 5-6."""
     from uq.execute import run_response_study
-    from uq.figures import response_figures
+    from uq.paper_figures import response_figures
 
     study = _load_study(args.study, "response")
     result = run_response_study(study, out=args.out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
@@ -309,7 +309,8 @@ def add_plot_arguments(parser: argparse.ArgumentParser) -> None:
 def plot_command(args: argparse.Namespace) -> int:
     """`ies plot`: redraw the figures of a result folder from its data files (`sim.plots.redraw`)."""
     import sim.plots.figures  # noqa: F401 - registers ies sweep's, overview's and trace's folders
-    import uq.figures  # noqa: F401 - registers the study folders
+    import uq.figures  # noqa: F401 - registers the Sobol' and reproduce folders
+    import uq.paper_figures  # noqa: F401 - registers the interval and response study folders
     from sim.common.errors import SimulationInputError
     from sim.common.files import report_written
     from sim.plots.redraw import PlotOptions, kind_of, redraw, style

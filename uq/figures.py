@@ -11,8 +11,9 @@
   the paper's optimum marked), response studies, through `sim.plots.figures`.
 * Sobol': S1 and ST with their confidence intervals vs level, and the repetition-noise share.
 
-Only the data files are read, never the runs, so `ies plot` redraws any of them (`sim.plots.redraw`: the study kinds
-are registered here). Every figure is written in the formats of the plot options (PNG and PDF by default).
+Only the data files are read, never the runs, so `ies plot` redraws any of them (`sim.plots.redraw`: the Sobol' and
+`ies reproduce` folders are registered here, the interval and response studies with the figure table in
+`uq.paper_figures`, which names the figures). This module knows no figure's name. Every figure is written in the formats of the plot options (PNG and PDF by default).
 """
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ import json
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -137,11 +138,15 @@ def _marks(ax: Any, band: dict, prefix: str = "") -> None:
                 label=f"{prefix}monotonicity not tested (no noise estimate)")
 
 
-def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
-    """Draw Figs. 7 and 8 (as far as the study has the designs; the joint band under the name of the row of
-    `uq.paper_figures.PAPER_FIGURES` that shows the output) and the nominal levels from folder/*.csv."""
-    from uq.paper_figures import INDIVIDUAL_FIGURE, box_figure
+#: the joint-band figure of a banded output: (file stem, title, a level of the paper to mark (value, label) or None)
+BoxFigure = tuple[str, str, "tuple[float, str] | None"]
 
+
+def interval_figures(folder: str | Path, options: PlotOptions | None = None, *, individual_stem: str,
+                     box_figure: Callable[[str], BoxFigure]) -> list[Path]:
+    """Draw Figs. 7 and 8 (as far as the study has the designs) and the nominal levels from folder/*.csv: the
+    individual variation under the stem `individual_stem`, the joint band of an output as `box_figure(output)` names it
+    (`uq.paper_figures.interval_figures` passes the figure table's names)."""
     folder = Path(folder)
     options = options or PlotOptions()
     plt = pyplot()
@@ -178,7 +183,7 @@ def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> 
         fig.suptitle(f"Individual variation (cf. Fig. 7); {nominal_text}", fontsize=9)
         fig.text(0.5, 0.005, note, ha="center", fontsize=7)
         fig.tight_layout(rect=(0, 0.03, 1, 1))
-        paths += _save(fig, folder, INDIVIDUAL_FIGURE, options)
+        paths += _save(fig, folder, individual_stem, options)
         plt.close(fig)
 
     box = [d for d in designs if d in ("joint", "residual")]
@@ -192,10 +197,9 @@ def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> 
             _band_with_noise(ax, band, color, alpha, f"{label} (+- SE of its edges)")
             _marks(ax, band, prefix=f"{d}: ")
         _errorbar(ax, *nominal, "k.--", label=nominal_text)
-        row = box_figure(output)  # Fig. 8 for the resonant level, Fig. D.3 for r (uq.paper_figures)
-        stem, title = row.name, row.box_titles.get(output) or next(iter(row.box_titles.values()))
-        if row.reference is not None:
-            ax.axhline(row.reference[0], color="k", lw=1, ls="-.", alpha=0.6, label=row.reference[1])
+        stem, title, reference = box_figure(output)  # Fig. 8 for the resonant level, Fig. D.3 for r
+        if reference is not None:
+            ax.axhline(reference[0], color="k", lw=1, ls="-.", alpha=0.6, label=reference[1])
         ax.set_xlabel(_LEVEL)
         ax.set_ylabel(_YLABEL.get(output, output))
         ax.set_title(title, fontsize=10)
@@ -283,7 +287,8 @@ def read_overview(folder: Path, options: PlotOptions | None = None) -> dict[str,
 @dataclass(frozen=True)
 class ResponseData:
     """What a response study's figures are drawn from: its folder, study.json (`meta`), overview.csv for the
-    chosen levels (`read_overview`), the plot options and the line of run settings every title carries."""
+    chosen levels (`read_overview`; empty for a series study), the plot options and the line of run settings every
+    title carries."""
 
     folder: Path
     meta: dict
@@ -292,31 +297,17 @@ class ResponseData:
     runs: str
 
 
-def response_figures(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
-    """The figures a response study's [response] figures ask for, each drawn by its row of
-    `uq.paper_figures.PAPER_FIGURES` (Figs. 5, 6, D.2, D.3 from sweeps.csv, overview.csv and runs.csv; a series
-    study's Fig. 11 or C.1 from each value's overview.csv)."""
-    from uq.paper_figures import PAPER_FIGURES
-
-    folder = Path(folder)
-    options = options or PlotOptions()
+def response_data(folder: Path, options: PlotOptions) -> ResponseData:
+    """What a response study's figures are drawn from (`ResponseData`): study.json, and for a study of one point its
+    overview.csv at the chosen levels (a series study's figure reads each value's own overview.csv)."""
     meta = _study(folder)
     protocol = meta["study"]["protocol_resolved"]
+    runs = f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold"
     if "series_folders" in meta:
-        runs = (f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold, "
-                f"{protocol['integrator']}")
-        row = PAPER_FIGURES[meta["study"]["response"]["figures"][0]]
-        return row.series_panel(ResponseData(folder, meta, {}, options, runs), row.name) if row.series_panel else []
+        return ResponseData(folder, meta, {}, options, f"{runs}, {protocol['integrator']}")
     overview = read_overview(folder, options)
     selected([float(r["level"]) for r in _rows(folder / "overview.csv")], options, folder)
-    runs = f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold"
-    data = ResponseData(folder, meta, overview, options, runs)
-    paths: list[Path] = []
-    listed = set(meta["study"]["response"]["figures"])
-    for row in PAPER_FIGURES.values():
-        if row.name in listed and row.response_panel is not None:
-            paths += row.response_panel(data, row.name)
-    return paths
+    return ResponseData(folder, meta, overview, options, runs)
 
 
 def frequency_responses(data: ResponseData, stem: str) -> list[Path]:
@@ -386,9 +377,7 @@ def series_figure(caption: str, paper_line: tuple[float, str] | None = None):
     return draw
 
 
-register("ies interval", _kind_is("interval"))(interval_figures)
 register("ies sobol", _kind_is("sobol"))(sobol_figure)
-register("response study (ies response, ies reproduce of a response figure)", _kind_is("response"))(response_figures)
 
 
 def _result_children(folder: Path) -> list[Path]:
@@ -403,7 +392,7 @@ def _result_children(folder: Path) -> list[Path]:
 REPRODUCE = "ies reproduce --out"
 
 
-@register(REPRODUCE, lambda folder: bool(_result_children(folder)))
+@register(REPRODUCE, lambda folder: not (folder / "study.json").is_file() and bool(_result_children(folder)))
 def redraw_children(folder: Path, options: PlotOptions) -> list[Path]:
     """Every result subfolder (fig5, fig6, fig7, fig8 of `ies reproduce`), each into its own folder (or into
     OUT/NAME with --out)."""

@@ -19,7 +19,10 @@ from importlib.resources import files
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
+from sim.plots.redraw import register
+
 if TYPE_CHECKING:
+    from sim.plots.redraw import PlotOptions
     from uq.figures import ResponseData
 
 #: draws one figure of a response study: (the study's data, the figure's file stem) -> the files written
@@ -43,8 +46,35 @@ def _figures(name: str, *args: Any) -> Callable[..., list[Path]]:
     return draw
 
 
-interval_figures: FolderDrawer = _figures("interval_figures")
-response_figures: FolderDrawer = _figures("response_figures")
+def interval_figures(folder: str | Path, options: "PlotOptions | None" = None) -> list[Path]:
+    """Figs. 7 and 8 of an interval study (`uq.figures.interval_figures`) under this table's names: the individual
+    variation as INDIVIDUAL_FIGURE, the joint band of an output as the row that shows it (`box_figure`)."""
+    from uq.figures import interval_figures as draw
+
+    def box(output: str) -> tuple[str, str, tuple[float, str] | None]:
+        row = box_figure(output)
+        return row.name, row.box_titles.get(output) or next(iter(row.box_titles.values())), row.reference
+
+    return draw(folder, options, individual_stem=INDIVIDUAL_FIGURE, box_figure=box)
+
+
+def response_figures(folder: str | Path, options: "PlotOptions | None" = None) -> list[Path]:
+    """The figures a response study's [response] figures ask for, each drawn by its row's panel (Figs. 5, 6, D.2,
+    D.3 from sweeps.csv, overview.csv and runs.csv; a series study's Fig. 11 or C.1, its first figure, by the row's
+    series panel from each value's overview.csv), in the order of the table."""
+    from sim.plots.redraw import PlotOptions
+    from uq.figures import response_data
+
+    data = response_data(Path(folder), options or PlotOptions())
+    listed = data.meta["study"]["response"]["figures"]
+    if "series_folders" in data.meta:
+        row = PAPER_FIGURES[listed[0]]
+        return row.series_panel(data, row.name) if row.series_panel is not None else []
+    paths: list[Path] = []
+    for row in PAPER_FIGURES.values():
+        if row.name in listed and row.response_panel is not None:
+            paths += row.response_panel(data, row.name)
+    return paths
 
 
 def response_table(folder: Path, summary: Mapping, name: str) -> None:
@@ -176,3 +206,16 @@ def box_figure(output: str) -> PaperFigure:
         if output in row.box_titles:
             return row
     return PAPER_FIGURES[DEFAULT_BOX_FIGURE]
+
+
+def _study_kind(kind: str) -> Callable[[Path], bool]:
+    """Whether a folder holds a study of `kind` (its study.json says so)."""
+    def detect(folder: Path) -> bool:
+        path = folder / "study.json"
+        return path.is_file() and json.loads(path.read_text()).get("study", {}).get("kind") == kind
+
+    return detect
+
+
+register("ies interval", _study_kind("interval"))(interval_figures)
+register("response study (ies response, ies reproduce of a response figure)", _study_kind("response"))(response_figures)
