@@ -13,7 +13,8 @@
 
 Only the data files are read, never the runs, so `ies plot` redraws any of them (`sim.plots.redraw`: the Sobol' and
 `ies reproduce` folders are registered here, the interval and response studies with the figure table in
-`uq.paper_figures`, which names the figures). This module knows no figure's name. Every figure is written in the formats of the plot options (PNG and PDF by default).
+`uq.paper_figures`, which names the figures). This module knows no figure's name. Every figure is written in the
+formats of the plot options (PNG and PDF by default).
 """
 from __future__ import annotations
 
