@@ -35,6 +35,7 @@ from uq.space import Parameter, ParameterSpace, parameter_of, table2_space
 if TYPE_CHECKING:
     from sim.model.parameters import SystemSettings
     from sim.model.system import Impactor, ModalModel
+    from sim.stepped_sine.protocol import SteppedSine, SweepResult
 
 _ROOT = Path(__file__).resolve().parent.parent
 
@@ -115,7 +116,7 @@ class IESModel:
     name: str = "ies"
     modal_file: str | None = None
     variant: Mapping[str, float] = field(default_factory=dict)
-    rig: Any = field(default=None, compare=False, repr=False)
+    rig: "ModalModel | None" = field(default=None, compare=False, repr=False)
     banded_outputs: tuple[str, ...] = ("mean", "max")
     contact_law: str = "hertz"
 
@@ -157,7 +158,7 @@ class IESModel:
         """The protocol with every default filled in (for the study metadata)."""
         return _protocol_dict(self._stepped_sine())
 
-    def _stepped_sine(self):
+    def _stepped_sine(self) -> "SteppedSine":
         from sim.stepped_sine.protocol import SteppedSine
 
         from sim.common.errors import SimulationInputError
@@ -194,7 +195,7 @@ class IESModel:
         except SimulationInputError as exc:
             raise StudyError(f"[study] {exc}") from None
 
-    def _rig(self):
+    def _rig(self) -> "ModalModel":
         from sim.common.errors import SimulationInputError
         from sim.hosts.modal_file import load_modal_model
         from sim.hosts.variants import with_higher_mode_damping
@@ -227,7 +228,7 @@ class IESModel:
         rig = self.rig if self.rig is not None else self._rig()
         return build_system(rig, self._settings(params))
 
-    def stepped_sine(self) -> Any:
+    def stepped_sine(self) -> "SteppedSine":
         """The study's stepped-sine protocol (`sim.stepped_sine.protocol.SteppedSine`)."""
         return self._stepped_sine()
 
@@ -267,7 +268,7 @@ class IESModel:
         return {"mean": own.resonant_mean, "max": own.resonant_max, "apr": 1.0 if own.regime == "APR" else 0.0,
                 **{name: float(own.scattering[name][at][0]) for name in SCATTERING_MEASURES}, "trace": trace}
 
-    def sweep_result(self, records: list[Mapping[str, Any]]) -> Any:
+    def sweep_result(self, records: list[Mapping[str, Any]]) -> "SweepResult | None":
         """The frequency response (`sim.stepped_sine.protocol.SweepResult`, Fig. 5) of the runs of one (point, level), rebuilt
         from their traces and aggregated exactly as `ies sweep` does (`sim.stepped_sine.protocol.aggregate_runs`); None
         without runs."""
@@ -310,7 +311,7 @@ class IESModel:
 _TRACE = ("eta", "eta_actual", "leg", "mean", "max", "min", "std", "impacts_per_period", "hold_periods")
 
 
-def _protocol_dict(protocol: Any) -> dict:
+def _protocol_dict(protocol: "SteppedSine") -> dict:
     out = asdict(protocol) if hasattr(protocol, "__dataclass_fields__") else dict(vars(protocol))
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in out.items()}
 
