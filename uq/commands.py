@@ -167,12 +167,12 @@ def print_interval_result(folder: Path, summary: dict, name: str) -> None:
 
 def print_response_result(folder: Path, name: str) -> None:
     """The table a response study prints: that of the figure it is named after when it has one
-    (`uq.paper_figures.PaperFigure.response_table`: Figs. D.2, D.3 the impacts and scattering measures), else the
+    (`uq.paper_figures.PaperFigure.table`: Figs. D.2, D.3 the impacts and scattering measures), else the
     resonant levels and the optimum (Fig. 6)."""
     from uq.paper_figures import PAPER_FIGURES, response_table
 
     row = PAPER_FIGURES.get(name)
-    (response_table if row is None else row.response_table)(folder, {}, name)
+    (response_table if row is None else row.table)(folder, {}, name)
 
 
 # ---- ies reproduce ------------------------------------------------------------------------------------------
@@ -258,7 +258,7 @@ def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list
     """Calibration (the given one, or run unless disabled) when an interval study needs it, then each figure's
     study, its figures and its summary."""
     from uq.execute import run_interval_study, run_response_study
-    from uq.paper_figures import PAPER_FIGURES
+    from uq.paper_figures import PAPER_FIGURES, STUDY_FIGURES, interval_table
     from uq.space import K_H_STAR, calibrated_k_H
     from uq.study import with_calibration
 
@@ -279,7 +279,7 @@ def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list
         print(f"{figure}: {study.source} -> {folder}/")
         run = run_response_study if study.kind == "response" else run_interval_study
         result = run(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet)
-        paths = row.draw(result.folder)
+        paths = STUDY_FIGURES[study.kind](result.folder)
         if row.traced:
             from uq.execute import series_traces
 
@@ -287,7 +287,7 @@ def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list
         s = result.summary
         print(f"{figure}: {s['tasks']} runs ({s['ran']} run now), {s['failed_runs']} failed, "
               f"{s['wall_time_s']:.1f} s; figures: {', '.join(p.name for p in paths)}")
-        row.table(folder, s, figure)
+        (row.table if study.kind == "response" else interval_table)(folder, s, figure)
     return 0
 
 

@@ -1,8 +1,8 @@
 """The paper's figures that the workbench reproduces: `PAPER_FIGURES`, one row per figure.
 
 A row (`PaperFigure`) says everything `ies reproduce NAME` and the figure code need: the figure's name (also the
-file stem of its drawing and the folder OUT/NAME), its study file, how a response study draws it
-(`response_panel`, or `series_panel` for a study run once per value of a parameter), the table printed after the
+file stem of its drawing and the folder OUT/NAME), its study file, the function that draws it from a response
+study's data (`draw`; for a study run once per value of a parameter when `series`), the table printed after the
 run, whether `ies reproduce all` runs it, and for the interval studies the joint-band figure of an output. Adding a
 figure is adding a row: `ies reproduce`'s choices, the [response] figures a study file may ask for (`uq.study`),
 the drawing of a response folder (`uq.figures.response_figures`, also `ies plot`) and the printed summary all read
@@ -27,8 +27,6 @@ if TYPE_CHECKING:
 
 #: draws one figure of a response study: (the study's data, the figure's file stem) -> the files written
 ResponsePanel = Callable[["ResponseData", str], list[Path]]
-#: draws a finished study's figures from its folder (`uq.figures.interval_figures`, `response_figures`)
-FolderDrawer = Callable[[Path], list[Path]]
 #: prints a figure's table after its study ran: (result folder, the run's summary, the name it is printed under)
 TablePrinter = Callable[[Path, Mapping, str], None]
 
@@ -69,11 +67,11 @@ def response_figures(folder: str | Path, options: "PlotOptions | None" = None) -
     listed = data.meta["study"]["response"]["figures"]
     if "series_folders" in data.meta:
         row = PAPER_FIGURES[listed[0]]
-        return row.series_panel(data, row.name) if row.series_panel is not None else []
+        return row.draw(data, row.name) if row.draw is not None and row.series else []
     paths: list[Path] = []
     for row in PAPER_FIGURES.values():
-        if row.name in listed and row.response_panel is not None:
-            paths += row.response_panel(data, row.name)
+        if row.name in listed and row.draw is not None and not row.series:
+            paths += row.draw(data, row.name)
     return paths
 
 
@@ -130,24 +128,22 @@ class PaperFigure:
 
     name: the figure (its file stem and the folder OUT/NAME of `ies reproduce`); help: what it shows;
     study: the stem of a shipped study file (uq/studies/STEM.toml, STEM-quick.toml with --quick) or the path of a
-    study file; draw: what draws its study's folder after the run; table: what prints its summary; in_all: run by
-    `ies reproduce all`; response_panel / series_panel: how a response study (a series study) that lists the
-    figure in [response] figures draws it (None: not a response figure); response_table: what a response study
-    named after the figure prints (`ies response`); traced: the levels whose time histories
-    are traced after the run (Fig. C.1b); box_titles: for an interval study, {banded output: title} of the joint-band
-    figure drawn under this name; reference: a level of the paper drawn on that figure (value, label).
+    study file; draw: how a response study that lists the figure in [response] figures draws it (None: drawn by
+    an interval study's designs, Figs. 7, 8); table: what a response study named after the figure prints (an
+    interval study prints its bands, `interval_table`); in_all: run by `ies reproduce all`; series: `draw` draws a
+    series study (one run per value of a parameter, Fig. 11); traced: the levels whose time histories are traced
+    after the run (Fig. C.1b); box_titles: for an interval study, {banded output: title} of the joint-band figure
+    drawn under this name; reference: a level of the paper drawn on that figure (value, label).
     """
 
     name: str
     help: str
     study: str
-    draw: FolderDrawer
+    draw: ResponsePanel | None
     table: TablePrinter
     in_all: bool
-    response_panel: ResponsePanel | None = None
-    series_panel: ResponsePanel | None = None
+    series: bool = False
     traced: tuple[float, ...] = ()
-    response_table: TablePrinter = response_table
     box_titles: Mapping[str, str] = field(default_factory=dict)
     reference: tuple[float, str] | None = None
 
@@ -160,30 +156,28 @@ class PaperFigure:
 
 #: the paper's figures, in the order `ies reproduce all` runs them
 PAPER_FIGURES: dict[str, PaperFigure] = {row.name: row for row in (
-    PaperFigure("fig5", "frequency responses (Sects. 5.1-5.2)", "fig5", response_figures, response_table, True,
-                response_panel=_figures("frequency_responses")),
-    PaperFigure("fig6", "resonant level vs excitation level (Sect. 5.3)", "fig6", response_figures, response_table,
-                True, response_panel=_figures("resonant_levels")),
-    PaperFigure("fig7", "individual variation of D, g, k_H (Sect. 5.4)", "fig7", interval_figures, interval_table,
-                True),
-    PaperFigure("fig8", "joint and residual variation of D, g, k_H (Sect. 5.4)", "fig8", interval_figures,
-                interval_table, True, box_titles={"mean": "Joint variation (cf. Fig. 8)"}),
-    PaperFigure("figD2", "impacts per period vs excitation level (Appendix D)", "figD2", response_figures,
+    PaperFigure("fig5", "frequency responses (Sects. 5.1-5.2)", "fig5", _figures("frequency_responses"),
+                response_table, True),
+    PaperFigure("fig6", "resonant level vs excitation level (Sect. 5.3)", "fig6", _figures("resonant_levels"),
+                response_table, True),
+    PaperFigure("fig7", "individual variation of D, g, k_H (Sect. 5.4)", "fig7", None, response_table, True),
+    PaperFigure("fig8", "joint and residual variation of D, g, k_H (Sect. 5.4)", "fig8", None, response_table, True,
+                box_titles={"mean": "Joint variation (cf. Fig. 8)"}),
+    PaperFigure("figD2", "impacts per period vs excitation level (Appendix D)", "figD2",
+                _figures("scattering_figure", "impacts", "impacts per period (cf. Fig. D.2)"), scattering_table, True),
+    PaperFigure("figD3", "restitution vs excitation level (Appendix D)", "figD3",
+                _figures("scattering_figure", "restitution", "restitution, APR levels (cf. Fig. D.3)"),
                 scattering_table, True,
-                response_panel=_figures("scattering_figure", "impacts", "impacts per period (cf. Fig. D.2)"),
-                response_table=scattering_table),
-    PaperFigure("figD3", "restitution vs excitation level (Appendix D)", "figD3", interval_figures, interval_table,
-                True, response_panel=_figures("scattering_figure", "restitution", "restitution, APR levels (cf. Fig. D.3)"),
-                response_table=scattering_table,
                 box_titles={"restitution": "Modal coefficient of restitution from the tip, joint variation (cf. Fig. D.3)",
                             "restitution_wall": "Modal coefficient of restitution from the wall, joint variation "
                                                 "(cf. Fig. D.3)"},
                 reference=(0.8, "paper: r ~ 0.8 (Fig. D.3)")),
-    PaperFigure("fig11", "damped contact law, Eq. 10 (Sect. 5.5)", "fig11", response_figures, response_table, False,
-                series_panel=_figures("series_figure", "cf. Fig. 11",
-                                      (7.5, "paper: contact dissipation matters above 7.5"))),
-    PaperFigure("figC1", "dry friction (Appendix C)", "figC1", response_figures, response_table, False,
-                series_panel=_figures("series_figure", "cf. Fig. C.1 and the low end of Fig. 6"), traced=(1.26, 5.3)),
+    PaperFigure("fig11", "damped contact law, Eq. 10 (Sect. 5.5)", "fig11",
+                _figures("series_figure", "cf. Fig. 11", (7.5, "paper: contact dissipation matters above 7.5")),
+                response_table, False, series=True),
+    PaperFigure("figC1", "dry friction (Appendix C)", "figC1",
+                _figures("series_figure", "cf. Fig. C.1 and the low end of Fig. 6"), response_table, False,
+                series=True, traced=(1.26, 5.3)),
 )}
 
 #: the name under which `interval_figures` writes the individual variation (Fig. 7)
@@ -194,7 +188,7 @@ DEFAULT_BOX_FIGURE = "fig8"
 
 def response_figure_names() -> tuple[str, ...]:
     """The figures a response study may list in [response] figures (rows with a response or series panel)."""
-    return tuple(row.name for row in PAPER_FIGURES.values() if row.response_panel or row.series_panel)
+    return tuple(row.name for row in PAPER_FIGURES.values() if row.draw is not None)
 
 
 def figures_of_all() -> tuple[str, ...]:
@@ -221,3 +215,7 @@ def _study_kind(kind: str) -> Callable[[Path], bool]:
 
 register("ies interval", _study_kind("interval"))(interval_figures)
 register("response study (ies response, ies reproduce of a response figure)", _study_kind("response"))(response_figures)
+
+
+#: what draws a finished study's folder, by the study's kind (each figure of it through its row)
+STUDY_FIGURES: dict[str, Callable[[Path], list[Path]]] = {"interval": interval_figures, "response": response_figures}

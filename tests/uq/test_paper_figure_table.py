@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from uq.cli import main
-from uq.paper_figures import PAPER_FIGURES, PaperFigure, figures_of_all, response_figure_names, response_table
+from uq.paper_figures import PAPER_FIGURES, PaperFigure, figures_of_all, response_figure_names
 
 
 def one_column(data, stem: str) -> list[Path]:
@@ -37,8 +37,7 @@ def toy_row(tmp_path, monkeypatch: pytest.MonkeyPatch) -> PaperFigure:
     study.write_text("[study]\nkind = 'response'\nrepetitions = 1\n[excitation]\nlevels = [2.0]\n"
                      "eta = { start = 0.975, stop = 0.98, n = 2 }\nwait = 0.1\nhold = 0.1\n"
                      "[response]\nfigures = ['figToy']\n")
-    row = PaperFigure("figToy", "the resonant mean, one column", str(study), PAPER_FIGURES["fig6"].draw, one_line,
-                      in_all=False, response_panel=one_column, response_table=response_table)
+    row = PaperFigure("figToy", "the resonant mean, one column", str(study), one_column, one_line, in_all=False)
     monkeypatch.setitem(PAPER_FIGURES, row.name, row)
     return row
 
