@@ -361,6 +361,11 @@ def _parse_contact_law(head: Mapping[str, Any], space: ParameterSpace) -> str:
 
 
 def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir: Path, source: str) -> ParameterSpace:
+    """The parameter space of [parameters.KEY] tables; for the simulator KEY is a row's study key in
+    `sim.model.parameters.PARAMETERS` (its name in the space, CSV columns and messages is the row's name)."""
+    if table is not None and model_spec == "ies":
+        by_key = {row.study_key: name for name, row in PARAMETERS.items()}
+        table = {by_key.get(key, key): spec for key, spec in table.items()}
     model = make_model(model_spec, parameters=tuple(table or {}))
     default = model.default_space()
     if default is None:  # a user's function: every parameter must be given in full

@@ -1,7 +1,7 @@
 """The parameter seam (issue 27): one row of `sim.model.parameters.PARAMETERS` is all a new parameter needs.
 
-The toy row, added inside the test only, scales the sphere's mass; a tiny interval study lists it as
-[parameters.sphere_mass_scale] and runs through `ies interval` end to end (study file, parameter space, response
+The toy row, added inside the test only, scales the sphere's mass; a tiny interval study lists it under its study
+key [parameters.mass_scale] and runs through `ies interval` end to end (study file, parameter space, response
 model, impactor builder, runner, bands), and `ies sweep` gains its option. References that are not our code: the
 mass the impactor is built with is m_a = 0.0177 kg (Table 1) times the row's value.
 """
@@ -16,7 +16,7 @@ from sim.model.parameters import PARAMETERS, SPHERE_MASS, CliOption, Feed, Uncer
 from uq.cli import main
 
 TOY = UncertainParameter("sphere_mass_scale", "-", "sphere mass / m_a", 1.0, (1.0, 1.5), Feed("mass", scale=True),
-                         "sphere_mass_scale", option=CliOption("--sphere-mass-scale", "X", "sphere mass over m_a"))
+                         "mass_scale", option=CliOption("--sphere-mass-scale", "X", "sphere mass over m_a"))
 
 
 @pytest.fixture
@@ -38,7 +38,7 @@ def test_the_toy_row_feeds_the_impactor_builder(toy_row: UncertainParameter) -> 
 
 def test_a_tiny_interval_study_varies_the_toy_row(toy_row: UncertainParameter, tmp_path) -> None:
     study = tmp_path / "toy.toml"
-    study.write_text("[study]\nkind = 'interval'\nrepetitions = 1\n[parameters.sphere_mass_scale]\nmin = 1.0\n"
+    study.write_text("[study]\nkind = 'interval'\nrepetitions = 1\n[parameters.mass_scale]\nmin = 1.0\n"
                      "max = 1.5\n[excitation]\nlevels = [7.4]\neta = { start = 0.975, stop = 0.98, n = 2 }\n"
                      "wait = 0.1\nhold = 0.1\n[interval]\ninterior = 0\n")
     out = tmp_path / "o"
