@@ -57,9 +57,9 @@ def interval_figures(folder: str | Path, options: "PlotOptions | None" = None) -
 
 
 def response_figures(folder: str | Path, options: "PlotOptions | None" = None) -> list[Path]:
-    """The figures a response study's [response] figures ask for, each drawn by its row's panel (Figs. 5, 6, D.2,
-    D.3 from sweeps.csv, overview.csv and runs.csv; a series study's Fig. 11 or C.1, its first figure, by the row's
-    series panel from each value's overview.csv), in the order of the table."""
+    """The figures a response study's [response] figures ask for, each drawn by its row's `draw` (Figs. 5, 6, D.2,
+    D.3 from sweeps.csv, overview.csv and runs.csv; a series study's Fig. 11 or C.1, its first figure, from each
+    value's overview.csv), in the order of the table."""
     from sim.plots.redraw import PlotOptions
     from uq.figures import response_data
 
