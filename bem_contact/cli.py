@@ -13,41 +13,31 @@ Both compute the force at 20 indentations from 2 to 40 um, fit f = k_H delta^1.5
 of Eq. 8; the error bar comes from repeating the curve on a grid half as fine. The indentation is
 measured from the first touch; on a scan, from the first touch on the wall denoised by a second-order
 Gaussian filter (--denoise, default 90 um; 0 = the raw scan, whose noise peaks bias k_H low; see
-`scans.contact`). The libraries (`scans`, `bem_contact.calibration.calibrate_k_H`) do the work; this
-module only chooses the gap map (see `gap_source`), prints and plots.
+`scans.contact`). The libraries do the work (`bem_contact.pipeline`: the gap map, the run, the JSON object;
+`bem_contact.calibration.calibrate_k_H`: the fit); this module only reads the options, prints and plots.
 
 `--json` prints one object in SI units (also `calibration.json` of `ies reproduce`): k_H, k_H_star (Eq. 8),
 k_H_ratio, k_H_error (N/m^1.5, |k_H(N) - k_H(N/2)|), fit_residual, crater_depth, rim_height, crater_diameter,
 clearance_min, clearance_max (m), grid, solver, sphere, placement, holes, warnings, the curve and its settings;
 with --tangential k_t and k_t_mindlin (N/m), contact_radius (m), normal_force and normal_force_for_paper (N).
 
-`add_commands(subparsers)` registers the command with the front door (`uq.cli`); `calibrate_default`
-gives `ies reproduce` the calibration in process. The scans stage is imported here because reading a scan
-and pressing on it is the pipeline's arrow scans -> bem_contact. Heavy imports stay inside the functions,
-so that `ies --help` stays fast.
+`add_commands(subparsers)` registers the command with the front door (`uq.cli`), which hands
+`bem_contact.pipeline.calibrate_default` to `ies reproduce`. Heavy imports stay inside the functions, so that
+`ies --help` stays fast.
 """
 from __future__ import annotations
 
 import argparse
-import sys
-from dataclasses import dataclass
-from typing import Any, Callable
+import dataclasses
+from typing import Any
 
+from bem_contact.pipeline import (DEFAULT_DENOISE_UM, DEFAULT_GRID, DEFAULT_SIDE_MM, DEFAULT_TANGENTIAL_GRID,
+                                  PAPER_CLEARANCE_MM, PAPER_FLATTENING_MM, SPHERE_RADIUS, SPHERE_WEIGHT,
+                                  CalibrationSettings, GapSource, calibrate, summary,
+                                  tangential)
 from sim.common.options import figure_file
 
 HELP = "calibrate the Hertzian spring constant k_H by BEM contact on a scanned crater or the flat wall (Sect. 4.1, Eq. 8, Fig. 3)"
-
-SPHERE_RADIUS = 7.92e-3  # m, Sect. 2
-SPHERE_WEIGHT = 0.0177 * 9.81  # N, m_a g: the normal load of Appendix C
-K_T_PAPER = 22e6  # N/m, Appendix C: "stiffness 22 kN/mm"
-DEFAULT_GRID = 256
-DEFAULT_TANGENTIAL_GRID = 96  # BEM k_t within 0.1 % of Mindlin's at the weight
-DEFAULT_SIDE_MM = 2.5  # contact radius at 40 um is 0.56 mm: the domain holds it with room to spare
-PAPER_FLATTENING_MM = 0.02  # Sect. 4.1: sphere diameter 15.80 mm in the flattened regions, 15.84 nominal
-PAPER_CLEARANCE_MM = 0.58  # Sect. 4.1: (17 - 15.84) / 2
-DEFAULT_DENOISE_UM = 90.0  # = scans.contact.DEFAULT_DENOISE (not imported here: `ies --help` stays light)
-NOISY_RAW = 0.1e-6  # m: raw-scan noise beyond which k_H is biased by more than about half a percent
-
 
 def add_commands(subparsers: Any) -> None:
     """Register `calibrate` on the front door's subparsers (argparse)."""
@@ -113,180 +103,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     output = parser.add_argument_group("output")
     output.add_argument("--json", action="store_true", help="print one JSON object (SI units, k_H in N/m^1.5)")
     output.add_argument("--plot", type=figure_file, metavar="FILE", help="write the force-indentation plot (Fig. 3c style; for a scan beside the levelled crater map, Fig. 3b), e.g. k_H.png")
-
-
-@dataclass(frozen=True)
-class GapSource:
-    """What is calibrated: gap_at(n) -> (gap map (m), dx (m)) on n elements across, a label and its facts."""
-
-    gap_at: Callable[[int], Any]
-    label: str
-    facts: dict[str, Any]
-
-
-def flat_wall(args: argparse.Namespace) -> GapSource:
-    """The ideal sphere (Sect. 2: R = 7.92 mm) on the nominally flat cavity wall."""
-    from bem_contact.errors import ContactInputError
-    from bem_contact.geometry import sphere_gap
-
-    side_mm = DEFAULT_SIDE_MM if args.side_mm is None else args.side_mm
-    if not side_mm > 0:
-        raise ContactInputError(f"--side-mm {side_mm} must be > 0 (default {DEFAULT_SIDE_MM})")
-    side = side_mm * 1e-3
-    return GapSource(
-        gap_at=lambda n: sphere_gap(n, side, SPHERE_RADIUS, args.shape),
-        label=f"flat wall, ideal sphere ({args.shape}) R = {SPHERE_RADIUS * 1e3:g} mm",
-        facts={"geometry": "flat", "shape": args.shape, "R": SPHERE_RADIUS, "side": side,
-               "indentation_reference": "first touch of the ideal sphere on the flat wall"},
-    )
-
-
-def scanned_wall(args: argparse.Namespace) -> GapSource:
-    """The sphere above a scanned crater (Sect. 4.1, Fig. 3b): read, level, measure, place the sphere.
-
-    Everything that can be wrong with the scan is checked here, before any BEM work or file output.
-    """
-    import math
-
-    from scans import (PAPER_CRATER, ScanError, Sphere, clearance_bounds, crater_metrics, example_path,
-                       level_scan, read_scan, scan_contact)
-
-    for name in ("flattening", "clearance", "smooth", "denoise"):
-        value = getattr(args, name)
-        if not (math.isfinite(value) and value >= 0):
-            raise ScanError(f"--{name} {value} must be a finite number >= 0")
-    if args.pixel_size is not None and not (math.isfinite(args.pixel_size) and args.pixel_size > 0):
-        raise ScanError(f"--pixel-size {args.pixel_size} must be > 0 (in --units)")
-    path = args.scan if args.scan is not None else example_path("crater")
-    scan = read_scan(path, units=args.units, pixel_size=args.pixel_size)
-    surface = level_scan(scan, imprint=args.imprint)
-    metrics = crater_metrics(surface)
-    flattening = args.flattening * 1e-3
-    sphere = Sphere(SPHERE_RADIUS, flattening if args.sphere == "flattened" else 0.0)
-    side = None if args.side_mm is None else args.side_mm * 1e-3
-    contact = scan_contact(surface, sphere, placement=args.placement, delta_max=args.delta_max_um * 1e-6, side=side,
-                           smoothing=args.smooth * 1e-6, denoise=args.denoise * 1e-6)
-    clearance_min, clearance_max = clearance_bounds(metrics.depth, flattening, args.clearance * 1e-3)
-    facts: dict[str, Any] = {
-        "geometry": "scan",
-        "scan": str(path),
-        "scan_kind": scan.kind,
-        "scan_points": len(scan.vertices),
-        "units_in_file": scan.units,
-        "imprint": surface.imprint,
-        "sphere": sphere.describe(),
-        "R": SPHERE_RADIUS,
-        "sphere_flattening_in_bem": sphere.flattening,
-        "placement": contact.placement,
-        "sphere_axis_point": surface.to_scanner(*contact.centre),
-        "sphere_axis_direction": surface.axes[2],
-        "side": contact.side,
-        "smoothing": contact.smoothing,
-        "denoise": contact.denoise,
-        "indentation_reference": _reference(contact.denoise, contact.smoothing),
-        "wall_tilt_deg": surface.tilt_deg(),
-        "noise": metrics.noise,
-        "spikes_removed": surface.spikes,
-        "flat_fraction": surface.flat_fraction,
-        "crater_depth": metrics.depth,
-        "rim_height": metrics.rim_height,
-        "crater_diameter": metrics.diameter,
-        "clearance_nominal": args.clearance * 1e-3,
-        "flattening": flattening,
-        "clearance_min": clearance_min,
-        "clearance_max": clearance_max,
-        "warnings": list(metrics.warnings) + _noise_warnings(contact.denoise, metrics),
-    }
-    if args.scan is None:
-        facts["scan_note"] = (f"shipped example: synthetic crater {PAPER_CRATER.depth * 1e6:g} um deep, "
-                              f"{PAPER_CRATER.pileup * 1e6:g} um pile-up (scans.examples)")
-
-    def gap_at(n: int):
-        gap, dx = contact.gap_at(n)
-        facts.setdefault("holes", {})[str(n)] = contact.holes[n].describe()
-        return gap, dx
-
-    label = f"{scan.source}{' (imprint, inverted)' if surface.imprint else ''}, {sphere.describe()}"
-    facts["_contact"], facts["_metrics"] = contact, metrics  # for the plot; not in the JSON
-    return GapSource(gap_at=gap_at, label=label, facts=facts)
-
-
-def _reference(denoise: float, smoothing: float) -> str:
-    """Which indentation reference the curve uses (text and JSON)."""
-    if denoise > 0:
-        text = (f"first touch on the wall denoised by a second-order Gaussian filter of {denoise * 1e6:g} um "
-                "(exact for quadratic surfaces; --denoise 0 for the raw scan)")
-    else:
-        text = "first touch on the raw scan (noise peaks included; k_H low by about 6 % per um of noise)"
-    return text + (f", then smoothed over {smoothing * 1e6:g} um" if smoothing else "")
-
-
-def _noise_warnings(denoise: float, metrics) -> list[str]:
-    """Warnings about scanner noise (raw scan) or a denoising filter wide against the crater."""
-    warnings = []
-    if denoise == 0 and metrics.noise > NOISY_RAW:
-        warnings.append(f"scanner noise {metrics.noise * 1e6:.2g} um on the raw scan (--denoise 0): the first touch moves onto "
-                        "noise peaks and k_H comes out low (paper-like crater: -0.6 % at 0.1 um, -3.4 % at 0.5 um); "
-                        f"drop --denoise 0 (default {DEFAULT_DENOISE_UM:g} um)")
-    if denoise > 0 and metrics.diameter > 0 and denoise > metrics.diameter / 8:
-        warnings.append(f"the denoising filter ({denoise * 1e6:g} um) is wide against the crater ({metrics.diameter * 1e3:.3g} mm "
-                        "across) and may flatten it; use a smaller --denoise (about diameter / 16)")
-    return warnings
-
-
-def gap_source(args: argparse.Namespace) -> GapSource:
-    """Choose the gap map from the arguments: --flat, or a scan (SCAN, default the shipped crater)."""
-    from scans import ScanError
-
-    if args.flat:
-        if args.scan is not None:
-            raise ScanError("give either a SCAN file or --flat, not both")
-        return flat_wall(args)
-    return scanned_wall(args)
-
-
-def calibrate(args: argparse.Namespace):
-    """Run the calibration the arguments describe; returns (Calibration, GapSource, E* in Pa)."""
-    import numpy as np
-
-    from bem_contact.calibration import calibrate_k_H
-    from bem_contact.errors import ContactInputError
-    from bem_contact.materials import BRASS, STEEL, contact_modulus
-
-    if args.points < 2:
-        raise ContactInputError(f"--points {args.points}: need at least 2 indentations for a fit")
-    if not 0 < args.delta_min_um < args.delta_max_um:
-        raise ContactInputError(
-            f"indentations must satisfy 0 < --delta-min-um < --delta-max-um (got {args.delta_min_um}, {args.delta_max_um})"
-        )
-    source = gap_source(args)
-    E_star = contact_modulus(STEEL, BRASS)
-    deltas = np.round(np.linspace(args.delta_min_um, args.delta_max_um, args.points) * 1e-6, 13)  # m, no float noise
-    from tqdm import tqdm
-
-    # progress on stderr for long runs (fine grids); silent when stderr is not a terminal
-    with tqdm(total=2 * len(deltas), desc="contact solves", unit="solve", leave=False, disable=not sys.stderr.isatty()) as bar:
-        grid = DEFAULT_GRID if args.grid is None else args.grid
-        result = calibrate_k_H(source.gap_at, grid, E_star, deltas, solver=args.solver, R=SPHERE_RADIUS, on_solve=bar.update)
-    return result, source, E_star
-
-
-def summary(result, source: GapSource, E_star: float) -> dict[str, Any]:
-    """The JSON object of `ies calibrate --json` (SI units)."""
-    data = result.summary()
-    data.update({k: v for k, v in source.facts.items() if not k.startswith("_")})
-    data["E_star"] = E_star
-    data["materials"] = {"wall": "steel, E = 207 GPa, nu = 0.3", "sphere": "brass, E = 102 GPa, nu = 0.3"}
-    data["units"] = {"k_H": "N/m^1.5", "k_H_star": "N/m^1.5", "k_H_error": "N/m^1.5", "deltas": "m (from first touch)",
-                     "forces": "N", "contact_areas": "m^2", "dx": "m", "side": "m", "R": "m", "E_star": "Pa",
-                     "fit_residual": "1 (||f - k_H delta^1.5|| / ||f||)", "k_H_ratio": "1 (k_H / k_H*, Eq. 8)"}
-    if data.get("geometry") == "scan":
-        data["units"].update({k: "m" for k in ("crater_depth", "rim_height", "crater_diameter", "clearance_min",
-                                                "clearance_max", "clearance_nominal", "flattening", "noise",
-                                                "sphere_flattening_in_bem", "sphere_axis_point", "smoothing",
-                                                "denoise")})
-        data["units"].update({"wall_tilt_deg": "deg", "flat_fraction": "1", "sphere_axis_direction": "1 (unit normal)"})
-    return data
 
 
 def _text(data: dict[str, Any], label: str) -> str:
@@ -358,35 +174,6 @@ def scan_plot(data: dict[str, Any], source: GapSource, path: str) -> None:
     save_figure(fig, path)
 
 
-def tangential(args: argparse.Namespace) -> dict[str, Any]:
-    """`ies calibrate --tangential`: k_t of the sphere stuck on the flat wall (Appendix C) by BEM and by Mindlin's
-    8 G* a, the paper's value and the normal force (N) for which 8 G* a would equal it (k_t grows as N^(1/3)).
-    Plain data in SI units (the JSON object)."""
-    import math
-
-    from bem_contact.errors import ContactInputError
-    from bem_contact.materials import BRASS, STEEL
-    from bem_contact.tangential import sphere_tangential_stiffness
-
-    if args.scan is not None or args.plot:
-        raise ContactInputError("--tangential is the ideal sphere on the flat wall: drop the SCAN file and --plot")
-    force = SPHERE_WEIGHT if args.normal_force is None else args.normal_force
-    if not (math.isfinite(force) and force > 0):
-        raise ContactInputError(f"--normal-force {force} must be a finite number of newtons > 0 (the weight: {SPHERE_WEIGHT:.4g})")
-    grid = DEFAULT_TANGENTIAL_GRID if args.grid is None else args.grid
-    if grid < 8:
-        raise ContactInputError(f"--grid {grid}: need at least 8 elements across the domain")
-    check = sphere_tangential_stiffness(force, SPHERE_RADIUS, BRASS, STEEL, grid=grid)
-    return {"k_t": check.k_t, "k_t_mindlin": check.k_t_mindlin, "contact_radius": check.contact_radius,
-            "normal_force": check.normal_force, "grid": check.grid, "k_t_paper": K_T_PAPER,
-            "paper_over_mindlin": K_T_PAPER / check.k_t_mindlin,
-            "normal_force_for_paper": force * (K_T_PAPER / check.k_t_mindlin) ** 3,
-            "weight": SPHERE_WEIGHT, "R": SPHERE_RADIUS,
-            "materials": {"wall": "steel, E = 207 GPa, nu = 0.3", "sphere": "brass, E = 102 GPa, nu = 0.3"},
-            "units": {"k_t": "N/m", "k_t_mindlin": "N/m (8 G* a)", "k_t_paper": "N/m", "contact_radius": "m",
-                      "normal_force": "N", "normal_force_for_paper": "N", "weight": "N (m_a g)", "R": "m"}}
-
-
 def _tangential_text(data: dict[str, Any]) -> str:
     kn_mm = 1e-6  # N/m -> kN/mm
     return "\n".join([
@@ -401,6 +188,11 @@ def _tangential_text(data: dict[str, Any]) -> str:
     ])
 
 
+def settings_of(args: argparse.Namespace) -> CalibrationSettings:
+    """The `bem_contact.pipeline.CalibrationSettings` of the command's options."""
+    return CalibrationSettings(**{f.name: getattr(args, f.name) for f in dataclasses.fields(CalibrationSettings)})
+
+
 def run(args: argparse.Namespace) -> int:
     """`ies calibrate`: calibrate, plot on request, print the summary (text or JSON)."""
     from sim.common.files import dumps, report_written
@@ -410,10 +202,14 @@ def run(args: argparse.Namespace) -> int:
 
         raise ContactInputError("--normal-force belongs to --tangential")
     if args.tangential:
-        data = tangential(args)
+        if args.scan is not None or args.plot:
+            from bem_contact.errors import ContactInputError
+
+            raise ContactInputError("--tangential is the ideal sphere on the flat wall: drop the SCAN file and --plot")
+        data = tangential(args.normal_force, args.grid)
         print(dumps(data) if args.json else _tangential_text(data))
         return 0
-    result, source, E_star = calibrate(args)
+    result, source, E_star = calibrate(settings_of(args))
     data = summary(result, source, E_star)
     if args.plot and data.get("geometry") == "scan":
         scan_plot(data, source, args.plot)
@@ -422,13 +218,3 @@ def run(args: argparse.Namespace) -> int:
     print(dumps(data) if args.json else _text(data, source.label))
     report_written([args.plot] if args.plot else [], json_mode=args.json)
     return 0
-
-
-def calibrate_default() -> dict[str, Any]:
-    """`ies calibrate --json` with every default (the shipped paper-like crater, Sect. 4.1), in process: the
-    JSON object as plain data (SI units; k_H in N/m^1.5). Raises the stages' errors as `ies calibrate` does."""
-    from sim.common.files import to_jsonable
-
-    parser = argparse.ArgumentParser()
-    add_arguments(parser)
-    return to_jsonable(summary(*calibrate(parser.parse_args([]))))

@@ -355,11 +355,28 @@ _INNER_LEVEL = 0.6
 _INNER_MARGIN = 2
 
 
-def _solve_on_box(h, dx, E_star, delta, solver, tol, x0, maxiter, workers, box):
+@dataclass(frozen=True)
+class _Problem:
+    """The settings of one `solve_contact` call, shared by its steps: gap map h (m, min 0), pitch dx (m), E* (Pa),
+    solver name, tolerance, iteration cap, FFT threads, and whether a missed tolerance raises."""
+
+    h: np.ndarray
+    dx: float
+    E_star: float
+    solver: str
+    tol: float
+    maxiter: int
+    workers: int
+    raise_on_failure: bool
+
+
+def _solve_on_box(problem: _Problem, delta: float, x0: np.ndarray | None, box: tuple[slice, slice]):
     """Displacement control restricted to `box`; returns (pressure on the box, iterations)."""
+    h, dx, E_star, solver, tol, maxiter = (problem.h, problem.dx, problem.E_star, problem.solver, problem.tol,
+                                           problem.maxiter)
     rows, cols = box
     hs = h[rows, cols]
-    op = normal_operator_cached(h.shape, dx, E_star, workers).restricted(*hs.shape)
+    op = normal_operator_cached(h.shape, dx, E_star, problem.workers).restricted(*hs.shape)
     x0s = None if x0 is None else np.asarray(x0, dtype=float)[rows, cols]
     if solver == "pk":
         ps, _, _, iterations, _ = polonsky_keer(op, hs, delta=delta, area=dx * dx, x0=x0s, tol=tol, maxiter=maxiter)
@@ -375,12 +392,13 @@ def _solve_on_box(h, dx, E_star, delta, solver, tol, x0, maxiter, workers, box):
     return ps.reshape(hs.shape), iterations
 
 
-def _solve_indentation(h, dx, E_star, delta, solver, tol, x0, maxiter, workers):
+def _solve_indentation(problem: _Problem, delta: float, x0: np.ndarray | None):
     """Displacement control; returns (p on the full grid, iterations, residual, complementarity error).
 
     The accuracy measures are evaluated on the whole candidate box {h < delta}: outside it p = 0 and g > 0."""
+    h, dx, E_star, solver, tol = problem.h, problem.dx, problem.E_star, problem.solver, problem.tol
     full = _candidate_box(h, delta)
-    op = normal_operator_cached(h.shape, dx, E_star, workers).restricted(full[0].stop - full[0].start, full[1].stop - full[1].start)
+    op = normal_operator_cached(h.shape, dx, E_star, problem.workers).restricted(full[0].stop - full[0].start, full[1].stop - full[1].start)
     boxes = [full]
     if solver == "pk":
         inner = _candidate_box(h, _INNER_LEVEL * delta, _INNER_MARGIN)
@@ -389,7 +407,7 @@ def _solve_indentation(h, dx, E_star, delta, solver, tol, x0, maxiter, workers):
     p = np.zeros_like(h)
     total = 0
     for box in boxes:
-        ps, iterations = _solve_on_box(h, dx, E_star, delta, solver, tol, x0, maxiter, workers, box)
+        ps, iterations = _solve_on_box(problem, delta, x0, box)
         total += iterations
         p[...] = 0.0
         p[box] = ps
@@ -401,9 +419,14 @@ def _solve_indentation(h, dx, E_star, delta, solver, tol, x0, maxiter, workers):
     return p, total, residual, complementarity
 
 
-def _finish(h, dx, E_star, p, delta, iterations, residual, complementarity, solver, tol, workers, maxiter, raise_on_failure):
+def _finish(problem: _Problem, p: np.ndarray, delta: float, iterations: int, residual: float,
+            complementarity: float) -> ContactResult:
+    """The `ContactResult` of pressure p (Pa) at indentation delta (m); ConvergenceError (one line) when the residual
+    missed the tolerance and the problem says to raise."""
+    h, dx, E_star, solver, tol, maxiter = (problem.h, problem.dx, problem.E_star, problem.solver, problem.tol,
+                                           problem.maxiter)
     converged = residual <= tol
-    if not converged and raise_on_failure:
+    if not converged and problem.raise_on_failure:
         raise ConvergenceError(
             f"solver {solver!r} stopped after {iterations} iterations with residual {residual:.3g} > tol {tol:.3g} "
             f"(maxiter {maxiter}); raise maxiter, loosen tol or use solver='pk'"
@@ -412,7 +435,7 @@ def _finish(h, dx, E_star, p, delta, iterations, residual, complementarity, solv
         pressure=p, gap=h, force=float(p.sum()) * dx * dx, indentation=float(delta),
         contact_area=float(np.count_nonzero(p > 0)) * dx * dx, iterations=int(iterations), residual=residual,
         complementarity_error=complementarity, solver=solver, converged=converged, tol=tol, dx=float(dx),
-        E_star=float(E_star), _operator=normal_operator_cached(h.shape, dx, E_star, workers),
+        E_star=float(E_star), _operator=normal_operator_cached(h.shape, dx, E_star, problem.workers),
     )
 
 
@@ -458,9 +481,10 @@ def solve_contact(
     if not (tol > 0):
         raise ContactInputError(f"tol = {tol!r} must be > 0")
 
+    problem = _Problem(h, dx, E_star, solver, tol, maxiter, workers, raise_on_failure)
     if indentation is not None:
-        p, iterations, residual, compl = _solve_indentation(h, dx, E_star, float(indentation), solver, tol, x0, maxiter, workers)
-        return _finish(h, dx, E_star, p, float(indentation), iterations, residual, compl, solver, tol, workers, maxiter, raise_on_failure)
+        p, iterations, residual, compl = _solve_indentation(problem, float(indentation), x0)
+        return _finish(problem, p, float(indentation), iterations, residual, compl)
 
     if solver == "pk":
         op = normal_operator_cached(h.shape, dx, E_star, workers)
@@ -468,12 +492,13 @@ def solve_contact(
             op, h, force=float(force), area=dx * dx, x0=None if x0 is None else np.asarray(x0, float), tol=tol, maxiter=maxiter
         )
         residual, compl = kkt_measures(p, h - delta + op(p), op.self_compliance, delta)
-        return _finish(h, dx, E_star, p, delta, iterations, residual, compl, solver, tol, workers, maxiter, raise_on_failure)
-    return _solve_force_by_search(h, dx, E_star, float(force), solver, tol, x0, maxiter, workers, raise_on_failure)
+        return _finish(problem, p, delta, iterations, residual, compl)
+    return _solve_force_by_search(problem, float(force), x0)
 
 
-def _solve_force_by_search(h, dx, E_star, W, solver, tol, x0, maxiter, workers, raise_on_failure) -> ContactResult:
+def _solve_force_by_search(problem: _Problem, W: float, x0: np.ndarray | None) -> ContactResult:
     """Load control for the dense solvers: find delta with F(delta) = W (F increasing, locally ~ delta^1.5)."""
+    h, dx, E_star, solver, tol = problem.h, problem.dx, problem.E_star, problem.solver, problem.tol
     # first guess from below: ignoring the elements' interaction, p_i = (delta - h_i) / K_ii over-estimates
     # the force at any delta, so its root under-estimates the indentation (and keeps the first solves small)
     kii = love_kernel(1, 1, dx, E_star)[0, 0]
@@ -486,7 +511,7 @@ def _solve_force_by_search(h, dx, E_star, W, solver, tol, x0, maxiter, workers, 
     state = {"x0": x0, "total": 0}
 
     def solve_at(d: float):
-        p, iterations, residual, compl = _solve_indentation(h, dx, E_star, d, solver, tol, state["x0"], maxiter, workers)
+        p, iterations, residual, compl = _solve_indentation(problem, d, state["x0"])
         state["x0"], state["total"] = p, state["total"] + iterations
         return p, residual, compl, float(p.sum()) * dx * dx
 
@@ -496,7 +521,7 @@ def _solve_force_by_search(h, dx, E_star, W, solver, tol, x0, maxiter, workers, 
     for _ in range(60):
         p, residual, compl, F = solve_at(delta)
         if abs(F / W - 1.0) <= tol:
-            return _finish(h, dx, E_star, p, delta, state["total"], residual, compl, solver, tol, workers, maxiter, raise_on_failure)
+            return _finish(problem, p, delta, state["total"], residual, compl)
         if F > W:
             high = delta
             break
@@ -512,7 +537,7 @@ def _solve_force_by_search(h, dx, E_star, W, solver, tol, x0, maxiter, workers, 
         except RuntimeError:
             high = math.inf
     if not math.isfinite(high):
-        if raise_on_failure:
+        if problem.raise_on_failure:
             raise ConvergenceError(f"solver {solver!r}: the search for the indentation at force {W:g} N did not converge; use solver='pk'")
         residual = math.inf  # reported as not converged
-    return _finish(h, dx, E_star, p, delta, state["total"], residual, compl, solver, tol, workers, maxiter, raise_on_failure)
+    return _finish(problem, p, delta, state["total"], residual, compl)

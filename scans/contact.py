@@ -224,5 +224,5 @@ def scan_contact(
             f"the grid side {side * 1e3:.3g} mm is smaller than the region the sphere can touch at "
             f"{delta_max * 1e6:.3g} um indentation ({needed * 1e3:.3g} mm across); use a larger side or the automatic one"
         )
-    return ScanContact(surface, sphere, centre, placement, float(side), reach, float(delta_max), float(smoothing),
-                       float(denoise))
+    return ScanContact(surface=surface, sphere=sphere, centre=centre, placement=placement, side=float(side),
+                       reach=reach, delta_max=float(delta_max), smoothing=float(smoothing), denoise=float(denoise))

@@ -22,7 +22,7 @@ from typing import Any, Iterator, Sequence
 
 from sim.analysis import cli as signal_cli
 from sim.common.errors import SimulationInputError
-from sim.common.options import clearance, figure_file, friction_coefficient, hertz_constant, positive_int, tangential_stiffness
+from sim.common.options import figure_file, positive_int
 
 MODES_HELP = "modal model of the host structure: frequencies, damping, mode values, participation (built-in rig or file)"
 SWEEP_HELP = "stepped-sine frequency response (mean and max amplitude per eta, spread over repetitions; Fig. 5)"
@@ -39,13 +39,9 @@ def add_modes_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies modes`."""
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
     parser.add_argument("--save", metavar="FILE", help="write the model as a modal-model file (.toml)")
-    source = parser.add_mutually_exclusive_group()
-    source.add_argument("--model", metavar="FILE", help="read a modal-model file instead of the built-in seed rig")
-    source.add_argument("--solid", action="store_true",
-                        help="the rig as a 3D solid finite-element model (sim.hosts.solid; needs pip install '.[solid]')")
-    source.add_argument("--from-calculix", dest="from_calculix", metavar="JOB.frd",
-                        help="mode shapes of a CalculiX *FREQUENCY job (ASCII .frd; with --mesh JOB.inp and the node "
-                             "sets --wall-left, --wall-right, --tip; participation from JOB.dat)")
+    from sim.hosts.sources import add_source_options
+
+    add_source_options(parser.add_mutually_exclusive_group())  # sim.hosts.sources.HOST_SOURCES: --model, --solid, ...
     parser.add_argument("--variant", default=None, metavar="NAME",
                         help="updating variant of the built-in rig: joint-spring (default) or effective-modulus; "
                              "with --solid a variant of the solid model (sim.hosts.variants.SOLID_VARIANTS: beam-neck, "
@@ -139,135 +135,15 @@ def modes_table(data: dict) -> str:
     return "\n".join(lines)
 
 
-def _solid_geometry(path: str | None) -> tuple[Any, Any]:
-    """(SolidGeometry, SolidMaterial) of a --geometry TOML file (the rig's defaults without one)."""
-    import dataclasses
-    import tomllib
-
-    from sim.hosts.solid import SolidGeometry, SolidMaterial
-
-    if path is None:
-        return SolidGeometry(), SolidMaterial()
-    try:
-        doc = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise SimulationInputError(f"{path}: not valid TOML ({exc})") from None
-    unknown = set(doc) - {"geometry", "material"}
-    if unknown:
-        raise SimulationInputError(f"{path}: unknown table(s) {', '.join(sorted(unknown))}; use [geometry] and [material]")
-    built = []
-    for table, cls in (("geometry", SolidGeometry), ("material", SolidMaterial)):
-        values = doc.get(table, {})
-        fields = {f.name for f in dataclasses.fields(cls)}
-        wrong = set(values) - fields
-        if wrong:
-            raise SimulationInputError(f"{path}: unknown key(s) {', '.join(sorted(wrong))} in [{table}]; "
-                                       f"known: {', '.join(sorted(fields))}")
-        built.append(cls(**values))
-    return tuple(built)
-
-
-def _external_model(args: argparse.Namespace) -> tuple[Any, dict | None, list[str]]:
-    """(model, provenance, report lines) of --solid or --from-calculix."""
-    import sys
-
-    if args.variant is not None and not args.solid:
-        raise SimulationInputError("--variant with --from-calculix: the job defines the model; drop --variant")
-    if args.solid:
-        from sim.hosts.solid import MESH_LEVELS, solid_rig_model
-        from sim.hosts.variants import SOLID_VARIANTS, solid_variant_model
-
-        level = args.mesh or "coarse"
-        if level not in MESH_LEVELS:
-            raise SimulationInputError(f"--mesh {level!r}: with --solid give a mesh level ({', '.join(MESH_LEVELS)})")
-        if not (args.patch_radius >= 0):
-            raise SimulationInputError(f"--patch-radius must be >= 0 (m), got {args.patch_radius!r}")
-        if args.variant is not None and args.variant not in SOLID_VARIANTS:
-            raise SimulationInputError(f"--variant {args.variant!r} is not a solid-model variant; choose one of "
-                                       f"{', '.join(SOLID_VARIANTS)}")
-        if args.variant is not None and (args.geometry or args.patch_radius):
-            raise SimulationInputError("--variant fixes the solid model's geometry and contact point; drop --geometry "
-                                       "and --patch-radius, or drop --variant")
-        geometry, material = _solid_geometry(args.geometry)  # a bad geometry file: one line before any work
-        sys.stderr.write(f"solving the 3D solid model ({level} mesh and a coarser one for the convergence check; "
-                         "about 1-3 min) ...\n")
-        if args.variant is not None:
-            result = solid_variant_model(args.variant, level, n_modes=args.n_modes)
-        else:
-            result = solid_rig_model(level, geometry, material, n_modes=args.n_modes, patch_radius=args.patch_radius)
-        return result.model, result.provenance, result.report
-    from sim.hosts.calculix import calculix_modal_model
-
-    missing = [o for o, v in (("--mesh JOB.inp", args.mesh), ("--wall-left", args.wall_left),
-                              ("--wall-right", args.wall_right), ("--tip", args.tip)) if not v]
-    if missing:
-        raise SimulationInputError(f"--from-calculix also needs {', '.join(missing)}")
-    result = calculix_modal_model(args.from_calculix, args.mesh, args.wall_left, args.wall_right, args.tip,
-                                  dat=args.dat, units=args.units, n_modes=args.n_modes, floor=args.floor,
-                                  beam_mass=args.beam_mass)
-    return result.model, result.provenance, result.report
-
-
-def _fixed_joint_model(stiffness: float, variant: str, n_modes: int) -> tuple[Any, Any, dict, list[str]]:
-    """`ies modes --joint-stiffness K`: the built-in rig re-updated (sim.hosts.rig.update_rig) with the joint's
-    translational stiffness fixed at K (N/m; sim.hosts.rig.update_rig_fixed_joint): (model, updated RigParameters,
-    provenance, report lines)."""
-    import math
-
-    from sim.common.files import to_jsonable
-    from sim.hosts.rig import rig_modal_model, update_rig_fixed_joint
-
-    if not (stiffness > 0):  # also refuses NaN
-        raise SimulationInputError(f"--joint-stiffness must be positive in N/m (inf = rigid), got {stiffness!r}")
-    fit = update_rig_fixed_joint(stiffness, variant=variant)
-    label = "rigid" if math.isinf(stiffness) else f"{stiffness:.4g} N/m"
-    model = rig_modal_model(fit.params, n_modes, f"built-in seed rig (sim.hosts.rig, Timoshenko beam, variant {variant} "
-                                                  f"re-updated with the joint stiffness fixed at {label})")
-    errors = [100 * e for e in fit.frequency_errors]
-    plain = {"model": "built-in Timoshenko beam (sim.hosts.rig), re-updated (sim.hosts.rig.update_rig_fixed_joint)",
-             "variant": variant,
-             "joint_translational_stiffness_N_per_m": stiffness if math.isfinite(stiffness) else "rigid",
-             "updated_parameters": fit.params.as_dict(), "f1_f4_error_percent": errors,
-             "f9_hz": fit.f9_hz, "cost": fit.cost, "on_bounds": list(fit.on_bounds)}
-    report = [f"joint stiffness fixed at {label}; re-updated: E = {fit.params.E / 1e9:.2f} GPa, neck "
-              f"{1e3 * fit.params.neck_length:.2f} mm x {1e3 * fit.params.neck_width_y:.2f} mm (y); f1..f4 "
-              + ", ".join(f"{e:+.3f}" for e in errors) + f" %, f9 = {fit.f9_hz:.0f} Hz"
-              + (f"; on bounds: {', '.join(fit.on_bounds)}" if fit.on_bounds else "")]
-    return model, fit.params, to_jsonable(plain), report
-
-
 def modes_command(args: argparse.Namespace) -> int:
     """`ies modes`: show (and with --save write) the built-in rig's model, a modal-model file, the 3D solid
     model or the modes of a CalculiX job."""
     from sim.common.files import dumps, report_written
     from sim.hosts.modal_file import save_modal_model
+    from sim.hosts.sources import host_model
 
-    rig = provenance = None
-    report: list[str] = []
-    if not 1 <= args.n_modes <= 30:
-        raise SimulationInputError(f"--n-modes must lie in 1..30, got {args.n_modes}")
-    if args.joint_stiffness is not None and (args.solid or args.from_calculix or args.model):
-        raise SimulationInputError("--joint-stiffness re-updates the built-in rig; drop --model, --solid and "
-                                   "--from-calculix")
-    if args.solid or args.from_calculix:
-        model, provenance, report = _external_model(args)
-    elif args.mesh or args.geometry or args.wall_left or args.wall_right or args.tip or args.dat or args.floor \
-            or args.beam_mass is not None:
-        raise SimulationInputError("--mesh, --geometry, --wall-left, --wall-right, --tip and --dat belong to --solid "
-                                   "or --from-calculix")
-    elif args.model:
-        if args.variant is not None:
-            raise SimulationInputError("--variant selects a built-in rig model; it cannot be used with --model")
-        model = model_file(args.model)
-    else:
-        from sim.hosts.rig import DEFAULT_VARIANT, rig_modes, seed_rig_model, variant_parameters
-
-        variant = args.variant or DEFAULT_VARIANT
-        if args.joint_stiffness is not None:
-            model, params, provenance, report = _fixed_joint_model(args.joint_stiffness, variant, args.n_modes)
-        else:
-            model, params = seed_rig_model(n_modes=args.n_modes, variant=variant), variant_parameters(variant)
-        rig = rig_modes(params, n_modes=max(args.n_modes, 9))  # its updating summary needs f1..f9
+    host = host_model(args)  # the row of sim.hosts.sources.HOST_SOURCES the options select
+    model, rig, provenance, report = host.model, host.rig, host.provenance, host.report
     data = describe_modes(model, rig)
     if provenance is not None:
         data["provenance"] = provenance
@@ -281,28 +157,22 @@ def modes_command(args: argparse.Namespace) -> int:
 # ---- the system and the protocol, shared by ies sweep and ies overview ---------------------------------------
 
 def add_system_arguments(parser: argparse.ArgumentParser) -> None:
-    """Model and impactor options (Table 2 parameters)."""
+    """Model and impactor options: --model, --no-impactor, --contact-law and one option per parameter of
+    `sim.model.parameters.PARAMETERS` that has one (Table 2's D, g, k_H; r_cont, friction, k_t)."""
+    from sim.model.contact_law import CONTACT_LAWS
+    from sim.model.parameters import PARAMETERS
+
     parser.add_argument("--model", metavar="FILE", help="modal-model file (default: the built-in model of the seed rig)")
-    parser.add_argument("--D", type=float, metavar="D1", help="modal damping ratio of mode 1 (-), default the model's (0.00085)")
-    parser.add_argument("--g", type=clearance, metavar="G",
-                        help="clearance g in m, or with a unit: 0.58mm, 580um (default 0.58 mm)")
-    parser.add_argument("--k-H", dest="k_H", type=hertz_constant, metavar="K_H",
-                        help="Hertz constant k_H in N/m^1.5, or with a unit: 282e3N/mm^1.5 (default 282e3 N/mm^1.5 = "
-                             "8.918e9 N/m^1.5)")
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
-    parser.add_argument("--contact-law", dest="contact_law", choices=("hertz", "hertz-damped"), default=None,  # sim.model.contact_law.CONTACT_LAWS
+    parser.add_argument("--contact-law", dest="contact_law", choices=CONTACT_LAWS, default=None,
                         help="normal contact law at both walls: hertz (Eq. 4, elastic, default) or hertz-damped (Eq. 10; "
                              "needs the model's beam mass; the exact integrator then takes every contact by "
                              "Dormand-Prince)")
-    parser.add_argument("--r-cont", dest="r_cont", type=float, default=None, metavar="R",
-                        help="r_cont,diss of Eq. 10 in (0, 1]: the coefficient of restitution the damped law is designed "
-                             "for (1 = elastic, bit for bit); implies --contact-law hertz-damped (default there 0.99)")
-    parser.add_argument("--friction", type=friction_coefficient, default=0.0, metavar="MU",
-                        help="Coulomb coefficient of dry friction between the sphere and the cavity floor (Appendix C; "
-                             "0 = off, the default; the paper: 0.07); needs --integrator ode3 and the model's phi_floor")
-    parser.add_argument("--k-t", dest="k_t", type=tangential_stiffness, default=22e6, metavar="K_T",
-                        help="tangential stiffness of the floor contact in N/m, or with a unit: 22kN/mm (default, "
-                             "Appendix C)")
+    for name, parameter in PARAMETERS.items():
+        option = parameter.option
+        if option is not None:
+            parser.add_argument(option.flag, dest=name, type=option.parse, default=None, metavar=option.metavar,
+                                help=option.help)
 
 
 def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int) -> None:
@@ -387,43 +257,22 @@ def parse_levels(text: str) -> list[float]:
     return [check_level(v) for v in values]
 
 
-def model_file(path: str) -> Any:
-    """The modal model of a file (`sim.hosts.modal_file`), its source naming the file first: ``file PATH (what the file
-    says it holds)``, so that a saved built-in model is reported as the file it now is."""
-    import dataclasses
-
-    from sim.hosts.modal_file import load_modal_model
-
-    model = load_modal_model(path)
-    return dataclasses.replace(model, source=f"file {path} ({model.source})")
-
-
 def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
-    """(modal model, impactor or None) of the system and impactor options (Eqs. 3-7, Table 2)."""
+    """(modal model, impactor or None) of the system and impactor options (Eqs. 3-7, Table 2), built and checked by
+    `sim.model.system.build_system` from the options of `sim.model.parameters.PARAMETERS`."""
     from sim.hosts.rig import seed_rig_model
-    from sim.model.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor, system_arrays
+    from sim.hosts.sources import model_file
+    from sim.model.parameters import PARAMETERS, SystemSettings, system_settings
+    from sim.model.system import build_impactor
+    from sim.model.system import build_system as build
 
     model = model_file(args.model) if args.model else seed_rig_model(n_modes=9)
-    if args.D is not None:
-        model = model.with_damping(args.D)
-    clearance = CLEARANCE_NOMINAL if args.g is None else args.g
-    k_H = K_H_NOMINAL if args.k_H is None else args.k_H
-    impactor = Impactor(SPHERE_MASS, clearance, k_H, contact_law(args), args.friction, args.k_t)  # validated even
-    if not args.no_impactor:                                                                    # with --no-impactor
-        system_arrays(model, impactor)  # Eq. 10 needs the beam mass, friction phi_floor: fail before any work
-        if impactor.friction > 0 and args.integrator != "ode3":
-            raise SimulationInputError(f"dry friction (--friction {args.friction:g}, Appendix C) is in the ode3 integrator "
-                                       f"only; add --integrator ode3")
-    return model, (None if args.no_impactor else impactor)
-
-
-def contact_law(args: argparse.Namespace) -> Any:
-    """The `sim.model.contact_law.ContactLaw` of --contact-law and --r-cont (--r-cont alone implies the damped law)."""
-    from sim.model.contact_law import DEFAULT_R_CONT, ContactLaw
-
-    name = args.contact_law or ("hertz-damped" if args.r_cont is not None else "hertz")
-    r_cont = args.r_cont if args.r_cont is not None else (DEFAULT_R_CONT if name == "hertz-damped" else 1.0)
-    return ContactLaw(name, r_cont)
+    values = {name: getattr(args, name, None) for name in PARAMETERS}
+    settings = system_settings(values, SystemSettings(contact_law=args.contact_law))
+    if args.no_impactor:  # the impactor's values are checked all the same
+        build_impactor(settings)
+        return (model if settings.D1 is None else model.with_damping(settings.D1)), None
+    return build(model, settings, integrator=args.integrator)
 
 
 def system_data(model: Any, impactor: Any) -> dict:

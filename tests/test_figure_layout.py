@@ -35,6 +35,7 @@ import sim.plots.figures
 import sim.common.files
 import sim.analysis.modal_fit
 import uq.figures
+import uq.paper_figures
 from sim.plots.redraw import PlotOptions, style
 
 LEVELS = [2.0, 4.0, 5.3, 6.7, 7.0, 7.4, 7.8, 9.0]
@@ -364,7 +365,7 @@ def trace_data(periods: int = 80) -> tuple[dict, np.ndarray, np.ndarray, np.ndar
 # --- the figures -------------------------------------------------------------------------------------------------
 
 def draw_response(tmp: Path) -> None:
-    uq.figures.response_figures(response_folder(tmp / "response"), PlotOptions(formats=(".png",)))
+    uq.paper_figures.response_figures(response_folder(tmp / "response"), PlotOptions(formats=(".png",)))
 
 
 def draw_sweep(tmp: Path) -> None:
@@ -378,12 +379,12 @@ def draw_overview_command(tmp: Path) -> None:
 
 
 def draw_interval(tmp: Path) -> None:
-    uq.figures.interval_figures(interval_folder(tmp / "fig7"), PlotOptions(formats=(".png",)))
+    uq.paper_figures.interval_figures(interval_folder(tmp / "fig7"), PlotOptions(formats=(".png",)))
 
 
 def draw_interval_restitution(tmp: Path) -> None:
     apr = [i for i, r in enumerate(REGIMES) if r == "APR"][:3]
-    uq.figures.interval_figures(interval_folder(tmp / "figD3", "restitution", [LEVELS[i] for i in apr],
+    uq.paper_figures.interval_figures(interval_folder(tmp / "figD3", "restitution", [LEVELS[i] for i in apr],
                                                 [REGIMES[i] for i in apr]), PlotOptions(formats=(".png",)))
 
 
@@ -399,7 +400,7 @@ def draw_series(tmp: Path) -> None:
             data[key] = [v * (1 + 0.05 * k) for v in data[key]]
         series.append((f"g={g}mm", data))
     sim.plots.figures.plot_series(series, tmp / "fig11.png", "Resonant mean for each g (cf. Fig. 11)",
-                            uq.figures.SERIES_FIGURES["fig11"][1])
+                            (7.5, "paper: contact dissipation matters above 7.5"))
     sim.plots.figures.plot_series(series[:3], tmp / "figC1.png", "Resonant mean for each g (cf. Fig. C.1)")
     sim.plots.figures.plot_series(series[:2], tmp / "fig6-compare.png", "Resonant mean of each study", paper_landmarks=True)
 

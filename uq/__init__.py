@@ -12,7 +12,7 @@ Public names, each imported from its module on first use, so that `import uq.err
   study:   Study, load_study (study files; all keys in its docstring)
   space:   Parameter, ParameterSpace, table2_space (Table 2)
   execute: run_interval_study, run_sobol_study, run_response_study -> StudyResult
-  figures: interval_figures, sobol_figure, response_figures (Figs. 5-8)
+  figures: sobol_figure; paper_figures: PAPER_FIGURES, interval_figures, response_figures (Figs. 5-8)
 """
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ _MODULE_OF = {
     "Parameter": "space", "ParameterSpace": "space", "table2_space": "space",
     "run_interval_study": "execute", "run_sobol_study": "execute", "run_response_study": "execute",
     "StudyResult": "execute",
-    "interval_figures": "figures", "sobol_figure": "figures", "response_figures": "figures",
+    "interval_figures": "paper_figures", "sobol_figure": "figures", "response_figures": "paper_figures",
 }
 __all__ = ["StudyError", *_MODULE_OF]
 

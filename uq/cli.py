@@ -18,6 +18,7 @@ import sys
 from typing import Sequence
 
 import bem_contact.cli
+import bem_contact.pipeline
 import sim.cli
 import uq.commands
 from bem_contact.errors import ContactInputError, ConvergenceError
@@ -33,7 +34,7 @@ NUMERICAL_FAILURES = (ConvergenceError, SimulationDiverged)
 STAGES = (
     (bem_contact.cli, {}),
     (sim.cli, {}),
-    (uq.commands, {"calibrate": bem_contact.cli.calibrate_default}),
+    (uq.commands, {"calibrate": bem_contact.pipeline.calibrate_default}),
 )
 
 

@@ -6,13 +6,12 @@
   resonant response levels, from Saltelli's sampling or a polynomial-chaos surrogate (`uq.surrogate`).
 * `ies response STUDY.toml`: the nominal point's frequency responses and resonant levels over the excitation
   levels through the task store (resumable, parallel, on a cluster), Figs. 5 and 6.
-* `ies reproduce fig5|fig6|fig7|fig8|figD2|figD3|all [--quick] [--out DIR]`: the paper's figures, run from the
-  shipped study files (uq/studies/fig5.toml ... figD3.toml, or their -quick variants) into DIR/fig5 ... DIR/figD3.
-  Before Figs. 7 and 8 it calibrates k_H on the shipped crater (the calibration `ies calibrate --json` prints,
-  kept in DIR/calibration.json) and uses the calibrated k_H as the upper bound of k_H, as the paper does with
-  its BEM result 1.52 k_H* (Sect. 4.1); the best estimate stays 1.25 k_H* unless the calibration falls below
-  it (then the midpoint of k_H* and the calibrated value). A failed calibration is one warning line, and
-  Table 2's bounds are kept.
+* `ies reproduce NAME|all [--quick] [--out DIR]`: the paper's figures of `uq.paper_figures.PAPER_FIGURES` (fig5,
+  fig6, fig7, fig8, figD2, figD3 in `all`; fig11, figC1 when named), each run from its study file (uq/studies/NAME.toml,
+  or its -quick variant) into DIR/NAME, drawn and printed by its row. Before a study that varies k_H it calibrates
+  k_H on the shipped crater (the calibration `ies calibrate --json` prints, kept in DIR/calibration.json) and
+  uses the calibrated k_H as the upper bound of k_H (`uq.study.with_calibration`, Sect. 4.1). A failed
+  calibration is one warning line, and Table 2's bounds are kept.
 * `ies plot DIR`: redraw the figures of a result folder from its data (`sim.plots.redraw`), in other formats, another
   matplotlib style or for a subset of the levels, without recomputing.
 * `ies compare DIR DIR ... --out OUT`: the Fig. 6 landmarks of several response studies side by side with the
@@ -48,13 +47,6 @@ REPRODUCE_HELP = ("reproduce the paper's Figs. 5 and 6 (nominal response), 7 and
 PLOT_HELP = "redraw a result folder's figures from its saved data (formats, style, levels) without recomputing"
 COMPARE_HELP = ("the Fig. 6 landmarks of several response studies side by side with the paper's: switch, optimum, "
                 "levels at 7.4 and 9, impacts, r and energy share at 7.4 (table and figure)")
-#: the paper's figures that `ies reproduce` runs, in the order of `all`
-FIGURES = ("fig5", "fig6", "fig7", "fig8", "figD2", "figD3")
-#: figures `ies reproduce` runs when named, not in `all` (five contact laws, friction: minutes even when quick)
-EXTRA_FIGURES = ("fig11", "figC1")
-#: the levels whose time histories a figure traces (Fig. C.1b: 1.26 and 5.3, with friction)
-TRACED = {"figC1": (1.26, 5.3)}
-
 
 def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
     """Register `interval`, `sobol`, `response`, `reproduce`, `plot` and `compare` on the front door's subparsers (argparse);
@@ -116,7 +108,7 @@ def add_response_arguments(parser: argparse.ArgumentParser) -> None:
 def interval_command(args: argparse.Namespace) -> int:
     """`ies interval`: the study's interval bands (Sect. 5.4), then Figs. 7-8; prints the bands."""
     from uq.execute import run_interval_study
-    from uq.figures import interval_figures
+    from uq.paper_figures import interval_figures
 
     study = _load_study(args.study, "interval")
     result = run_interval_study(study, out=args.out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
@@ -147,7 +139,7 @@ def sobol_command(args: argparse.Namespace) -> int:
 def response_command(args: argparse.Namespace) -> int:
     """`ies response`: the study's frequency responses and resonant levels (Sects. 5.2-5.3), then Figs. 5-6."""
     from uq.execute import run_response_study
-    from uq.figures import response_figures
+    from uq.paper_figures import response_figures
 
     study = _load_study(args.study, "response")
     result = run_response_study(study, out=args.out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
@@ -181,57 +173,33 @@ def _report(result: Any, figures: list[Path]) -> None:
 
 
 def print_interval_result(folder: Path, summary: dict, name: str) -> None:
-    """The bands with their noise and checks, and for an individual variation the trends (Figs. 7, 8)."""
-    from uq.results import band_table, influence_line, trend_table
+    """The bands with their noise and checks, and for an individual variation the trends (Figs. 7, 8;
+    `uq.paper_figures.interval_table`)."""
+    from uq.paper_figures import interval_table
 
-    for key in summary["untested"]:
-        print(f"{name}: monotonicity could not be tested for {key} (one repetition: no noise estimate)")
-    if any(key.startswith("individual:") for key in summary["monotone"]):
-        print(f"{name}: change of the resonant level from each parameter's min to its max:")
-        print(trend_table(folder))
-        print(f"{name}: {influence_line(folder)}")
-    print(f"{name}: bands (lower, nominal, upper +- standard error) and their checks:")
-    print(band_table(folder))
+    interval_table(folder, summary, name)
 
 
 def print_response_result(folder: Path, name: str) -> None:
-    """The resonant levels per excitation level and the optimum (Fig. 6); for Figs. D.2, D.3 the impacts and
-    scattering measures at the resonant eta."""
-    import json
+    """The table a response study prints: that of the figure it is named after when it has one
+    (`uq.paper_figures.PaperFigure.table`: Figs. D.2, D.3 the impacts and scattering measures), else the
+    resonant levels and the optimum (Fig. 6)."""
+    from uq.paper_figures import PAPER_FIGURES, response_table
 
-    from sim.hosts.variants import switch_line
-    from sim.stepped_sine.tables import optimum_line, overview_text, scattering_text
-
-    data = json.loads((folder / "study.json").read_text())
-    if "series_folders" in data:
-        from sim.stepped_sine.tables import series_text
-        from uq.figures import series_overviews
-
-        print(f"{name}: resonant mean (a / a_noabs*) and the input's dissipation shares at the resonant eta "
-              f"(contact / friction / mode 1 / modes 2..N) for each value:")
-        print(series_text(series_overviews(folder)))
-        return
-    overview = data["overview"]
-    if name in ("figD2", "figD3"):
-        print(f"{name}: impacts, restitution and energy scattering at the resonant eta of the nominal point:")
-        print(scattering_text(overview))
-        return
-    print(f"{name}: resonant levels (a / a_noabs*) of the nominal point:")
-    print(overview_text(overview))
-    print(f"{name}: {optimum_line(overview)}")
-    if "landmarks" in data:
-        print(f"{name}: {switch_line(data['landmarks'])}")
+    row = PAPER_FIGURES.get(name)
+    (response_table if row is None else row.table)(folder, {}, name)
 
 
 # ---- ies reproduce ------------------------------------------------------------------------------------------
 
 def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies reproduce`."""
-    parser.add_argument("figure", choices=(*FIGURES, *EXTRA_FIGURES, "all"),
-                        help="which figure(s): fig5 (frequency responses), fig6 (resonant level vs excitation level), "
-                             "fig7 and fig8 (uncertainty of D, g, k_H), figD2 and figD3 (impacts per period and "
-                             "restitution vs excitation level), fig11 (damped contact law, Eq. 10) and figC1 (dry friction, "
-                             "Appendix C; both not in all), all")
+    from uq.paper_figures import PAPER_FIGURES
+
+    rows = PAPER_FIGURES.values()
+    parser.add_argument("figure", choices=(*PAPER_FIGURES, "all"),
+                        help="which figure(s): " + ", ".join(f"{row.name} ({row.help}{'' if row.in_all else '; not in all'})"
+                                                             for row in rows) + ", all")
     parser.add_argument("--quick", action="store_true",
                         help="reduced protocol (fewer levels, frequencies, repetitions, shorter holds); same trends")
     parser.add_argument("--out", type=Path, default=Path("ies-out/reproduce"), metavar="DIR",
@@ -252,10 +220,10 @@ def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def study_file(figure: str, quick: bool) -> Path:
-    """The shipped study file of a figure."""
-    from importlib.resources import files
+    """The study file of a figure (`uq.paper_figures.PaperFigure.study_file`)."""
+    from uq.paper_figures import PAPER_FIGURES
 
-    return Path(str(files("uq") / "studies" / f"{figure}{'-quick' if quick else ''}.toml"))
+    return PAPER_FIGURES[figure].study_file(quick)
 
 
 def run_calibration(calibrate: Calibrate, out: Path) -> dict | None:
@@ -275,21 +243,6 @@ def run_calibration(calibrate: Calibrate, out: Path) -> dict | None:
     return data
 
 
-def with_calibration(study: Any, k_H_cal: float) -> Any:
-    """The study with k_H's upper bound at the calibrated value (and the best estimate kept below it)."""
-    from uq.space import K_H_STAR, ParameterSpace
-
-    space = study.space
-    k = space["k_H"]
-    best = space.extras.get("k_H_best_estimate", 1.25 * K_H_STAR)
-    if best > k_H_cal:
-        best = 0.5 * (k.min + k_H_cal)
-    params = tuple(replace(p, max=max(k_H_cal, p.min)) if p.name == "k_H" else p for p in space.parameters)
-    new_space = ParameterSpace(params, {**space.extras, "k_H_best_estimate": best, "k_H_calibrated": k_H_cal})
-    fix = {**study.fix, "k_H": best} if "k_H" in study.fix else dict(study.fix)
-    return replace(study, space=new_space, fix=fix)
-
-
 def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
     """`ies reproduce`: check every study first, connect to the cluster once, then calibrate (for Figs. 7-8, with
     `calibrate` unless --calibration FILE or --no-calibration) and run."""
@@ -297,7 +250,9 @@ def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
     from uq.space import calibrated_k_H
     from uq.study import load_study
 
-    figures = FIGURES if args.figure == "all" else (args.figure,)
+    from uq.paper_figures import figures_of_all
+
+    figures = figures_of_all() if args.figure == "all" else (args.figure,)
     studies = [load_study(study_file(f, args.quick)) for f in figures]
     if args.integrator:
         studies = [replace(s, protocol={**s.protocol, "integrator": args.integrator}) for s in studies]
@@ -341,41 +296,35 @@ def _reproduce_figure(args: argparse.Namespace, figure: str, study: Any, client:
                       calibration: dict | None, calibrated: bool) -> tuple[dict | None, bool]:
     """One figure of `ies reproduce`: the calibration first if its study varies k_H and none was made yet, then
     the study, its figures and its table. Returns (the calibration, whether it was made)."""
-    from uq.errors import StudyError
     from uq.execute import run_interval_study, run_response_study
-    from uq.figures import interval_figures, response_figures
+    from uq.paper_figures import PAPER_FIGURES, STUDY_FIGURES, interval_table
     from uq.space import K_H_STAR, calibrated_k_H
+    from uq.study import with_calibration
 
     out = args.out
+    row = PAPER_FIGURES[figure]
     if study.kind == "interval" and "k_H" in [p.name for p in study.space.varied]:  # calibrated once, first
         if not calibrated and calibration is None and not args.no_calibration:
             calibration = run_calibration(calibrate, out)
         if calibration is not None:
             k_cal = calibrated_k_H(calibration)
-            if k_cal < K_H_STAR:
-                raise StudyError(f"the calibrated k_H = {k_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; a "
-                                 "crater should stiffen the contact: check the calibration or use --no-calibration")
+            study = with_calibration(study, k_cal)  # one line if k_cal < k_H*
             if not calibrated:
                 print(f"calibrated k_H = {k_cal:.4g} N/m^1.5 = {k_cal / K_H_STAR:.3f} k_H* (upper bound of k_H)")
-            study = with_calibration(study, k_cal)
         calibrated = True
     folder = out / figure
     print(f"{figure}: {study.source} -> {folder}/")
-    run, draw = ((run_response_study, response_figures) if study.kind == "response"
-                 else (run_interval_study, interval_figures))
+    run = run_response_study if study.kind == "response" else run_interval_study
     result = run(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet)
-    paths = draw(result.folder)
-    if figure in TRACED:
+    paths = STUDY_FIGURES[study.kind](result.folder)
+    if row.traced:
         from uq.execute import series_traces
 
-        paths += series_traces(study, folder, TRACED[figure])
+        paths += series_traces(study, folder, row.traced)
     s = result.summary
     print(f"{figure}: {s['tasks']} runs ({s['ran']} run now), {s['failed_runs']} failed, "
           f"{s['wall_time_s']:.1f} s; figures: {', '.join(p.name for p in paths)}")
-    if study.kind == "response":
-        print_response_result(folder, figure)
-    else:
-        print_interval_result(folder, s, figure)
+    (row.table if study.kind == "response" else interval_table)(folder, s, figure)
     return calibration, calibrated
 
 
@@ -397,7 +346,8 @@ def add_plot_arguments(parser: argparse.ArgumentParser) -> None:
 def plot_command(args: argparse.Namespace) -> int:
     """`ies plot`: redraw the figures of a result folder from its data files (`sim.plots.redraw`)."""
     import sim.plots.figures  # noqa: F401 - registers ies sweep's, overview's and trace's folders
-    import uq.figures  # noqa: F401 - registers the study folders
+    import uq.figures  # noqa: F401 - registers the Sobol' and reproduce folders
+    import uq.paper_figures  # noqa: F401 - registers the interval and response study folders
     from sim.common.errors import SimulationInputError
     from sim.common.files import report_written
     from sim.plots.redraw import PlotOptions, kind_of, redraw, style

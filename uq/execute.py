@@ -192,7 +192,7 @@ def study_key(study: Study, model: Any) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, resume: bool, jobs: int,
+def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, *, resume: bool, jobs: int,
                 scheduler: str | None, progress: bool, client: Any) -> tuple[Any, StudyResult, dict, int, float]:
     """Connect to the cluster once (if any), then prepare the output folder and run every task of `points`.
 
@@ -247,8 +247,8 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
             unique.setdefault(p.key(), dict(p.values))
     points = list(unique.values())
     index = {key: i for i, key in enumerate(unique)}
-    model, result, results, ran, elapsed = _run_points(study, model, points, out, resume, jobs, scheduler, progress,
-                                                       client)
+    model, result, results, ran, elapsed = _run_points(study, model, points, out, resume=resume, jobs=jobs,
+                                                       scheduler=scheduler, progress=progress, client=client)
     folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
     level_labels = [f"level {lv:g}" for lv in study.levels]
@@ -289,7 +289,8 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     result.files.append(write_csv(folder / "bands.csv", BAND_COLUMNS, band_rows))
     members = [[d.name, p.label, p.role, index[p.key()]] for d in [Design("nominal", "box", (nominal,))] + designs
                for p in d.points]
-    result.files.append(_interval_netcdf(study, model, folder, points, results, stats, regimes, members, band_rows))
+    result.files.append(_interval_netcdf(study, model, folder, points, results, stats=stats, regimes=regimes,
+                                         members=members, band_rows=band_rows))
     monotone = {f"{d}/{o}": bd.monotone for (d, o), bd in bands.items()}
     untested = [f"{d}/{o}" for (d, o), bd in bands.items() if not bd.fully_tested]
     result.summary = {"tasks": len(results), "ran": ran, "reused": len(results) - ran, "failed_runs": n_failed,
@@ -298,7 +299,7 @@ def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
     return result
 
 
-def _interval_netcdf(study: Study, model: Any, folder: Path, points: list[dict], results: dict, stats: dict,
+def _interval_netcdf(study: Study, model: Any, folder: Path, points: list[dict], results: dict, *, stats: dict,
                      regimes: np.ndarray, members: list[list], band_rows: list[list]) -> Path:
     """results.nc of an interval study (`uq.netcdf`): the runs and repetition statistics per point, each design's
     members (on design_point: member_design, member_label, member_role and member_point, the index along point; the
@@ -368,8 +369,9 @@ def _band_with_failures(design: Design, mean: np.ndarray, se: np.ndarray, z: flo
     cat = lambda attr: np.concatenate([getattr(b, attr) for b in parts])  # noqa: E731
     for b in parts:
         notes.extend(b.notes)
-    return Band(design.name, cat("lower"), cat("upper"), cat("corner_lower"), cat("corner_upper"), cat("flagged"),
-                cat("violation"), cat("tested"), notes)
+    return Band(design=design.name, lower=cat("lower"), upper=cat("upper"), corner_lower=cat("corner_lower"),
+                corner_upper=cat("corner_upper"), flagged=cat("flagged"), violation=cat("violation"),
+                tested=cat("tested"), notes=notes)
 
 
 def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = None, jobs: int = 1,
@@ -390,8 +392,8 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
         n = study.sobol_n if n is None else n
         X = sobol_sample(study.space, n, seed=study.seed)
     points = [study.space.from_values(x) for x in X]
-    model, result, results, ran, elapsed = _run_points(study, model, points, out, resume, jobs, scheduler, progress,
-                                                       client)
+    model, result, results, ran, elapsed = _run_points(study, model, points, out, resume=resume, jobs=jobs,
+                                                       scheduler=scheduler, progress=progress, client=client)
     folder = result.folder
     names, outputs = study.space.names, list(model.banded_outputs)
     rows, summary_rows, per_level, fit_rows = [], [], {}, []
@@ -432,8 +434,8 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                                    _runs_rows(results, points, study, model.outputs, names)))
     result.files.append(write_csv(folder / "sobol.csv", SOBOL_CSV.names, rows))
     result.files.append(write_csv(folder / "variance.csv", VARIANCE_CSV.names, summary_rows))
-    result.files.append(_sobol_netcdf(study, model, folder, points, results, stats, regimes, rows, summary_rows,
-                                      fit_rows if pce else None))
+    result.files.append(_sobol_netcdf(study, model, folder, points, results, stats=stats, regimes=regimes, rows=rows,
+                                      summary_rows=summary_rows, fit_rows=fit_rows if pce else None))
     if pce:
         result.files.append(write_csv(folder / "surrogate.csv", SURROGATE_COLUMNS, fit_rows))
         sample = {"method": "pce", "design_points": study.surrogate_points, "degree": study.surrogate_degree,
@@ -446,7 +448,7 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
     return result
 
 
-def _sobol_netcdf(study: Study, model: Any, folder: Path, points: list[dict], results: dict, stats: dict,
+def _sobol_netcdf(study: Study, model: Any, folder: Path, points: list[dict], results: dict, *, stats: dict,
                   regimes: np.ndarray, rows: list[list], summary_rows: list[list], fit_rows: list[list] | None) -> Path:
     """results.nc of a Sobol' study (`uq.netcdf`): the runs and repetition statistics per sample point, the indices
     per parameter and level (OUTPUT_S1, ...), the variance and noise per level, and the surrogate's fit (pce)."""
@@ -503,8 +505,8 @@ def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, 
                                     client=client)
     model = _checked_model(study)
     point = study.space.nominal()
-    model, result, results, ran, elapsed = _run_points(study, model, [point], out, resume, jobs, scheduler, progress,
-                                                       client)
+    model, result, results, ran, elapsed = _run_points(study, model, [point], out, resume=resume, jobs=jobs,
+                                                       scheduler=scheduler, progress=progress, client=client)
     folder = result.folder
     n_failed = sum(1 for rec in results.values() if rec["error"])
     if n_failed:

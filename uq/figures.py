@@ -11,16 +11,19 @@
   the paper's optimum marked), response studies, through `sim.plots.figures`.
 * Sobol': S1 and ST with their confidence intervals vs level, and the repetition-noise share.
 
-Only the data files are read, never the runs, so `ies plot` redraws any of them (`sim.plots.redraw`: the study kinds
-are registered here). Every figure is written in the formats of the plot options (PNG and PDF by default).
+Only the data files are read, never the runs, so `ies plot` redraws any of them (`sim.plots.redraw`: the Sobol' and
+`ies reproduce` folders are registered here, the interval and response studies with the figure table in
+`uq.paper_figures`, which names the figures). This module knows no figure's name. Every figure is written in the
+formats of the plot options (PNG and PDF by default).
 """
 from __future__ import annotations
 
 import csv
 import json
 from collections import defaultdict
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -198,17 +201,15 @@ def _level_step(levels: np.ndarray) -> float:
     return float(np.min(np.diff(unique))) if unique.size > 1 else 1.0
 
 
-#: the joint band's figure per banded output: file stem and title (Fig. 8 for the response level, Fig. D.3 for r)
-_BOX_FIGURES = {"mean": ("fig8", "Joint variation (cf. Fig. 8)"),
-                "restitution": ("figD3", "Modal coefficient of restitution from the tip, joint variation (cf. Fig. D.3)"),
-                "restitution_wall": ("figD3", "Modal coefficient of restitution from the wall, joint variation (cf. Fig. D.3)")}
+#: the joint-band figure of a banded output: (file stem, title, a level of the paper to mark (value, label) or None)
+BoxFigure = tuple[str, str, "tuple[float, str] | None"]
 
 
-def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
-    """Draw Figs. 7 and 8 (as far as the study has the designs) and the nominal levels from folder/*.csv: every
-    legend beside or below its axes, the panels of Fig. 7 on one y scale, the regimes of the nominal point
-    (`uq.results.nominal_regimes`) shaded, the corners' parameter values in the legends, and the factor to the
-    tip amplitude in mm (Eq. B.1) where the output is a resonant level."""
+def interval_figures(folder: str | Path, options: PlotOptions | None = None, *, individual_stem: str,
+                     box_figure: Callable[[str], BoxFigure]) -> list[Path]:
+    """Draw Figs. 7 and 8 (as far as the study has the designs) and the nominal levels from folder/*.csv: the
+    individual variation under the stem `individual_stem`, the joint band of an output as `box_figure(output)` names it
+    (`uq.paper_figures.interval_figures` passes the figure table's names)."""
     folder = Path(folder)
     options = options or PlotOptions()
     plt = pyplot()
@@ -256,7 +257,7 @@ def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> 
         axes[0][0].set_ylabel(_YLABEL.get(output, output))
         fig.suptitle(f"Individual variation (cf. Fig. 7); {nominal_text}", fontsize=10)
         fig.supxlabel(notes, fontsize=LEGEND_PT)
-        paths += _save(fig, folder, "fig7", options)
+        paths += _save(fig, folder, individual_stem, options)
         plt.close(fig)
 
     box = [d for d in designs if d in ("joint", "residual")]
@@ -276,9 +277,9 @@ def interval_figures(folder: str | Path, options: PlotOptions | None = None) -> 
                              offset=offset, width=0.22 * step)
             _marks(ax, band, prefix=f"{d}: ", offset=offset)
         _errorbar(ax, *nominal, "kD" if discrete else "k.--", ms=4, label=nominal_text)
-        stem, title = _BOX_FIGURES.get(output, _BOX_FIGURES["mean"])
-        if stem == "figD3":
-            ax.axhline(0.8, color="k", lw=1, ls="-.", alpha=0.6, label="paper: $r$ ~ 0.8 (Fig. D.3)")
+        stem, title, reference = box_figure(output)  # Fig. 8 for the resonant level, Fig. D.3 for r
+        if reference is not None:
+            ax.axhline(reference[0], color="k", lw=1, ls="-.", alpha=0.6, label=reference[1])
         if discrete:
             ax.set_xticks(np.unique(band["level"]))
         ax.set_xlabel(LEVEL_LABEL)
@@ -386,53 +387,78 @@ def read_overview(folder: Path, options: PlotOptions | None = None) -> dict[str,
     return dict(data)
 
 
-def response_figures(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
-    """Fig. 5 (the frequency response at every level, a panel each) and Fig. 6 (resonant levels against the
-    excitation level, the paper's optimum marked), as the study's [response] figures ask, from sweeps.csv and
-    overview.csv."""
-    from sim.plots.figures import plot_overview, plot_sweeps
+@dataclass(frozen=True)
+class ResponseData:
+    """What a response study's figures are drawn from: its folder, study.json (`meta`), overview.csv for the
+    chosen levels (`read_overview`; empty for a series study), the plot options and the line of run settings every
+    title carries."""
 
-    folder = Path(folder)
-    options = options or PlotOptions()
+    folder: Path
+    meta: dict
+    overview: dict[str, list]
+    options: PlotOptions
+    runs: str
+
+
+def response_data(folder: Path, options: PlotOptions) -> ResponseData:
+    """What a response study's figures are drawn from (`ResponseData`): study.json, and for a study of one point its
+    overview.csv at the chosen levels (a series study's figure reads each value's own overview.csv)."""
     meta = _study(folder)
-    if "series_folders" in meta:
-        return _series_figure(folder, meta, options)
-    overview = read_overview(folder, options)
-    selected([float(r["level"]) for r in _rows(folder / "overview.csv")], options, folder)
     protocol = meta["study"]["protocol_resolved"]
     runs = f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold"
-    factor = _tip_mm_per_level(meta)
-    paths: list[Path] = []
-    if "fig5" in meta["study"]["response"]["figures"]:
-        by_level: dict[float, dict[str, list]] = defaultdict(lambda: defaultdict(list))
-        for r in _rows(folder / "sweeps.csv", options):
-            for key, value in r.items():
-                by_level[float(r["level"])][key].append(value if key == "regime" else float(value))
-        regime = dict(zip(overview["levels"], overview["regime"]))
-        if factor is not None:  # a_noabs* at each level (m): the panels' right-hand axes in mm
-            for level, data in by_level.items():
-                data["a_noabs"] = 1e-3 * factor * level
-        panels = [(data, f"$a_\\mathrm{{base}}/a_\\mathrm{{base}}^*$ = {level:g} (resonance: {regime.get(level, '?')})")
-                  for level, data in sorted(by_level.items())]
-        paths += options.paths(folder, "fig5")
-        for path in options.paths(folder, "fig5"):
-            plot_sweeps(panels, path, f"Frequency responses (cf. Fig. 5), nominal parameters, {runs}; bands: "
-                                      "range of the runs")
-    for figure in ("figD2", "figD3"):
-        if figure in meta["study"]["response"]["figures"]:
-            from sim.plots.figures import plot_scattering
+    if "series_folders" in meta:
+        return ResponseData(folder, meta, {}, options, f"{runs}, {protocol['integrator']}")
+    overview = read_overview(folder, options)
+    selected([float(r["level"]) for r in _rows(folder / "overview.csv")], options, folder)
+    return ResponseData(folder, meta, overview, options, runs)
 
-            what = "impacts per period (cf. Fig. D.2)" if figure == "figD2" else "restitution, APR levels (cf. Fig. D.3)"
-            runs_rows = _rows(folder / "runs.csv", options)
-            for path in options.paths(folder, figure):
-                plot_scattering(overview, runs_rows, path, f"{what} at the resonant $\\eta$, nominal parameters, {runs}",
-                                figure)
-            paths += options.paths(folder, figure)
-    if "fig6" in meta["study"]["response"]["figures"]:
-        paths += options.paths(folder, "fig6")
-        for path in options.paths(folder, "fig6"):
-            plot_overview(overview, path, f"Resonant level vs excitation level (cf. Fig. 6), nominal parameters, {runs}",
-                          paper_optimum=True, mm_per_level=factor)
+
+def frequency_responses(data: ResponseData, stem: str) -> list[Path]:
+    """Fig. 5: the frequency response at every level, a panel each, from sweeps.csv."""
+    from sim.plots.figures import plot_sweeps
+
+    by_level: dict[float, dict[str, list]] = defaultdict(lambda: defaultdict(list))
+    for r in _rows(data.folder / "sweeps.csv", data.options):
+        for key, value in r.items():
+            by_level[float(r["level"])][key].append(value if key == "regime" else float(value))
+    regime = dict(zip(data.overview["levels"], data.overview["regime"]))
+    factor = _tip_mm_per_level(data.meta)
+    if factor is not None:  # a_noabs* at each level (m): the panels' right-hand axes in mm
+        for level, values in by_level.items():
+            values["a_noabs"] = 1e-3 * factor * level
+    panels = [(values, f"$a_\\mathrm{{base}}/a_\\mathrm{{base}}^*$ = {level:g} (resonance: {regime.get(level, '?')})")
+              for level, values in sorted(by_level.items())]
+    paths = data.options.paths(data.folder, stem)
+    for path in paths:
+        plot_sweeps(panels, path, f"Frequency responses (cf. Fig. 5), nominal parameters, {data.runs}; bands: "
+                                  "range of the runs")
+    return paths
+
+
+def scattering_figure(measure: str, what: str):
+    """A drawer of Fig. D.2 (`measure` "impacts") or D.3 ("restitution") at the resonant eta from overview.csv
+    and runs.csv (`sim.plots.figures.plot_scattering`); `what` begins its title."""
+    def draw(data: ResponseData, stem: str) -> list[Path]:
+        from sim.plots.figures import plot_scattering
+
+        runs_rows = _rows(data.folder / "runs.csv", data.options)
+        paths = data.options.paths(data.folder, stem)
+        for path in paths:
+            plot_scattering(data.overview, runs_rows, path, f"{what} at the resonant $\\eta$, nominal parameters, "
+                                                            f"{data.runs}", measure)
+        return paths
+
+    return draw
+
+
+def resonant_levels(data: ResponseData, stem: str) -> list[Path]:
+    """Fig. 6: resonant levels against the excitation level, the paper's optimum marked, from overview.csv."""
+    from sim.plots.figures import plot_overview
+
+    paths = data.options.paths(data.folder, stem)
+    for path in paths:
+        plot_overview(data.overview, path, f"Resonant level vs excitation level (cf. Fig. 6), nominal parameters, "
+                                           f"{data.runs}", paper_optimum=True, mm_per_level=_tip_mm_per_level(data.meta))
     return paths
 
 
@@ -442,22 +468,22 @@ def series_overviews(folder: Path, options: PlotOptions | None = None) -> list[t
     return [(sub, read_overview(folder / sub, options)) for sub in meta["series_folders"]]
 
 
-def _series_figure(folder: Path, meta: dict, options: PlotOptions) -> list[Path]:
-    """Fig. 11: the resonant mean against the excitation level for each value of the series."""
-    from sim.plots.figures import plot_series
+def series_figure(caption: str, paper_line: tuple[float, str] | None = None):
+    """A drawer of a series study's figure (Fig. 11, C.1): the resonant mean against the excitation level for each
+    value of the series; `caption` ("cf. Fig. 11") and the paper's level to mark (`paper_line`) go on it."""
+    def draw(data: ResponseData, stem: str) -> list[Path]:
+        from sim.plots.figures import plot_series
 
-    protocol = meta["study"]["protocol_resolved"]
-    name = next(iter(meta["study"]["series"]))
-    figure = meta["study"]["response"]["figures"][0]
-    runs = (f"{meta['study']['repetitions']} runs, {protocol['wait']:g} s wait, {protocol['hold']:g} s hold, "
-            f"{protocol['integrator']}")
-    paper = SERIES_FIGURES.get(figure, ("", None))
-    paths = options.paths(folder, figure)
-    series = [(series_label(sub), data) for sub, data in series_overviews(folder, options)]
-    for path in paths:
-        plot_series(series, path, f"Resonant mean for each {name} ({paper[0]}), contact law "
-                    f"{meta['study']['contact_law']}, {runs}", paper[1], mm_per_level=_tip_mm_per_level(meta))
-    return paths
+        name = next(iter(data.meta["study"]["series"]))
+        paths = data.options.paths(data.folder, stem)
+        for path in paths:
+            plot_series([(series_label(sub), values) for sub, values in series_overviews(data.folder, data.options)],
+                        path, f"Resonant mean for each {name} ({caption}), contact law "
+                              f"{data.meta['study']['contact_law']}, {data.runs}", paper_line,
+                        mm_per_level=_tip_mm_per_level(data.meta))
+        return paths
+
+    return draw
 
 
 def series_label(sub: str) -> str:
@@ -469,14 +495,7 @@ def series_label(sub: str) -> str:
         return sub
 
 
-#: the paper's figure of a series study and what the paper says (a level marked on it)
-SERIES_FIGURES = {"fig11": ("cf. Fig. 11", (7.5, "paper: contact dissipation matters above 7.5")),
-                  "figC1": ("cf. Fig. C.1 and the low end of Fig. 6", None)}
-
-
-register("ies interval", _kind_is("interval"))(interval_figures)
 register("ies sobol", _kind_is("sobol"))(sobol_figure)
-register("response study (ies reproduce fig5, fig6, figD2, figD3)", _kind_is("response"))(response_figures)
 
 
 def _result_children(folder: Path) -> list[Path]:
@@ -491,7 +510,7 @@ def _result_children(folder: Path) -> list[Path]:
 REPRODUCE = "ies reproduce --out"
 
 
-@register(REPRODUCE, lambda folder: bool(_result_children(folder)))
+@register(REPRODUCE, lambda folder: not (folder / "study.json").is_file() and bool(_result_children(folder)))
 def redraw_children(folder: Path, options: PlotOptions) -> list[Path]:
     """Every result subfolder (fig5, fig6, fig7, fig8 of `ies reproduce`), each into its own folder (or into
     OUT/NAME with --out)."""

@@ -203,7 +203,8 @@ def band(design: Design, values: np.ndarray, noise: np.ndarray | None = None, *,
     violation = np.where(tested, violation, np.nan)
     lower = np.where(flagged, np.minimum(corner_lo, y.min(axis=0)), corner_lo)
     upper = np.where(flagged, np.maximum(corner_hi, y.max(axis=0)), corner_hi)
-    return Band(design.name, lower, upper, corner_lo, corner_hi, flagged, violation, tested, notes)
+    return Band(design=design.name, lower=lower, upper=upper, corner_lower=corner_lo, corner_upper=corner_hi,
+                flagged=flagged, violation=violation, tested=tested, notes=notes)
 
 
 def propagate(func: Callable[[Mapping[str, float]], float | np.ndarray], design: Design, *,

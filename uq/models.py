@@ -26,13 +26,59 @@ import inspect
 import math
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Protocol, runtime_checkable
 
 from sim.stepped_sine.measures import SCATTERING_MEASURES
 from uq.errors import StudyError
-from uq.space import Parameter, ParameterSpace, table2_space
+from uq.space import Parameter, ParameterSpace, parameter_of, table2_space
+
+if TYPE_CHECKING:
+    from sim.model.parameters import SystemSettings
+    from sim.model.system import Impactor, ModalModel
+    from sim.stepped_sine.protocol import SteppedSine, SweepResult
 
 _ROOT = Path(__file__).resolve().parent.parent
+
+
+@runtime_checkable
+class ResponseModel(Protocol):
+    """What a study evaluates (`make_model`): a picklable callable from (parameter values, excitation level,
+    repetition, seed) to named scalar outputs, with the aggregation of the runs of one (point, level).
+
+    The runner may also use optional hooks when a model has them: ``with_rig()``, ``warm_up()``,
+    ``resolved_protocol()``, ``describe()`` (`uq.execute`, `uq.runner`).
+    """
+
+    @property
+    def name(self) -> str:
+        """The study file's ``model`` key ("ies", "ishigami", "function")."""
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """The inputs the model reads from a point (names of the parameter space)."""
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        """Every output a run returns."""
+
+    @property
+    def banded_outputs(self) -> tuple[str, ...]:
+        """The outputs whose bands and indices a study computes."""
+
+    def default_space(self) -> ParameterSpace | None:
+        """The parameter space when the study lists none (None: the study must give every parameter)."""
+
+    def version(self) -> str:
+        """A hash of the code that computes the outputs (part of every cached task's key)."""
+
+    def check(self) -> None:
+        """Fail with one `StudyError` line before any task runs when the settings cannot work."""
+
+    def aggregate(self, records: list[Mapping[str, Any]]) -> Mapping[str, Any]:
+        """{output: (value, standard error, samples)} over the repetitions of one (point, level)."""
+
+    def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> Mapping[str, Any]:
+        """One run: {output: value} (and, for the simulator, its "trace")."""
 
 
 def _hash_files(paths: list[Path]) -> str:
@@ -70,34 +116,40 @@ class IESModel:
     name: str = "ies"
     modal_file: str | None = None
     variant: Mapping[str, float] = field(default_factory=dict)
-    rig: Any = field(default=None, compare=False, repr=False)
+    rig: "ModalModel | None" = field(default=None, compare=False, repr=False)
     banded_outputs: tuple[str, ...] = ("mean", "max")
     contact_law: str = "hertz"
 
-    parameters = ("D", "g", "k_H")
-    #: parameters a study may add to Table 2's (they enter a task's point, and so its key, only when listed):
-    #: r_cont,diss of the damped contact law (Eq. 10; listing it implies contact_law = "hertz-damped"), and the
-    #: friction coefficient mu and tangential stiffness k_t (N/m) of dry friction at the floor (Appendix C; ode3)
-    #: and the sphere's mass m_a (kg; `ies design` varies the sphere)
-    optional_parameters = ("r_cont", "friction", "k_t", "m_a")
     #: the resonant levels, the regime (1 = APR) and the scattering measures of `sim.stepped_sine.measures` at the resonant
     #: mean's eta (Sect. 5.5, Appendix D)
     outputs = ("mean", "max", "apr", *SCATTERING_MEASURES)
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """Table 2's parameters (D, g, k_H): the table2 rows of `sim.model.parameters.PARAMETERS`."""
+        from sim.model.parameters import table2_parameters
+
+        return tuple(row.name for row in table2_parameters())
+
+    @property
+    def optional_parameters(self) -> tuple[str, ...]:
+        """Parameters a study may add to Table 2's, the other rows of `PARAMETERS` (they enter a task's point, and so
+        its key, only when listed): r_cont,diss of the damped contact law (Eq. 10; listing it implies contact_law =
+        "hertz-damped"), the friction coefficient mu and tangential stiffness k_t (N/m) of dry friction at the floor
+        (Appendix C; ode3), and any row added to the table."""
+        from sim.model.parameters import optional_parameters
+
+        return tuple(row.name for row in optional_parameters())
 
     def default_space(self) -> ParameterSpace:
         return table2_space()
 
     def optional_parameter(self, name: str) -> Parameter:
-        """The default of an optional parameter (`optional_parameters`), before the study's table fills it in."""
-        from sim.model.contact_law import DEFAULT_R_CONT
-        from sim.model.friction import K_T_PAPER, MU_PAPER
-        from sim.model.parameters import SPHERE_MASS
+        """The default of an optional parameter (`optional_parameters`), before the study's table fills it in: its row
+        of `PARAMETERS` held at its nominal value."""
+        from sim.model.parameters import PARAMETERS
 
-        nominal, unit, label = {"m_a": (SPHERE_MASS, "kg", "sphere mass m_a (Table 1)"),
-                                "r_cont": (DEFAULT_R_CONT, "-", "r_cont,diss of the damped contact law (Eq. 10)"),
-                                "friction": (MU_PAPER, "-", "friction coefficient mu at the floor (App. C)"),
-                                "k_t": (K_T_PAPER, "N/m", "tangential stiffness k_t at the floor (App. C)")}[name]
-        return Parameter(name, nominal, nominal, nominal, unit, label, positive=name != "friction")  # mu = 0: off
+        return parameter_of(PARAMETERS[name])
 
     def version(self) -> str:
         return _source_version("sim", "uq/models.py")
@@ -106,7 +158,7 @@ class IESModel:
         """The protocol with every default filled in (for the study metadata)."""
         return _protocol_dict(self._stepped_sine())
 
-    def _stepped_sine(self):
+    def _stepped_sine(self) -> "SteppedSine":
         from sim.stepped_sine.protocol import SteppedSine
 
         from sim.common.errors import SimulationInputError
@@ -131,23 +183,19 @@ class IESModel:
         self.check_physics({})
 
     def check_physics(self, params: Mapping[str, float]) -> None:
-        """The model and protocol can simulate a point with these optional parameters (`optional_parameters`): Eq. 10
-        needs the model's beam mass, friction its phi_floor and the ode3 integrator; one line otherwise."""
+        """The model and protocol can simulate a point with these optional parameters (`optional_parameters`): the
+        checks of `sim.model.system.build_system` (Eq. 10 needs the model's beam mass, friction its phi_floor and the
+        ode3 integrator), one line otherwise."""
         from sim.common.errors import SimulationInputError
-        from sim.model.system import system_arrays
+        from sim.model.system import build_system
 
         point = {"g": 1e-3, "k_H": 1e9, **params}
-        if self.contact_law == "hertz" and point.get("friction", 0.0) == 0.0:
-            return
         try:
-            system_arrays(self._rig(), self._impactor(point))
+            build_system(self._rig(), self._settings(point), integrator=self._stepped_sine().integrator)
         except SimulationInputError as exc:
             raise StudyError(f"[study] {exc}") from None
-        if point.get("friction", 0.0) > 0.0 and self._stepped_sine().integrator != "ode3":
-            raise StudyError("[parameters.friction] dry friction (Appendix C) is in the ode3 integrator only; set "
-                             "[excitation] integrator = \"ode3\"")
 
-    def _rig(self):
+    def _rig(self) -> "ModalModel":
         from sim.common.errors import SimulationInputError
         from sim.hosts.modal_file import load_modal_model
         from sim.hosts.variants import with_higher_mode_damping
@@ -163,25 +211,24 @@ class IESModel:
                 raise StudyError(f"[variant] {exc}") from None
         return rig
 
-    def _impactor(self, params: Mapping[str, float]):
-        """The sphere of Eqs. 3-6 with this run's g and k_H, its mass scaled by [variant] sphere_mass_factor, the
-        study's contact law (Eq. 10 with this run's r_cont when damped) and this run's friction (Appendix C)."""
-        from sim.model.contact_law import DEFAULT_R_CONT, ContactLaw
-        from sim.model.friction import K_T_PAPER
-        from sim.model.system import SPHERE_MASS, Impactor
+    def _settings(self, params: Mapping[str, float]) -> "SystemSettings":
+        """What this run's parameters feed (`sim.model.parameters.system_settings`): the sphere of Eqs. 3-6 with its
+        mass scaled by [variant] sphere_mass_factor and the study's contact law, then every parameter of the point."""
+        from sim.model.parameters import SPHERE_MASS, SystemSettings, system_settings
 
-        mass = params.get("m_a", SPHERE_MASS) * self.variant.get("sphere_mass_factor", 1.0)
-        law = (ContactLaw(self.contact_law, params.get("r_cont", DEFAULT_R_CONT)) if self.contact_law != "hertz"
-               else ContactLaw())
-        return Impactor(mass=mass, clearance=params["g"], k_H=params["k_H"], contact_law=law,
-                        friction=params.get("friction", 0.0), k_t=params.get("k_t", K_T_PAPER))
+        base = SystemSettings(mass=SPHERE_MASS * self.variant.get("sphere_mass_factor", 1.0),
+                              contact_law=self.contact_law)
+        return system_settings(params, base)
 
-    def simulated_system(self, params: Mapping[str, float]) -> tuple[Any, Any]:
-        """(modal model with this point's D, impactor) of a point of the study's space."""
+    def simulated_system(self, params: Mapping[str, float]) -> tuple["ModalModel", "Impactor"]:
+        """(modal model with this point's D, impactor) of a point of the study's space
+        (`sim.model.system.build_system`, the builder `ies sweep` uses too)."""
+        from sim.model.system import build_system
+
         rig = self.rig if self.rig is not None else self._rig()
-        return rig.with_damping(params["D"]), self._impactor(params)
+        return build_system(rig, self._settings(params))
 
-    def stepped_sine(self) -> Any:
+    def stepped_sine(self) -> "SteppedSine":
         """The study's stepped-sine protocol (`sim.stepped_sine.protocol.SteppedSine`)."""
         return self._stepped_sine()
 
@@ -221,7 +268,7 @@ class IESModel:
         return {"mean": own.resonant_mean, "max": own.resonant_max, "apr": 1.0 if own.regime == "APR" else 0.0,
                 **{name: float(own.scattering[name][at][0]) for name in SCATTERING_MEASURES}, "trace": trace}
 
-    def sweep_result(self, records: list[Mapping[str, Any]]) -> Any:
+    def sweep_result(self, records: list[Mapping[str, Any]]) -> "SweepResult | None":
         """The frequency response (`sim.stepped_sine.protocol.SweepResult`, Fig. 5) of the runs of one (point, level), rebuilt
         from their traces and aggregated exactly as `ies sweep` does (`sim.stepped_sine.protocol.aggregate_runs`); None
         without runs."""
@@ -264,7 +311,7 @@ class IESModel:
 _TRACE = ("eta", "eta_actual", "leg", "mean", "max", "min", "std", "impacts_per_period", "hold_periods")
 
 
-def _protocol_dict(protocol: Any) -> dict:
+def _protocol_dict(protocol: "SteppedSine") -> dict:
     out = asdict(protocol) if hasattr(protocol, "__dataclass_fields__") else dict(vars(protocol))
     return {k: (list(v) if isinstance(v, tuple) else v) for k, v in out.items()}
 
@@ -363,7 +410,7 @@ class FunctionModel:
 
 def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, parameters: tuple[str, ...] = (),
                modal_model: str | Path | None = None, variant: Mapping[str, float] | None = None,
-               outputs: tuple[str, ...] = (), contact_law: str = "hertz") -> Any:
+               outputs: tuple[str, ...] = (), contact_law: str = "hertz") -> ResponseModel:
     """The model named by a study's ``model`` key ("ies", "ishigami" or "module:function"); modal_model: a
     modal-model file replacing the built-in rig of "ies"; variant: the [variant] table of "ies"; outputs: the
     outputs of "ies" whose bands and indices the study computes (default: the resonant mean and max);

@@ -53,6 +53,7 @@ FILES = {
     "overview.csv": "the resonant levels against the excitation level (Fig. 6's data)",
     "trace.csv": "a time history at 51.2 kHz (tip, walls, sphere, contact forces)",
     "trace.json": "the time history's settings, per-period amplitudes and impacts",
+    "results.nc": "every number of the CSV tables as one xarray Dataset with units (`uq.results.open_study`)",
     "fig5": "Fig. 5: frequency responses (mean and max amplitude per eta with the runs' range) of the nominal system",
     "fig6": "Fig. 6: resonant mean and max against the excitation level, regimes and the optimum (the paper's marked)",
     "fig7": "Fig. 7: the resonant mean's band from D, g and k_H varied one at a time",

@@ -103,8 +103,9 @@ def sobol_indices(space: ParameterSpace, X: np.ndarray, Y: np.ndarray, *, num_re
     finite, notes, fatal = check_runs(Y, X, problem["names"])
     nan = np.full(k, np.nan)
     if fatal:
-        return SobolResult(problem["names"], nan, nan, nan, nan, np.nan, np.nan, np.nan,
-                           int((~finite).sum()), confidence, fatal, notes)
+        return SobolResult(names=problem["names"], S1=nan, S1_conf=nan, ST=nan, ST_conf=nan, variance=np.nan,
+                           noise_variance=np.nan, noise_share=np.nan, failed_runs=int((~finite).sum()),
+                           confidence=confidence, message=fatal, notes=notes)
     counts = finite.sum(axis=1)
     clean = np.where(finite, Y, 0.0)
     ybar = clean.sum(axis=1) / counts
@@ -125,14 +126,16 @@ def sobol_indices(space: ParameterSpace, X: np.ndarray, Y: np.ndarray, *, num_re
         notes.append("no noise estimate (one repetition per point): how much of the variance is repetition noise is "
                      "unknown; run repetitions >= 2")
     if variance <= 0:
-        return SobolResult(problem["names"], nan, nan, nan, nan, variance, noise_variance, np.nan,
-                           int((~finite).sum()), confidence, "the output does not vary over the sample", notes)
+        return SobolResult(names=problem["names"], S1=nan, S1_conf=nan, ST=nan, ST_conf=nan, variance=variance,
+                           noise_variance=noise_variance, noise_share=np.nan, failed_runs=int((~finite).sum()),
+                           confidence=confidence, message="the output does not vary over the sample", notes=notes)
     if noise_variance >= 0.5 * variance:
         notes.append(f"repetition noise makes up {noise_variance / variance:.0%} of the variance (a share >= 100 % "
                      "means no parameter effect is resolved above the noise): the indices mostly describe noise; "
                      "raise the repetitions or the hold time")
     res = sobol_analyzer.analyze(problem, ybar, calc_second_order=False, num_resamples=num_resamples,
                                  conf_level=confidence, print_to_console=False, seed=seed)
-    return SobolResult(problem["names"], np.asarray(res["S1"]), np.asarray(res["S1_conf"]), np.asarray(res["ST"]),
-                       np.asarray(res["ST_conf"]), variance, noise_variance, noise_variance / variance,
-                       int((~finite).sum()), confidence, "", notes)
+    return SobolResult(names=problem["names"], S1=np.asarray(res["S1"]), S1_conf=np.asarray(res["S1_conf"]),
+                       ST=np.asarray(res["ST"]), ST_conf=np.asarray(res["ST_conf"]), variance=variance,
+                       noise_variance=noise_variance, noise_share=noise_variance / variance,
+                       failed_runs=int((~finite).sum()), confidence=confidence, message="", notes=notes)

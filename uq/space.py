@@ -20,22 +20,15 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from sim.common.errors import SimulationInputError
-from sim.model.system import CLEARANCE_NOMINAL, D1_NOMINAL, K_H_NOMINAL
-from sim.common.units import CLEARANCE, K_H, K_T, implausible, parse_quantity
+from sim.common.units import implausible, parse_quantity
+from sim.model.parameters import K_H_NOMINAL, N_PER_MM15, PARAMETERS, UncertainParameter, table2_parameters  # noqa: F401
 from uq.errors import StudyError
 
-# Table 2 of the seed paper (SI units); the nominal values are the simulator's (sim.model.system).
-# k_H in N/m^1.5: 1 N/mm^1.5 = 1e3^1.5 N/m^1.5.
-N_PER_MM15 = 1e3**1.5
+# Table 2 of the seed paper (SI units) is the table2 rows of `sim.model.parameters.PARAMETERS`, the one table of the
+# parameters; k_H in N/m^1.5: 1 N/mm^1.5 = 1e3^1.5 N/m^1.5.
 K_H_STAR = K_H_NOMINAL  # Eq. 8, nominal sphere on a flat wall (282e3 N/mm^1.5)
 K_H_BEST_ESTIMATE_FACTOR = 1.25  # Sect. 4.1
 K_H_BEST_ESTIMATE = K_H_BEST_ESTIMATE_FACTOR * K_H_STAR
-TABLE2 = {
-    "D": dict(nominal=D1_NOMINAL, min=0.00075, max=0.00090, unit="-", label="modal damping ratio D_1"),
-    "g": dict(nominal=CLEARANCE_NOMINAL, min=CLEARANCE_NOMINAL, max=0.612e-3, unit="m", label="clearance g"),
-    "k_H": dict(nominal=K_H_STAR, min=K_H_STAR, max=428e3 * N_PER_MM15, unit="N/m^1.5",
-                label="Hertzian spring constant k_H"),
-}
 
 
 def column_name(name: str, unit: str) -> str:
@@ -179,17 +172,22 @@ class ParameterSpace:
         return out
 
 
+def parameter_of(row: UncertainParameter) -> Parameter:
+    """The `Parameter` of a row of `sim.model.parameters.PARAMETERS`: its nominal value, interval, unit, label and
+    limits."""
+    low, high = row.interval
+    return Parameter(row.name, row.nominal, low, high, row.unit, row.label, upper_limit=row.upper_limit,
+                     positive=row.positive)
+
+
 def table2_space(k_H_max: float | None = None) -> ParameterSpace:
-    """The default IES space of Table 2 (D, g, k_H), optionally with a calibrated upper bound for k_H."""
-    specs = {name: dict(spec) for name, spec in TABLE2.items()}
-    if k_H_max is not None:
-        specs["k_H"]["max"] = float(k_H_max)
-    params = tuple(
-        Parameter(name, spec["nominal"], spec["min"], spec["max"], spec["unit"], spec["label"],
-                  upper_limit=1.0 if name == "D" else np.inf)
-        for name, spec in specs.items()
-    )
-    return ParameterSpace(params, {"k_H_best_estimate": K_H_BEST_ESTIMATE})
+    """The default IES space of Table 2 (D, g, k_H: the table2 rows of `PARAMETERS`), optionally with a calibrated
+    upper bound for k_H."""
+    params = tuple(parameter_of(row) for row in table2_parameters())
+    space = ParameterSpace(params, {"k_H_best_estimate": K_H_BEST_ESTIMATE})
+    if k_H_max is None:
+        return space
+    return ParameterSpace(tuple(replace(p, max=float(k_H_max)) if p.name == "k_H" else p for p in params), space.extras)
 
 
 _RATIO = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*\*?\s*k_H\*\s*$")
@@ -215,7 +213,7 @@ def resolve_k_H(value: object, *, base_dir: Path | None = None) -> float:
                 path = base_dir / path
             return calibrated_k_H(path)
         try:
-            return parse_quantity(value, K_H)
+            return parse_quantity(value, PARAMETERS["k_H"].quantity)
         except SimulationInputError:
             pass
     raise StudyError(f"cannot read k_H = {value!r}: give N/m^1.5, a value with its unit like \"282e3 N/mm^1.5\", "
@@ -227,18 +225,20 @@ def resolve_value(name: str, value: object, *, base_dir: Path | None = None) -> 
     or a string with its unit ("0.58 mm", `sim.common.units`); other parameters unchanged (checked by `Parameter`)."""
     if name == "k_H":
         return resolve_k_H(value, base_dir=base_dir)
-    if name in ("g", "k_t") and isinstance(value, str):
+    row = PARAMETERS.get(name)
+    if row is not None and row.quantity is not None and isinstance(value, str):
         try:
-            return parse_quantity(value, CLEARANCE if name == "g" else K_T)
+            return parse_quantity(value, row.quantity)
         except SimulationInputError as exc:
             raise StudyError(str(exc)) from None
     return value
 
 
 def plausibility_warning(name: str, value: float) -> str | None:
-    """`sim.common.units.implausible` for g and k_H (a clearance above 10 mm, a k_H below 1e6 N/m^1.5, ...)."""
-    quantity = {"g": CLEARANCE, "k_H": K_H}.get(name)
-    return None if quantity is None else implausible(float(value), quantity)
+    """`sim.common.units.implausible` for the parameters of `PARAMETERS` with a unit parser (a clearance above 10 mm,
+    a k_H below 1e6 N/m^1.5, ...)."""
+    row = PARAMETERS.get(name)
+    return None if row is None or row.quantity is None else implausible(float(value), row.quantity)
 
 
 def calibrated_k_H(source: str | Path | Mapping) -> float:

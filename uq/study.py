@@ -82,13 +82,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+from sim.model.parameters import PARAMETERS
 from uq.errors import StudyError
-from uq.models import make_model
+from uq.models import ResponseModel, make_model
 from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_H, resolve_value
 
 KINDS = ("interval", "sobol", "response")
-#: the figures a response study draws (Figs. 5 and 6 of the seed paper)
-RESPONSE_FIGURES = ("fig5", "fig6", "figD2", "figD3", "fig11", "figC1")
 DESIGNS = ("individual", "joint", "residual")
 _KEYS = {
     "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output", "outputs", "contact_law"},
@@ -103,9 +102,17 @@ _KEYS = {
 _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
 
 
-@dataclass(frozen=True)
+def _response_figure_names() -> tuple[str, ...]:
+    """The figures a response study may draw: the response rows of `uq.paper_figures.PAPER_FIGURES` (imported here:
+    it brings the figure code)."""
+    from uq.paper_figures import response_figure_names
+
+    return response_figure_names()
+
+
+@dataclass(frozen=True, kw_only=True)
 class Study:
-    """A resolved, validated study (see the module docstring for the file layout)."""
+    """A resolved, validated study (see the module docstring for the file layout); built with named fields."""
 
     name: str
     kind: str
@@ -125,7 +132,7 @@ class Study:
     confidence: float = 0.95
     source: str = ""
     modal_model: Path | None = None
-    figures: tuple[str, ...] = RESPONSE_FIGURES
+    figures: tuple[str, ...] = field(default_factory=lambda: _response_figure_names())
     variant: Mapping[str, float] = field(default_factory=dict)
     outputs: tuple[str, ...] = ()
     contact_law: str = "hertz"
@@ -135,7 +142,8 @@ class Study:
     surrogate_degree: int = 2
     max_misfit: float = 0.1
 
-    def make_model(self) -> Any:
+    def make_model(self) -> ResponseModel:
+        """The study's response model (`uq.models.make_model`)."""
         return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
                           modal_model=self.modal_model, variant=self.variant, outputs=self.outputs,
                           contact_law=self.contact_law)
@@ -169,6 +177,29 @@ class Study:
             space = ParameterSpace(params, self.space.extras)
             out.append((f"{name}={value:g}", replace(self, space=space, series=None, name=f"{self.name} {name}={value:g}")))
         return out
+
+
+def with_calibration(study: Study, k_H_cal: float) -> Study:
+    """The study with k_H's upper bound at a calibrated k_H (N/m^1.5; `ies calibrate`), as the paper does with its BEM
+    result 1.52 k_H* (Sect. 4.1): the best estimate stays (1.25 k_H* by default) unless the calibration falls below
+    it, then it is the midpoint of k_H's lower bound and the calibrated value. A calibrated k_H below k_H* (Eq. 8)
+    is refused with one line: a crater stiffens the contact."""
+    from dataclasses import replace
+
+    from uq.space import K_H_BEST_ESTIMATE, K_H_STAR
+
+    if k_H_cal < K_H_STAR:
+        raise StudyError(f"the calibrated k_H = {k_H_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; a crater should "
+                         "stiffen the contact: check the calibration or use --no-calibration")
+    space = study.space
+    k = space["k_H"]
+    best = space.extras.get("k_H_best_estimate", K_H_BEST_ESTIMATE)
+    if best > k_H_cal:
+        best = 0.5 * (k.min + k_H_cal)
+    params = tuple(replace(p, max=max(k_H_cal, p.min)) if p.name == "k_H" else p for p in space.parameters)
+    new_space = ParameterSpace(params, {**space.extras, "k_H_best_estimate": best, "k_H_calibrated": k_H_cal})
+    fix = {**study.fix, "k_H": best} if "k_H" in study.fix else dict(study.fix)
+    return replace(study, space=new_space, fix=fix)
 
 
 def load_study(path: str | Path) -> Study:
@@ -276,9 +307,10 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
     if kind == "sobol" and not space.varied:
         raise StudyError("no parameter is varied; give at least one [parameters.NAME] with min < max")
     method, points, degree, max_misfit = _parse_surrogate(sb, kind, space)
-    figures = data.get("response", {}).get("figures", list(RESPONSE_FIGURES))
-    if not isinstance(figures, list) or not figures or any(f not in RESPONSE_FIGURES for f in figures):
-        raise StudyError(f"[response] figures must be a list from {', '.join(RESPONSE_FIGURES)}, got {figures!r}")
+    known = _response_figure_names()
+    figures = data.get("response", {}).get("figures", list(known))
+    if not isinstance(figures, list) or not figures or any(f not in known for f in figures):
+        raise StudyError(f"[response] figures must be a list from {', '.join(known)}, got {figures!r}")
     if kind == "response" and model_spec != "ies":
         raise StudyError("a response study runs the simulator: model = \"ies\"")
 
@@ -287,9 +319,12 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError(f"[study] outputs must be a list of distinct output names, e.g. [\"mean\", \"restitution\"], got {outputs!r}")
     contact_law = _parse_contact_law(head, space)
     series = _parse_series(data.get("response", {}).get("series"), kind, space)
-    study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
-                  sobol_n, bootstrap, confidence, source, modal_model, tuple(figures), variant, tuple(outputs),
-                  contact_law, series, method, points, degree, max_misfit)
+    study = Study(name=name, kind=kind, model=model_spec, space=space, levels=levels, repetitions=reps, seed=seed,
+                  output=output, protocol=protocol, designs=designs, interior=interior, z=z, fix=fix,
+                  sobol_n=sobol_n, bootstrap=bootstrap, confidence=confidence, source=source,
+                  modal_model=modal_model, figures=tuple(figures), variant=variant, outputs=tuple(outputs),
+                  contact_law=contact_law, series=series, sobol_method=method,
+                  surrogate_points=points, surrogate_degree=degree, max_misfit=max_misfit)
     for _, one in study.series_studies():
         _parse_contact_law({"contact_law": contact_law}, one.space)  # every value in range
     model = study.make_model()  # unknown model -> one line now
@@ -395,6 +430,11 @@ def _parse_contact_law(head: Mapping[str, Any], space: ParameterSpace) -> str:
 
 
 def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir: Path, source: str) -> ParameterSpace:
+    """The parameter space of [parameters.KEY] tables; for the simulator KEY is a row's study key in
+    `sim.model.parameters.PARAMETERS` (its name in the space, CSV columns and messages is the row's name)."""
+    if table is not None and model_spec == "ies":
+        by_key = {row.study_key: name for name, row in PARAMETERS.items()}
+        table = {by_key.get(key, key): spec for key, spec in table.items()}
     model = make_model(model_spec, parameters=tuple(table or {}))
     default = model.default_space()
     if default is None:  # a user's function: every parameter must be given in full
@@ -470,7 +510,7 @@ def _parse_fix(fix: Any, space: ParameterSpace, base_dir: Path, source: str) -> 
             if f"{pname}_best_estimate" not in space.extras:
                 raise StudyError(f"[interval] fix: '{pname}' has no best estimate; give a number")
             value = space.extras[f"{pname}_best_estimate"]
-        elif pname in ("k_H", "g"):
+        elif pname in PARAMETERS and PARAMETERS[pname].quantity is not None:  # k_H, g, k_t: also with a unit
             value = resolve_value(pname, raw, base_dir=base_dir)
             _warn_implausible(source, f"[interval] fix.{pname}", pname, value)
         else:

@@ -168,8 +168,8 @@ def pce_indices(space: ParameterSpace, X: np.ndarray, y: np.ndarray, *, degree: 
     bad = ~np.isfinite(y)
 
     def failed(message: str, variance: float = np.nan, noise_variance: float = np.nan) -> PCEResult:
-        return PCEResult(names, nan, nan, nan, nan, variance, noise_variance, np.nan, int(bad.sum()), confidence,
-                         message, [], degree=degree, points=y.size)
+        return PCEResult(names, nan, nan, nan, nan, variance, noise_variance, np.nan, failed_runs=int(bad.sum()),
+                         confidence=confidence, message=message, notes=[], degree=degree, points=y.size)
 
     if bad.any():
         return failed(f"{int(bad.sum())} design point(s) have no finite run; the surrogate needs every point "
@@ -206,6 +206,7 @@ def pce_indices(space: ParameterSpace, X: np.ndarray, y: np.ndarray, *, degree: 
     if share >= 0.5:
         notes.append(f"repetition noise makes up {share:.0%} of the variance: the indices mostly describe noise; "
                      "raise the repetitions or the hold time")
-    return PCEResult(names, S1, S1_conf, ST, ST_conf, variance, noise_variance, share, 0, confidence, "", notes,
+    return PCEResult(names, S1, S1_conf, ST, ST_conf, variance, noise_variance, share, failed_runs=0,
+                     confidence=confidence, message="", notes=notes,
                      degree=degree, terms=terms, points=y.size, cv_error=cv_error, noise_floor=floor,
                      regimes=distinct, smooth=not rough, rough="; ".join(rough))

@@ -152,9 +152,10 @@ def record_trace(model: ModalModel, impactor: Impactor | None, level: float, pro
     states = np.empty((int(periods) * M + 1, y.size))
     ledger = Ledger()
     amplitudes, impacts = run_step(y, int(periods), Omega, a_base, sys, states, ledger=ledger)
-    return Trace(simulated_signal(states, M, Omega, a_base, sys), states,
-                 simulated_contacts(states, M, Omega, a_base, sys), M, M * Omega / (2.0 * math.pi), amplitudes,
-                 impacts, level, a_base, a_noabs, eta, eta_actual, Omega, ledger)
+    return Trace(signal=simulated_signal(states, M, Omega, a_base, sys), states=states,
+                 contacts=simulated_contacts(states, M, Omega, a_base, sys), samples_per_period=M,
+                 fs=M * Omega / (2.0 * math.pi), amplitudes=amplitudes, impacts=impacts, level=level, a_base=a_base,
+                 a_noabs=a_noabs, eta=eta, eta_actual=eta_actual, Omega=Omega, ledger=ledger)
 
 
 def trace_rows(trace: Trace) -> np.ndarray:

@@ -339,7 +339,7 @@ class CalculixResult:
 
 
 def calculix_modal_model(frd: str | os.PathLike, inp: str | os.PathLike, wall_left: str, wall_right: str,
-                         tip: str, dat: str | os.PathLike | None = None, units: str = "m-kg-s", n_modes: int = 9,
+                         tip: str, *, dat: str | os.PathLike | None = None, units: str = "m-kg-s", n_modes: int = 9,
                          modes: Sequence[int] | None = None, floor: str | None = None,
                          beam_mass: float | None = None) -> CalculixResult:
     """Modal model (Sect. 3.1, Eq. 7) from a CalculiX *FREQUENCY job: eigenvectors from `frd`, node sets from

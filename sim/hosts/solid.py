@@ -714,7 +714,7 @@ def _convergence(model: ModalModel, coarser: ModalModel, size: float, coarse_siz
 
 
 def solid_rig_model(mesh: str | float = "coarse", geometry: SolidGeometry = SolidGeometry(),
-                    material: SolidMaterial = SolidMaterial(), element: str = "hex20", n_modes: int = 9,
+                    material: SolidMaterial = SolidMaterial(), *, element: str = "hex20", n_modes: int = 9,
                     patch_radius: float = 0.0, wall_points: tuple[Sequence[float], Sequence[float]] | None = None,
                     convergence: bool = True, symmetry: str = "full") -> SolidResult:
     """The rig's modal model from the 3D solid model (Sect. 3.1, Eq. 7; `ies modes --solid`): mesh level "coarse",

@@ -670,7 +670,7 @@ def _advance(y, run):
 # Python entry point
 # ----------------------------------------------------------------------------------------------------------
 def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float, h_max: float,
-             h_fixed: float = 0.0, samples: int = 1, book: bool = True) -> tuple[Constants, Grid]:
+             h_fixed: float = 0.0, samples: int = 1, *, book: bool = True) -> tuple[Constants, Grid]:
     """Constants and grid of the kernels for one excitation (see the module docstring for the symbols); the
     state is recorded at `samples` equally spaced instants per period; `book`: keep the contact work of the
     energy bookkeeping, the impact log and the ledger's rows (else the ledger is not written)."""

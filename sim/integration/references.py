@@ -21,7 +21,7 @@ from sim.integration.energy import energy_parts
 from sim.model.system import Impactor, ModalModel, SystemArrays, system_arrays
 
 
-def reference_run(y0: np.ndarray, t_end: float, Omega: float, a_base: float, sys: SystemArrays, rtol: float = 1e-12,
+def reference_run(y0: np.ndarray, t_end: float, Omega: float, a_base: float, sys: SystemArrays, *, rtol: float = 1e-12,
                   atol_scale: float = 1e-16, pieces: list | None = None,
                   t0: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Eqs. 3-7 with the Hertz law at both walls under q_base = a_base cos(Omega t) (SI units), by DOP853 from

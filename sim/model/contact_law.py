@@ -29,10 +29,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from sim.common.errors import SimulationInputError
+from sim.model.parameters import DEFAULT_R_CONT  # noqa: F401 (the paper's value, re-exported)
 
 CONTACT_LAWS = ("hertz", "hertz-damped")
-#: r_cont,diss of the damped law when none is given: the paper's value for its dissipation partition (Sect. 5.5)
-DEFAULT_R_CONT = 0.99
 
 
 def xi_of_r_cont(r_cont: ArrayLike) -> np.ndarray:

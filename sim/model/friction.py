@@ -24,11 +24,9 @@ import numpy as np
 from scipy.optimize import brentq
 
 from sim.common.errors import SimulationInputError
-from sim.model.parameters import SPHERE_MASS
+from sim.model.parameters import K_T_PAPER, MU_PAPER, SPHERE_MASS  # noqa: F401 (re-exported)
 
 GRAVITY = 9.81  # m/s^2
-K_T_PAPER = 22e6  # N/m, Appendix C ("22 kN/mm")
-MU_PAPER = 0.07  # Appendix C
 
 
 @dataclass(frozen=True)

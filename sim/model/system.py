@@ -45,7 +45,8 @@ import numpy as np
 
 from sim.model.contact_law import ContactLaw
 from sim.common.errors import SimulationInputError
-from sim.model.parameters import CLEARANCE_NOMINAL, D1_NOMINAL, K_H_NOMINAL, SPHERE_MASS  # noqa: F401 (re-exported)
+from sim.model.parameters import (CLEARANCE_NOMINAL, D1_NOMINAL, K_H_NOMINAL, K_T_PAPER,  # noqa: F401 (re-exported)
+                                 SPHERE_MASS, SystemSettings)
 
 
 
@@ -136,7 +137,7 @@ class Impactor:
     k_H: float = K_H_NOMINAL
     contact_law: ContactLaw = ContactLaw()
     friction: float = 0.0  # Coulomb coefficient mu of the floor contact (Appendix C); 0: no friction
-    k_t: float = 22e6  # N/m, tangential stiffness of the floor contact (Appendix C: 22 kN/mm)
+    k_t: float = K_T_PAPER  # N/m, tangential stiffness of the floor contact (Appendix C: 22 kN/mm)
 
     def __post_init__(self) -> None:
         for name, label in (("mass", "sphere mass"), ("clearance", "clearance g"), ("k_H", "k_H"), ("k_t", "k_t (N/m)")):
@@ -214,10 +215,12 @@ def damping_factor(model: ModalModel, impactor: Impactor) -> float:
 def system_arrays(model: ModalModel, impactor: Impactor) -> SystemArrays:
     """Pack a modal model and an impactor for the kernels (contiguous float64 copies)."""
     as_f8 = lambda a: np.ascontiguousarray(a, dtype=np.float64).copy()  # noqa: E731
+    phi_f, k_t, slip_force, slider = friction_arrays(model, impactor)
     return SystemArrays(
-        as_f8(model.omega), as_f8(model.damping_ratios), as_f8(model.phi_wall_left), as_f8(model.phi_wall_right),
-        as_f8(model.phi_tip), as_f8(model.participation), float(impactor.mass), float(impactor.k_H),
-        float(impactor.clearance), damping_factor(model, impactor), *friction_arrays(model, impactor),
+        omega=as_f8(model.omega), D=as_f8(model.damping_ratios), phi_l=as_f8(model.phi_wall_left),
+        phi_r=as_f8(model.phi_wall_right), phi_tip=as_f8(model.phi_tip), gamma=as_f8(model.participation),
+        m_a=float(impactor.mass), k_H=float(impactor.k_H), g=float(impactor.clearance),
+        c_damp=damping_factor(model, impactor), phi_f=phi_f, k_t=k_t, slip_force=slip_force, slider=slider,
     )
 
 
@@ -231,6 +234,36 @@ def friction_arrays(model: ModalModel, impactor: Impactor) -> tuple[np.ndarray, 
         return np.zeros(n), float(impactor.k_t), 0.0, np.zeros(2)
     phi_f = np.ascontiguousarray(floor_values(model, model.source), dtype=np.float64).copy()
     return phi_f, float(impactor.k_t), float(impactor.friction * impactor.mass * GRAVITY), np.zeros(2)
+
+
+def build_impactor(settings: SystemSettings) -> Impactor:
+    """The sphere of Eqs. 3-6 from `sim.model.parameters.SystemSettings` (what the parameters of `PARAMETERS` feed):
+    mass (kg), g (m), k_H (N/m^1.5), the contact law (Eq. 4, or Eq. 10 with r_cont) and friction (Appendix C).
+    Every value is checked here, one line each (`Impactor`, `ContactLaw`)."""
+    law = ContactLaw(settings.law_name, settings.law_r_cont)
+    return Impactor(mass=settings.mass, clearance=settings.clearance, k_H=settings.k_H, contact_law=law,
+                    friction=settings.friction, k_t=settings.k_t)
+
+
+def build_system(model: ModalModel, settings: SystemSettings, *,
+                 integrator: str | None = None) -> tuple[ModalModel, Impactor]:
+    """The one impactor builder of the workbench, used by `ies sweep/overview/trace` (`sim.cli`) and by studies
+    (`uq.models.IESModel`): (the model with D_1 = settings.D1 when given, the impactor of `build_impactor`).
+
+    The checks that need the model and the integrator live here, once, so that a bad combination fails before any
+    work with one line: the damped law (Eq. 10) needs the model's beam mass, dry friction (Appendix C) the model's
+    floor values and the ode3 integrator (`integrator`: the protocol's; None skips that check).
+    """
+    if settings.D1 is not None:
+        model = model.with_damping(settings.D1)
+    impactor = build_impactor(settings)
+    if impactor.contact_law.dissipative or impactor.friction > 0:
+        system_arrays(model, impactor)  # beam mass (Eq. 10) and phi_floor (friction): one line if missing
+    if impactor.friction > 0 and integrator is not None and integrator != "ode3":
+        raise SimulationInputError(f"dry friction (mu = {impactor.friction:g}, Appendix C) is in the ode3 integrator "
+                                   "only; choose it (--integrator ode3, or [excitation] integrator = \"ode3\" in a "
+                                   "study file)")
+    return model, impactor
 
 
 def contact_forces(s: np.ndarray, u_a: float, sys: SystemArrays) -> tuple[float, float]:

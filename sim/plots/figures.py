@@ -243,17 +243,22 @@ def plot_series(series: Sequence[tuple[str, Mapping[str, Any]]], path: str | os.
         legend_beside(ax, title=tip_note(mm_per_level))
 
 
+#: what `plot_scattering` draws: impacts per period (Fig. D.2) or the coefficient of restitution (Fig. D.3)
+SCATTERING_PLOTS = ("impacts", "restitution")
+
+
 def plot_scattering(overview: Mapping[str, Any], runs: Sequence[Mapping[str, Any]], path: str | os.PathLike,
-                    title: str, figure: str) -> None:
-    """Fig. D.2 ("figD2": all and significant impacts per excitation period, the regimes shaded) or Fig. D.3
-    ("figD3": the modal coefficient of restitution r, Eq. D.1, from the tip and from the wall, at the levels whose
-    resonant response is almost periodic: separate points, no line between levels) against the excitation level,
-    at the resonant eta (`sim.stepped_sine.tables.overview_data` keys), each with the range of the runs' own values as error
-    bars (`runs`: rows with level and the measures; Appendix D)."""
+                    title: str, measure: str) -> None:
+    """Fig. D.2 (`measure` "impacts": all and significant impacts per excitation period, the regimes shaded) or Fig.
+    D.3 ("restitution": the modal coefficient of restitution r, Eq. D.1, from the tip and from the wall, at the levels
+    whose resonant response is almost periodic: separate points, no line between levels) against the excitation level, at the resonant eta (`sim.stepped_sine.tables.overview_data` keys), each
+    with the range of the runs' own values as error bars (`runs`: rows with level and the measures; Appendix D)."""
     import numpy as np
 
     levels = np.asarray(overview["levels"], dtype=float)
-    if figure == "figD2":
+    if measure not in SCATTERING_PLOTS:
+        raise ValueError(f"plot_scattering: measure {measure!r} is not one of {', '.join(SCATTERING_PLOTS)}")
+    if measure == "impacts":
         curves = (("impacts_per_period", "all contact onsets", "s--", "C3", "none"),
                   ("significant_impacts_per_period", "significant impacts", "o-", "C0", None))
         ylabel = "impacts per excitation period"
@@ -265,12 +270,12 @@ def plot_scattering(overview: Mapping[str, Any], runs: Sequence[Mapping[str, Any
         keep = np.array([regime == "APR" for regime in overview["regime"]])
     step = float(np.min(np.diff(np.unique(levels)))) if np.unique(levels).size > 1 else 1.0
     with plot_to(path, figsize=(9.0, 4.4)) as (fig, ax):
-        if figure == "figD2":
+        if measure == "impacts":
             shade_regimes(ax, levels, overview["regime"])
         for k, (key, label, style, color, face) in enumerate(curves):
             value = np.asarray(overview[key], dtype=float)[keep]
             # figD3: the two estimates side by side at each level, so that neither hides the other's bar
-            x = levels[keep] + (0.06 * step * (2 * k - 1) if figure == "figD3" else 0.0)
+            x = levels[keep] + (0.06 * step * (2 * k - 1) if measure == "restitution" else 0.0)
             per_run = [[float(r[key]) for r in runs if float(r["level"]) == level and key in r]
                        for level in levels[keep]]
             lo = np.array([np.nanmin(v) if np.isfinite(v).any() else np.nan for v in map(np.asarray, per_run)])
@@ -281,7 +286,7 @@ def plot_scattering(overview: Mapping[str, Any], runs: Sequence[Mapping[str, Any
                             lw=1.2, label=f"{label} (bars: range of the runs)")
             else:
                 ax.plot(x, value, style, color=color, mfc=face, ms=5, lw=1.2, label=label)
-        if figure == "figD3":
+        if measure == "restitution":
             ax.axhline(0.8, color="k", lw=1, ls="-.", alpha=0.6, label="paper: $r$ ~ 0.8 (Fig. D.3)")
             ax.axhline(1.0, color="k", lw=0.8, alpha=0.3, label="$r$ = 1: elastic")
         else:

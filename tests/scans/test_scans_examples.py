@@ -53,7 +53,7 @@ def test_examples_read_back_as_generated(name):
     imprint=st.booleans(),
     seed=st.integers(0, 2**16),
 )
-def test_depth_and_placement_for_random_craters_and_scans(depth, radius, pileup_share, aspect, tilt, azimuth, rotation, imprint, seed):
+def test_depth_and_placement_for_random_craters_and_scans(*, depth, radius, pileup_share, aspect, tilt, azimuth, rotation, imprint, seed):
     shape = CraterShape(depth=depth, radius=radius, pileup=pileup_share * depth, rim_width=0.25 * radius, aspect=aspect)
     scan = synthetic_scan(shape, side=4.5e-3, triangle=40e-6, noise=0.05e-6, tilt_deg=tilt, tilt_azimuth_deg=azimuth,
                           rotation_deg=rotation, orientation="imprint" if imprint else "crater", seed=seed)

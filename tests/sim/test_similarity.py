@@ -26,7 +26,7 @@ def rig():
     return seed_rig_model()
 
 
-def response(model, s, integrator, n_periods, friction=0.0, level=LEVEL, eta=ETA, perturbation=0.0, k_H_power=0.5):
+def response(model, s, integrator, n_periods, *, friction=0.0, level=LEVEL, eta=ETA, perturbation=0.0, k_H_power=0.5):
     """Per-period tip amplitudes / s and contact onsets, from the base-velocity start (times 1 + perturbation), for
     the design scaled by s (k_H by s^-k_H_power: 0.5 is the law)."""
     impactor = Impactor(clearance=s * CLEARANCE_NOMINAL, k_H=K_H_NOMINAL / s**k_H_power, friction=friction)

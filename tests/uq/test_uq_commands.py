@@ -99,7 +99,8 @@ def test_reproduce_rejects_bad_calibration(tmp_path, capsys):
 
 
 def test_calibrated_k_H_becomes_the_upper_bound():
-    from uq.commands import study_file, with_calibration
+    from uq.commands import study_file
+    from uq.study import with_calibration
     from uq.space import K_H_STAR
     from uq.study import load_study
 
@@ -157,7 +158,7 @@ def test_reproduce_unreachable_scheduler_fails_before_the_calibration(tmp_path, 
 
 
 def test_reproduce_calibrates_in_process(tmp_path, monkeypatch, capsys):
-    """Without --calibration FILE the front door's calibration (bem_contact.cli.calibrate_default, the shipped
+    """Without --calibration FILE the front door's calibration (bem_contact.pipeline.calibrate_default, the shipped
     crater) runs in this process; its JSON is kept in OUT/calibration.json and bounds k_H."""
     from uq.space import K_H_STAR
 

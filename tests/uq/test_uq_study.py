@@ -161,7 +161,7 @@ def test_variant_table_changes_the_sphere_mass_and_the_higher_modes_damping(tmp_
     assert "variant" not in plain.describe() and varied.describe()["variant"] == {
         "sphere_mass_factor": 1.4, "higher_mode_damping": 0.004}
     params = {"D": 0.00085, "g": 0.58e-3, "k_H": K_H_STAR}
-    assert varied._impactor(params).mass == pytest.approx(1.4 * SPHERE_MASS)
+    assert varied.simulated_system(params)[1].mass == pytest.approx(1.4 * SPHERE_MASS)
     builtin = seed_rig_model(n_modes=9).damping_ratios
     damping = varied.with_rig().rig.damping_ratios
     assert np.all(damping[4:] == 0.004) and np.array_equal(damping[:4], builtin[:4])
