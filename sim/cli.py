@@ -341,7 +341,7 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
     total = len(levels) * args.reps * len(protocol.legs) * protocol.n_eta
     long_run = len(levels) > 1 or total * (protocol.wait + protocol.hold) > LONG_SWEEP_S
     with output_folder(args.out) as folder:
-        warm_up(protocol.integrator, damped=impactor.contact_law.dissipative)
+        warm_up(protocol.integrator, damped=impactor is not None and impactor.contact_law.dissipative)
         with tqdm(total=total, desc=label, unit="pt", disable=not (long_run and sys.stderr.isatty()), leave=False,
                   file=sys.stderr, dynamic_ncols=True) as bar:
             results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed, progress=bar.update)
@@ -468,7 +468,7 @@ def trace_command(args: argparse.Namespace) -> int:
     if args.plot and not Path(args.plot).resolve().parent.is_dir():
         raise SimulationInputError(f"--plot {args.plot}: folder {Path(args.plot).parent} does not exist")
     with output_folder(args.out) as folder:
-        warm_up(protocol.integrator, damped=impactor.contact_law.dissipative)
+        warm_up(protocol.integrator, damped=impactor is not None and impactor.contact_law.dissipative)
         trace = record_trace(model, impactor, level, protocol, periods=args.periods, fs=args.fs, seed=args.seed)
         settings = {"integrator": protocol.integrator, "seed": args.seed, "protocol": dataclasses.asdict(protocol),
                     "fs_requested": args.fs, **system_data(model, impactor)}
