@@ -64,6 +64,12 @@ Layout (every table and key is optional except where noted; SI units)::
     series = { r_cont = [1.0, 0.99, 0.9] }   # optional: the whole study once per value of one listed
                                  # parameter (a response study each, in OUT/NAME=VALUE), as Fig. 11
 
+    [cluster]                    # optional: run on a batch cluster (uq.cluster; the --cluster-* options win)
+    kind = "slurm"               # slurm (tested), pbs, sge, lsf, oar, moab, htcondor
+    cores = 4                    # per job (a worker process each); memory = "8GB", walltime = "02:00:00",
+    max_jobs = 10                # queue = "short", account = "proj1", directives = ["--qos=short"],
+                                 # worker_timeout = 600 (s); unset values come from Dask's jobqueue.yaml
+
 Unknown tables or keys, unknown parameters, min > max, non-positive bounds and the like are refused with
 a `StudyError` whose one line names the file, the key and the fix.
 """
@@ -76,6 +82,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+from uq.cluster import ClusterSettings, parse_cluster_table
 from uq.errors import StudyError
 from uq.models import make_model
 from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_H, resolve_value
@@ -93,6 +100,7 @@ _KEYS = {
     "interval": {"designs", "interior", "z", "fix"},
     "sobol": {"n", "bootstrap", "confidence"},
     "response": {"figures", "series"},
+    "cluster": None,  # checked by uq.cluster.parse_cluster_table
 }
 _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
 
@@ -124,6 +132,8 @@ class Study:
     outputs: tuple[str, ...] = ()
     contact_law: str = "hertz"
     series: tuple[str, tuple[float, ...]] | None = None
+    #: where the study runs ([cluster], uq.cluster); not part of its results, so left out of to_dict and the key
+    cluster: ClusterSettings | None = None
 
     def make_model(self) -> Any:
         return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
@@ -274,9 +284,10 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError(f"[study] outputs must be a list of distinct output names, e.g. [\"mean\", \"restitution\"], got {outputs!r}")
     contact_law = _parse_contact_law(head, space)
     series = _parse_series(data.get("response", {}).get("series"), kind, space)
+    cluster = parse_cluster_table(data["cluster"]) if "cluster" in data else None
     study = Study(name, kind, model_spec, space, levels, reps, seed, output, protocol, designs, interior, z, fix,
                   sobol_n, bootstrap, confidence, source, modal_model, tuple(figures), variant, tuple(outputs),
-                  contact_law, series)
+                  contact_law, series, cluster)
     for _, one in study.series_studies():
         _parse_contact_law({"contact_law": contact_law}, one.space)  # every value in range
     model = study.make_model()  # unknown model -> one line now
