@@ -12,7 +12,8 @@ Settings come, lowest first, from Dask's own configuration (``~/.config/dask/job
 unset is not passed, so the next source below fills it.
 
 Failures are one line: an unknown kind, dask-jobqueue not installed (naming the ``cluster`` extra), the submit
-command (``sbatch``) not on the PATH, a job the batch system refuses (its own message) are `StudyError`s (exit 2);
+command (``sbatch``) not on the PATH, a job the batch system refuses (its own message, from SLURM's dry run
+``sbatch --test-only`` before anything runs) are `StudyError`s (exit 2);
 no worker connected within ``worker_timeout`` seconds (jobs pending in a closed queue, jobs dying at start) is a
 `ClusterUnavailable` (exit 3) naming ``--resume``. A worker whose job dies or reaches its walltime loses only the
 tasks in flight, which Dask reruns on the other workers while the adaptive cluster submits a replacement job;
@@ -221,7 +222,9 @@ def _cluster_kwargs(settings: ClusterSettings) -> dict[str, Any]:
     cores = settings.cores or config.get("cores") or 1
     kw: dict[str, Any] = {"cores": cores, "memory": settings.memory or config.get("memory") or f"{2 * cores}GB",
                           "processes": config.get("processes") or cores,  # single-threaded tasks: a process a core
-                          "silence_logs": "critical"}
+                          "silence_logs": "critical",
+                          # the dashboard on a free port unless the configuration names one (no port-in-use warning)
+                          "scheduler_options": {"dashboard_address": ":0", **(config.get("scheduler-options") or {})}}
     if kind not in ("htcondor",):
         if settings.walltime is not None:
             kw["walltime"] = settings.walltime
@@ -240,12 +243,27 @@ def _cluster_kwargs(settings: ClusterSettings) -> dict[str, Any]:
     return kw
 
 
-def _refusal(exc: BaseException, submit: str) -> str:
-    """The batch system's own message out of dask-jobqueue's 'Command exited with non-zero exit code' error."""
-    text = str(exc)
-    stderr = text.split("stderr:", 1)[1] if "stderr:" in text else text
-    lines = [line.strip() for line in stderr.splitlines() if line.strip()]
-    return lines[-1] if lines else f"{submit} failed ({type(exc).__name__})"
+#: kind -> the submit command's dry run, which checks a job script against the queues without submitting it
+PREFLIGHT = {"slurm": ["sbatch", "--test-only"]}
+
+
+def _preflight(kind: str, script: str) -> None:
+    """Show the worker job script to the batch system's dry run (SLURM: sbatch --test-only); a refusal (unknown
+    partition, account, limits) is a StudyError with the scheduler's own first error line. Kinds without a dry run
+    (all but SLURM) are not checked here: a refused job then shows as no worker within the worker timeout."""
+    import subprocess
+    import tempfile
+
+    if kind not in PREFLIGHT:
+        return
+    with tempfile.NamedTemporaryFile("w", suffix=".sh", prefix="ies-worker-") as fh:
+        fh.write(script)
+        fh.flush()
+        proc = subprocess.run([*PREFLIGHT[kind], fh.name], capture_output=True, text=True)
+    if proc.returncode:
+        lines = [line.strip() for line in (proc.stderr + proc.stdout).splitlines() if line.strip()]
+        first = next((line for line in lines if "error" in line.lower()), lines[0] if lines else "no message")
+        raise StudyError(f"the batch system refused the worker job: {first}")
 
 
 class _Watchdog(threading.Thread):
@@ -278,8 +296,8 @@ class _Watchdog(threading.Thread):
 def open_cluster(settings: ClusterSettings) -> Iterator[Any]:
     """A dask-jobqueue cluster of `settings.kind` scaling adaptively from 0 to max_jobs jobs, and a Client to it.
 
-    Checks before anything runs: dask-jobqueue importable, the submit command on the PATH, a first job accepted by
-    the batch system (else its message, one line). While the study runs, a watchdog stops it (ClusterUnavailable,
+    Checks before anything runs: dask-jobqueue importable, the submit command on the PATH, the job script accepted
+    by the batch system's dry run (SLURM; else its message, one line). While the study runs, a watchdog stops it (ClusterUnavailable,
     exit 3) when no worker is connected for worker_timeout seconds. On exit every job is cancelled."""
     job_class = _job_class(settings.kind)
     submit = KINDS[settings.kind][1]
@@ -296,11 +314,7 @@ def open_cluster(settings: ClusterSettings) -> Iterator[Any]:
         raise StudyError(f"--cluster {settings.kind}: {str(exc).splitlines()[0]}") from None
     watchdog = None
     try:
-        try:
-            cluster.scale(jobs=1)  # one job first, synchronously: a refusing queue is reported now
-            cluster.sync(cluster._correct_state)
-        except RuntimeError as exc:
-            raise StudyError(f"the batch system refused the worker job: {_refusal(exc, submit)}") from None
+        _preflight(settings.kind, cluster.job_script())
         cluster.adapt(minimum_jobs=0, maximum_jobs=max_jobs, wait_count=10, interval="1s")
         client = Client(cluster)
         watchdog = _Watchdog(cluster, client, timeout)
