@@ -94,7 +94,7 @@ def test_a_refused_queue_is_the_schedulers_one_line(on_slurm, study_file, tmp_pa
     code = main(["sobol", str(study_file), "--out", str(out), *CLUSTER, "--cluster-queue", "nosuch"])
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1, err
-    assert "refused the worker job" in err and "Invalid partition name specified" in err
+    assert "refused the worker job" in err and "invalid partition specified: nosuch" in err
     assert not out.exists()  # nothing written
 
 
