@@ -66,7 +66,7 @@ def test_no_sbatch_on_the_path(tmp_path, capsys, monkeypatch):
 
 
 def test_cluster_none_runs_locally_despite_the_table(tmp_path, capsys):
-    code, err, out = run(tmp_path, capsys, "--cluster", "none", "--jobs", "1", cluster="[cluster]\nkind = 'slurm'")
+    code, _err, out = run(tmp_path, capsys, "--cluster", "none", "--jobs", "1", cluster="[cluster]\nkind = 'slurm'")
     assert code == 0 and (out / "sobol.csv").is_file()
 
 
