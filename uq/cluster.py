@@ -165,7 +165,8 @@ def add_cluster_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--cluster", metavar="KIND",
                        help=f"submit Dask workers as batch jobs: {', '.join(KINDS)} (tested: slurm); "
                             f"'{NO_CLUSTER}' ignores the study file's [cluster] table")
-    group.add_argument("--cluster-cores", type=positive_int, metavar="N", help="cores per job (one worker process each)")
+    group.add_argument("--cluster-cores", type=positive_int, metavar="N",
+                       help="cores per job (one worker process each)")
     group.add_argument("--cluster-memory", metavar="SIZE", help="memory per job, e.g. 4GB")
     group.add_argument("--cluster-walltime", type=_walltime_option, metavar="HH:MM:SS", help="time limit per job")
     group.add_argument("--cluster-queue", metavar="NAME", help="queue (SLURM: partition)")
@@ -297,8 +298,9 @@ def open_cluster(settings: ClusterSettings) -> Iterator[Any]:
     """A dask-jobqueue cluster of `settings.kind` scaling adaptively from 0 to max_jobs jobs, and a Client to it.
 
     Checks before anything runs: dask-jobqueue importable, the submit command on the PATH, the job script accepted
-    by the batch system's dry run (SLURM; else its message, one line). While the study runs, a watchdog stops it (ClusterUnavailable,
-    exit 3) when no worker is connected for worker_timeout seconds. On exit every job is cancelled."""
+    by the batch system's dry run (SLURM; else its message, one line). While the study runs, a watchdog stops it
+    (ClusterUnavailable, exit 3) when no worker is connected for worker_timeout seconds. On exit every job is
+    cancelled."""
     job_class = _job_class(settings.kind)
     submit = KINDS[settings.kind][1]
     if shutil.which(submit) is None:

@@ -100,8 +100,10 @@ def test_throughput_of_each_engine(model_and_study, tmp_path, monkeypatch, capsy
             evaluate(model, task, study.seed)
 
     def engine(jobs=1, client=None):
-        return lambda tasks, folder: run_tasks(model, tasks, study.seed, ResultStore(prepare_output(folder, resume=False)), jobs=jobs,
-                                               client=client, progress=False)
+        def run(tasks, folder):
+            store = ResultStore(prepare_output(folder, resume=False))
+            run_tasks(model, tasks, study.seed, store, jobs=jobs, client=client, progress=False)
+        return run
 
     measure("bare", bare, pids=list)
     measure("joblib, 1 worker", engine(1), pids=list)
