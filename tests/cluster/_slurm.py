@@ -65,13 +65,17 @@ class LocalSlurm:
         self._remember("munged.pid")
         return ["AuthType=auth/munge", "CredType=cred/munge", f"AuthInfo=socket={sock}"]
 
-    def _remember(self, pidfile: str, wait: float = 5.0) -> None:
+    def _remember(self, pidfile: str, wait: float = 10.0) -> None:
+        """Keep the process id a daemon writes to `pidfile` (the file may exist a moment before its content)."""
         path = self.folder / pidfile
         deadline = time.monotonic() + wait
-        while time.monotonic() < deadline and not path.is_file():
+        while time.monotonic() < deadline:
+            text = path.read_text().split() if path.is_file() else []
+            if text:
+                self.pids.append(int(text[0]))
+                return
             time.sleep(0.05)
-        if path.is_file():
-            self.pids.append(int(path.read_text().split()[0]))
+        raise SlurmUnavailable(f"{pidfile} stayed empty for {wait:g} s; the daemon did not start")
 
     def write_config(self) -> None:
         for sub in ("state", "spool", "logs"):
@@ -111,7 +115,11 @@ class LocalSlurm:
             if proc.returncode:
                 self.stop()
                 raise SlurmUnavailable(f"{daemon} did not start: {(proc.stderr or proc.stdout).strip()[:200]}")
-            self._remember(pidfile)
+            try:
+                self._remember(pidfile)
+            except SlurmUnavailable:
+                self.stop()
+                raise
         deadline = time.monotonic() + timeout
         state = ""
         while time.monotonic() < deadline:
@@ -129,6 +137,15 @@ class LocalSlurm:
         out = subprocess.run(["squeue", "-h", "-o", "%i"], env={**os.environ, **self.env()}, capture_output=True,
                              text=True).stdout
         return out.split()
+
+    def drained(self, timeout: float = 20.0) -> bool:
+        """True once no job is queued or running (a cancelled job takes a moment to leave the queue)."""
+        deadline = time.monotonic() + timeout
+        while self.jobs():
+            if time.monotonic() > deadline:
+                return False
+            time.sleep(0.2)
+        return True
 
     def stop(self) -> None:
         """Cancel every job, then end the daemons this object started (by process id)."""

@@ -86,7 +86,7 @@ def test_a_cancelled_worker_job_loses_nothing_and_changes_no_number(on_slurm, st
     assert all(after[name] == mtime for name, mtime in seen["finished"].items())  # finished tasks not recomputed
     summary = json.loads((out / "study.json").read_text())["summary"]
     assert summary["tasks"] == summary["ran"] == TOTAL == len(after)
-    assert not on_slurm.jobs()  # every worker job is gone after the study
+    assert on_slurm.drained()  # every worker job is gone after the study
 
 
 def test_a_refused_queue_is_the_schedulers_one_line(on_slurm, study_file, tmp_path, capsys):
@@ -114,7 +114,7 @@ def test_no_worker_in_time_stops_naming_resume_and_keeps_finished_tasks(on_slurm
     assert code == 3 and len(err.strip().splitlines()) == 1, err
     assert "no worker of the slurm cluster was connected for 4 s" in err and "--resume" in err
     assert task_times(out) == kept and not (out / "sobol.csv").exists()
-    assert not on_slurm.jobs()  # the pending job was cancelled
+    assert on_slurm.drained()  # the pending job was cancelled
     assert main(["sobol", str(study_file), "--out", str(out), *CLUSTER, "--resume"]) == 0
     assert data_of(out) == data_of(serial)
     summary = json.loads((out / "study.json").read_text())["summary"]
