@@ -8,7 +8,7 @@ imports the contact stage), and turns the stages' errors into exit codes. It is 
 imports scans and bem_contact (their error classes and the calibration).
 
 User mistakes end with one line on stderr, ``ies <command>: error: <what and how to fix>``,
-and exit code 2; numerical failures exit with code 3. No traceback for either.
+and exit code 2; numerical failures and a batch cluster without workers exit with code 3. No traceback for either.
 """
 from __future__ import annotations
 
@@ -24,10 +24,12 @@ import uq.commands
 from bem_contact.errors import ContactInputError, ConvergenceError
 from scans.errors import ScanError
 from sim.common.errors import SimulationDiverged, SimulationInputError
-from uq.errors import StudyError
+from uq.errors import ClusterUnavailable, StudyError
 
 USER_ERRORS = (ContactInputError, ScanError, SimulationInputError, StudyError)
 NUMERICAL_FAILURES = (ConvergenceError, SimulationDiverged)
+#: the cluster's resources failed (no worker in time, workers dying): exit 3, the finished tasks kept
+RESOURCE_FAILURES = (ClusterUnavailable,)
 
 #: the dispatch table, in the pipeline's order: (stage command module, what it is handed); each module's
 #: add_commands(subparsers, **handed) registers its own subcommands
@@ -87,6 +89,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     except NUMERICAL_FAILURES as exc:
         sys.stderr.write(f"{prog}: numerical failure: {exc}\n")
+        return 3
+    except RESOURCE_FAILURES as exc:
+        sys.stderr.write(f"{prog}: cluster failure: {exc}\n")
         return 3
     except (FileNotFoundError, IsADirectoryError, NotADirectoryError, PermissionError) as exc:
         where = f": {exc.filename}" if getattr(exc, "filename", None) else ""

@@ -24,13 +24,14 @@ inside the functions, so that `ies --help` stays fast.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
 import os
 import sys
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable, Iterator
 
 from sim.common.options import figure_formats, level_list, positive_int
 from uq.errors import StudyError
@@ -67,7 +68,9 @@ def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
 # ---- ies interval, ies sobol --------------------------------------------------------------------------------
 
 def add_run_arguments(parser: argparse.ArgumentParser) -> None:
-    """--out, --jobs, --scheduler, --resume, --no-figures, --quiet."""
+    """--out, --jobs, --scheduler, --cluster and its options (`uq.cluster`), --resume, --no-figures, --quiet."""
+    from uq.cluster import add_cluster_arguments
+
     parser.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: the study's [study] output)")
     parser.add_argument("--jobs", type=positive_int, default=os.cpu_count() or 1, metavar="N",
                         help="local worker processes (default: the number of CPU cores; 1 runs in this process)")
@@ -77,6 +80,7 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
                         help="continue a study in --out: reuse finished tasks, run only the missing ones")
     parser.add_argument("--no-figures", action="store_true", help="write the data only")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_cluster_arguments(parser)
 
 
 def add_interval_arguments(parser: argparse.ArgumentParser) -> None:
@@ -111,8 +115,9 @@ def interval_command(args: argparse.Namespace) -> int:
     from uq.paper_figures import interval_figures
 
     study = _load_study(args.study, "interval")
-    result = run_interval_study(study, out=args.out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
-                                progress=not args.quiet)
+    with engine(args, study.cluster) as client:
+        result = run_interval_study(study, out=args.out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
+                                    progress=not args.quiet, client=client)
     _report(result, [] if args.no_figures else interval_figures(result.folder))
     print_interval_result(result.folder, result.summary, study.name)
     return 0
@@ -129,8 +134,9 @@ def sobol_command(args: argparse.Namespace) -> int:
     study = with_sobol_method(_load_study(args.study, "sobol"), args.method, args.points, args.degree)
     if study.sobol_method == "pce" and args.n is not None:
         raise StudyError("--n is Saltelli's base sample size; the surrogate's design size is --points")
-    result = run_sobol_study(study, out=args.out, n=args.n, jobs=args.jobs, scheduler=args.scheduler,
-                             resume=args.resume, progress=not args.quiet)
+    with engine(args, study.cluster) as client:
+        result = run_sobol_study(study, out=args.out, n=args.n, jobs=args.jobs, scheduler=args.scheduler,
+                                 resume=args.resume, progress=not args.quiet, client=client)
     _report(result, [] if args.no_figures else sobol_figure(result.folder))
     print(sobol_table(result.folder))
     return 0
@@ -142,11 +148,26 @@ def response_command(args: argparse.Namespace) -> int:
     from uq.paper_figures import response_figures
 
     study = _load_study(args.study, "response")
-    result = run_response_study(study, out=args.out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
-                                progress=not args.quiet)
+    with engine(args, study.cluster) as client:
+        result = run_response_study(study, out=args.out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
+                                    progress=not args.quiet, client=client)
     _report(result, [] if args.no_figures else response_figures(result.folder))
     print_response_result(result.folder, study.name)
     return 0
+
+
+@contextlib.contextmanager
+def engine(args: argparse.Namespace, table: Any) -> Iterator[Any]:
+    """The Dask client of a batch cluster when --cluster or the study's [cluster] table asks for one (started
+    here, closed on exit: `uq.cluster.open_cluster`), else None (--jobs or --scheduler, as the runner does)."""
+    from uq.cluster import cluster_settings, open_cluster
+
+    settings = cluster_settings(args, table)
+    if settings is None:
+        yield None
+        return
+    with open_cluster(settings) as client:
+        yield client
 
 
 def _load_study(path: Path, kind: str) -> Any:
@@ -208,6 +229,9 @@ def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
                         help="local worker processes (default: the number of CPU cores)")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://host:8786")
     parser.add_argument("--resume", action="store_true", help="continue an interrupted reproduction in --out")
+    from uq.cluster import add_cluster_arguments
+
+    add_cluster_arguments(parser)
     calib = parser.add_mutually_exclusive_group()
     calib.add_argument("--calibration", type=Path, metavar="FILE",
                        help="use this `ies calibrate --json` output instead of running the calibration")
@@ -264,7 +288,8 @@ def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
     calibration = None
     if args.calibration is not None:  # a bad file fails here too
         calibration = {"k_H": calibrated_k_H(args.calibration), "source": str(args.calibration)}
-    with dask_client(args.scheduler) as client:  # connected once, first: a bad address leaves nothing behind
+    with engine(args, None) as batch, dask_client(args.scheduler, batch) as client:
+        # connected (or the batch cluster started) once, first: a bad address leaves nothing behind
         check_writable(args.out)
         for model in models:  # every kernel any study's workers will call, compiled here once, before the first bar
             if hasattr(model, "warm_up"):
@@ -453,14 +478,16 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     add_run_arguments(parser)
 
 
-def design_problem(args: argparse.Namespace) -> tuple[Any, Path]:
-    """The design problem and output folder of `ies design`'s options and study file (options win)."""
+def design_problem(args: argparse.Namespace) -> tuple[Any, Path, Any]:
+    """The design problem, output folder and [cluster] table (`uq.cluster`) of `ies design`'s options and study file
+    (options win)."""
     import tomllib
 
     from uq import design as d
     from uq.errors import StudyError
 
     table: dict[str, Any] = {}
+    cluster = None
     protocol = dict(d.PROTOCOL)
     if args.study is not None:
         try:
@@ -470,6 +497,10 @@ def design_problem(args: argparse.Namespace) -> tuple[Any, Path]:
         if data.get("study", {}).get("kind") != "design":
             raise StudyError(f"{args.study}: [study] kind must be \"design\" for ies design")
         table = dict(data.get("design", {}))
+        if "cluster" in data:
+            from uq.cluster import parse_cluster_table
+
+            cluster = parse_cluster_table(data["cluster"])
         unknown = sorted(set(table) - set(DESIGN_OPTIONS))
         if unknown:
             raise StudyError(f"{args.study}: unknown key(s) in [design]: {', '.join(unknown)}; known: "
@@ -504,16 +535,17 @@ def design_problem(args: argparse.Namespace) -> tuple[Any, Path]:
         fields["baseline"] = d.parse_baseline(value("baseline"), radii, materials)
     problem = replace(problem, **fields)
     problem.check()
-    return problem, Path(args.out or value("output"))
+    return problem, Path(args.out or value("output")), cluster
 
 
 def design_command(args: argparse.Namespace) -> int:
     """`ies design`: screen, verify and recommend (uq.design)."""
     from uq.design import design_table, run_design
 
-    problem, out = design_problem(args)
-    result = run_design(problem, out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
-                        progress=not args.quiet, figures=not args.no_figures)
+    problem, out, cluster = design_problem(args)
+    with engine(args, cluster) as client:
+        result = run_design(problem, out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
+                            progress=not args.quiet, figures=not args.no_figures, client=client)
     print(design_table(result))
     print(f"wrote {len(result.files)} files to {result.folder}")
     return 0

@@ -154,6 +154,10 @@ def evaluate(model: Callable, task: Task, seed: int) -> dict:
     return record
 
 
+def _same(value: Any) -> Any:
+    return value
+
+
 def _run_one(model: Callable, key: str, task: Task, seed: int) -> tuple[str, dict]:
     return key, evaluate(model, task, seed)
 
@@ -249,15 +253,16 @@ def _run_and_store(model: Callable, pending: list[tuple[str, Task]], seed: int, 
 def _dispatch(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int,
               client: Any) -> Iterable[tuple[str, Task, dict]]:
     """(key, task, result) of every pending task as it finishes: in this process (jobs 1, no client), in `jobs`
-    local processes (joblib/loky) or on a Dask cluster (`client`: one future per task, the model scattered once
-    to every worker)."""
+    local processes (joblib/loky) or on a Dask cluster (`client`: one future per task, the model sent once)."""
     if not pending:
         return
     by_key = {k: t for k, t in pending}
     if client is not None:
         from distributed import as_completed
 
-        remote_model = client.scatter(model, broadcast=True)
+        # the model is sent once, as the result of a task rather than scattered data: when the workers holding it
+        # die (a batch job cancelled or out of walltime) the scheduler recomputes it, while scattered data is lost
+        remote_model = client.submit(_same, model, pure=False)
         futures = [client.submit(_run_one, remote_model, key, task, seed, pure=False) for key, task in pending]
         try:
             for future in as_completed(futures):

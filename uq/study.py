@@ -70,6 +70,12 @@ Layout (every table and key is optional except where noted; SI units)::
     series = { r_cont = [1.0, 0.99, 0.9] }   # optional: the whole study once per value of one listed
                                  # parameter (a response study each, in OUT/NAME=VALUE), as Fig. 11
 
+    [cluster]                    # optional: run on a batch cluster (uq.cluster; the --cluster-* options win)
+    kind = "slurm"               # slurm (tested), pbs, sge, lsf, oar, moab, htcondor
+    cores = 4                    # per job (a worker process each); memory = "8GB", walltime = "02:00:00",
+    max_jobs = 10                # queue = "short", account = "proj1", directives = ["--qos=short"],
+                                 # worker_timeout = 600 (s); unset values come from Dask's jobqueue.yaml
+
 Unknown tables or keys, unknown parameters, min > max, non-positive bounds and the like are refused with
 a `StudyError` whose one line names the file, the key and the fix.
 """
@@ -83,6 +89,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from sim.model.parameters import PARAMETERS
+from uq.cluster import ClusterSettings, parse_cluster_table
 from uq.errors import StudyError
 from uq.models import ResponseModel, make_model
 from uq.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_H, resolve_value
@@ -98,6 +105,7 @@ _KEYS = {
     "interval": {"designs", "interior", "z", "fix"},
     "sobol": {"n", "bootstrap", "confidence", "method", "points", "degree", "max_misfit"},
     "response": {"figures", "series"},
+    "cluster": None,  # checked by uq.cluster.parse_cluster_table
 }
 _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
 
@@ -141,6 +149,8 @@ class Study:
     surrogate_points: int = 0
     surrogate_degree: int = 2
     max_misfit: float = 0.1
+    #: where the study runs ([cluster], uq.cluster); not part of its results, so left out of to_dict and the key
+    cluster: ClusterSettings | None = None
 
     def make_model(self) -> ResponseModel:
         """The study's response model (`uq.models.make_model`)."""
@@ -319,12 +329,14 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError(f"[study] outputs must be a list of distinct output names, e.g. [\"mean\", \"restitution\"], got {outputs!r}")
     contact_law = _parse_contact_law(head, space)
     series = _parse_series(data.get("response", {}).get("series"), kind, space)
+    cluster = parse_cluster_table(data["cluster"]) if "cluster" in data else None
     study = Study(name=name, kind=kind, model=model_spec, space=space, levels=levels, repetitions=reps, seed=seed,
                   output=output, protocol=protocol, designs=designs, interior=interior, z=z, fix=fix,
                   sobol_n=sobol_n, bootstrap=bootstrap, confidence=confidence, source=source,
                   modal_model=modal_model, figures=tuple(figures), variant=variant, outputs=tuple(outputs),
                   contact_law=contact_law, series=series, sobol_method=method,
-                  surrogate_points=points, surrogate_degree=degree, max_misfit=max_misfit)
+                  surrogate_points=points, surrogate_degree=degree, max_misfit=max_misfit,
+                  cluster=cluster)
     for _, one in study.series_studies():
         _parse_contact_law({"contact_law": contact_law}, one.space)  # every value in range
     model = study.make_model()  # unknown model -> one line now
