@@ -5,18 +5,10 @@ import json
 import numpy as np
 import pytest
 
+from tests.support import AB_PARAMETERS
 from uq.cli import main
 
-AB = """
-[parameters.a]
-nominal = 0.5
-min = 0.0
-max = 1.0
-[parameters.b]
-nominal = 0.5
-min = 0.0
-max = 1.0
-"""
+AB = AB_PARAMETERS
 
 
 def rows(path):

@@ -6,6 +6,7 @@ import json
 import numpy as np
 import pytest
 
+from tests.support import AB_PARAMETERS
 from uq.cli import main
 from uq.space import Parameter, ParameterSpace
 
@@ -13,16 +14,7 @@ pytest.importorskip("openturns")
 from uq.surrogate import basis_size, pce_indices, pce_sample
 
 A, B = 7.0, 0.1
-AB = """
-[parameters.a]
-nominal = 0.5
-min = 0.0
-max = 1.0
-[parameters.b]
-nominal = 0.5
-min = 0.0
-max = 1.0
-"""
+AB = AB_PARAMETERS
 
 
 def ishigami(X):
