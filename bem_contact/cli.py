@@ -156,6 +156,7 @@ def scanned_wall(args: argparse.Namespace) -> GapSource:
     scan = read_scan(path, units=args.units, pixel_size=args.pixel_size)
     surface = level_scan(scan, imprint=args.imprint)
     metrics = crater_metrics(surface)
+    unit_warning = crater_units_check(metrics.diameter, metrics.depth, args.units, scan.source)
     flattening = args.flattening * 1e-3
     sphere = Sphere(SPHERE_RADIUS, flattening if args.sphere == "flattened" else 0.0)
     side = None if args.side_mm is None else args.side_mm * 1e-3
@@ -190,7 +191,7 @@ def scanned_wall(args: argparse.Namespace) -> GapSource:
         "flattening": flattening,
         "clearance_min": clearance_min,
         "clearance_max": clearance_max,
-        "warnings": list(metrics.warnings) + _noise_warnings(contact.denoise, metrics),
+        "warnings": list(metrics.warnings) + _noise_warnings(contact.denoise, metrics) + unit_warning,
     }
     if args.scan is None:
         facts["scan_note"] = (f"shipped example: synthetic crater {PAPER_CRATER.depth * 1e6:g} um deep, "
@@ -204,6 +205,39 @@ def scanned_wall(args: argparse.Namespace) -> GapSource:
     label = f"{scan.source}{' (imprint, inverted)' if surface.imprint else ''}, {sphere.describe()}"
     facts["_contact"], facts["_metrics"] = contact, metrics  # for the plot; not in the JSON
     return GapSource(gap_at=gap_at, label=label, facts=facts)
+
+
+#: a crater wider than this many times the chord of the sphere pressed to the crater's depth, 2 sqrt(2 R d - d^2),
+#: is implausible for its units (the paper-like crater: 1.27 in mm, its rim included; 4.0 read in cm, 6.4 in inches)
+CHORD_FACTOR = 2.5
+
+
+def crater_units_check(diameter: float, depth: float, units: str, source: str) -> list[str]:
+    """Whether a crater of `diameter` and `depth` (m, as read in `units`) can be the sphere's (R = 7.92 mm, Sect. 2):
+    wider than the sphere is refused (ScanError: the units are wrong), wider than CHORD_FACTOR times the sphere's chord
+    at that depth is one warning (returned as a list of lines); each names the unit that would fit."""
+    import math
+
+    from scans import ScanError
+    from scans.io import UNITS
+
+    def chord_ratio(scale: float) -> float:
+        d = depth * scale
+        return diameter * scale / (2.0 * math.sqrt(max(2.0 * SPHERE_RADIUS * d - d * d, 1e-30)))
+
+    def fits(unit: str) -> bool:
+        scale = UNITS[unit] / UNITS[units]
+        return diameter * scale <= 2.0 * SPHERE_RADIUS and chord_ratio(scale) <= CHORD_FACTOR
+
+    if diameter <= 0 or depth <= 0 or units not in UNITS or fits(units):
+        return []
+    better = next((u for u in ("mm", "um", "cm", "m", "in") if fits(u)), None)
+    hint = f"; the file looks like it is in {better}: use --units {better}" if better else "; check --units"
+    what = (f"{source}: read in {units}, the crater is {diameter * 1e3:.3g} mm across and {depth * 1e6:.3g} um deep")
+    if diameter > 2.0 * SPHERE_RADIUS:
+        raise ScanError(f"{what}: wider than the {2e3 * SPHERE_RADIUS:.2f} mm sphere that made it{hint}")
+    return [f"{what}: {chord_ratio(1.0):.1f} times the sphere's chord at that depth (a dent of the {SPHERE_RADIUS * 1e3:g} "
+            f"mm sphere is at most about {CHORD_FACTOR:g} times){hint}"]
 
 
 def _reference(denoise: float, smoothing: float) -> str:
@@ -276,12 +310,32 @@ def summary(result, source: GapSource, E_star: float) -> dict[str, Any]:
                      "forces": "N", "contact_areas": "m^2", "dx": "m", "side": "m", "R": "m", "E_star": "Pa",
                      "fit_residual": "1 (||f - k_H delta^1.5|| / ||f||)", "k_H_ratio": "1 (k_H / k_H*, Eq. 8)"}
     if data.get("geometry") == "scan":
+        data["holes_in_contact_zone"] = holes_in_contact_zone(data, source.facts["_contact"].holes.get(data["grid"]))
+        if data["holes_in_contact_zone"]:
+            data["warnings"] = [*data["warnings"], data["holes_in_contact_zone"]]
         data["units"].update({k: "m" for k in ("crater_depth", "rim_height", "crater_diameter", "clearance_min",
                                                 "clearance_max", "clearance_nominal", "flattening", "noise",
                                                 "sphere_flattening_in_bem", "sphere_axis_point", "smoothing",
                                                 "denoise")})
         data["units"].update({"wall_tilt_deg": "deg", "flat_fraction": "1", "sphere_axis_direction": "1 (unit normal)"})
     return data
+
+
+def holes_in_contact_zone(data: dict[str, Any], holes: Any) -> str | None:
+    """A warning when a filled hole of the scan (`scans.raster.HoleReport`) lies inside the contact zone at the
+    largest indentation (radius sqrt(A / pi) from the largest contact area A, m^2), where k_H then rests on
+    interpolated heights; None otherwise."""
+    import math
+
+    if holes is None or not data.get("contact_areas"):
+        return None
+    radius = math.sqrt(float(data["contact_areas"][-1]) / math.pi)
+    if not holes.nearest <= radius:
+        return None
+    return (f"a filled hole lies inside the contact zone: its nearest node is {holes.nearest * 1e6:.0f} um from the "
+            f"sphere's axis, the contact radius at {data['deltas'][-1] * 1e6:g} um indentation is {radius * 1e6:.0f} um; "
+            "k_H rests on interpolated heights there: rescan the crater without the dropout, or compare with the "
+            "hole elsewhere")
 
 
 def _text(data: dict[str, Any], label: str) -> str:
@@ -396,8 +450,10 @@ def _tangential_text(data: dict[str, Any]) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    """`ies calibrate`: calibrate, plot on request, print the summary (text or JSON)."""
-    from sim.files import dumps, report_written
+    """`ies calibrate`: calibrate, print the summary (text or JSON), plot on request."""
+    from pathlib import Path
+
+    from sim.files import check_writable, dumps, report_written, write_or_fallback
 
     if args.normal_force is not None and not args.tangential:
         from bem_contact.errors import ContactInputError
@@ -407,13 +463,22 @@ def run(args: argparse.Namespace) -> int:
         data = tangential(args)
         print(dumps(data) if args.json else _tangential_text(data))
         return 0
+    if args.plot:
+        check_writable(args.plot, "--plot")  # before the contact solves
     result, source, E_star = calibrate(args)
     data = summary(result, source, E_star)
-    if args.plot and data.get("geometry") == "scan":
-        scan_plot(data, source, args.plot)
-    elif args.plot:
-        plot(data, source.label, args.plot)
-    print(dumps(data) if args.json else _text(data, source.label))
+    print(dumps(data) if args.json else _text(data, source.label), flush=True)  # first: a refused figure loses nothing
+    if args.plot:
+        target = Path(args.plot)
+
+        def draw(folder: Path) -> None:
+            path = target if folder == target.parent else folder / target.name
+            if data.get("geometry") == "scan":
+                scan_plot(data, source, path)
+            else:
+                plot(data, source.label, path)
+
+        write_or_fallback(draw, target.parent, "calibrate")
     report_written([args.plot] if args.plot else [], json_mode=args.json)
     return 0
 

@@ -84,6 +84,18 @@ def announce(runs: int, simulated_per_run: float, cost: float, hint: str, stream
     return estimate
 
 
+def announce_runs(runs: int, seconds_per_run: float, hint: str, stream: TextIO | None = None) -> float:
+    """As `announce`, for runs whose wall time was measured (a study's first task): "runs x s per run"."""
+    stream = stream or sys.stderr
+    estimate = runs * seconds_per_run
+    if estimate > ANNOUNCE_AFTER_S:
+        line = (f"cost estimate: {runs} run(s) x {seconds_per_run:.2g} s per run (the first, measured) = about "
+                f"{duration_text(estimate)} on one core")
+        stream.write(f"warning: {line}; {hint}\n" if estimate > WARN_AFTER_S else f"{line}\n")
+        stream.flush()
+    return estimate
+
+
 def available_memory() -> float:
     """Memory (bytes) the system can give without swapping: MemAvailable of /proc/meminfo, else the free pages."""
     try:

@@ -37,13 +37,14 @@ T = TypeVar("T")
 
 
 def read_text(path: str | os.PathLike, kind: str, fmt: str, hint: str = "") -> str:
-    """The UTF-8 text of a user's input file; a missing file, a folder or a binary file is one line
-    (SimulationInputError) naming the file, its `kind` (e.g. "modal file"), the format `fmt` and a `hint`."""
+    """The UTF-8 text of a user's input file, without the byte-order mark spreadsheets write; a missing file, a
+    folder or a binary file is one line (SimulationInputError) naming the file, its `kind` (e.g. "modal file"), the
+    format `fmt` and a `hint`."""
     from sim.errors import SimulationInputError
 
     path = Path(path)
     try:
-        return path.read_bytes().decode("utf-8")
+        return path.read_bytes().decode("utf-8-sig")
     except FileNotFoundError:
         raise SimulationInputError(f"{kind} {path} not found{hint}") from None
     except IsADirectoryError:

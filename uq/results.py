@@ -13,6 +13,7 @@ import csv
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 
@@ -164,6 +165,20 @@ def band_table(folder: str | Path, output: str | None = None) -> str:
 NOISE_DOMINATES = 0.5
 
 
+def outside_unit_interval(values: Sequence[float], conf: Sequence[float]) -> int:
+    """How many Sobol' indices lie outside [0, 1] by more than their confidence half-width (an index is a share of
+    the variance: beyond its CI outside [0, 1] it says the base sample n is too small, not something about the model)."""
+    v, c = np.asarray(values, dtype=float), np.nan_to_num(np.asarray(conf, dtype=float))
+    return int(np.sum(np.isfinite(v) & ((v < -c) | (v > 1.0 + c))))
+
+
+def sample_size_advice(outside: int, total: int, n: int) -> str:
+    """The line that says indices outside [0, 1] beyond their CI mean too small a base sample n, and what to do."""
+    return (f"{outside} of {total} indices (S1, ST) lie outside [0, 1] beyond their confidence intervals: the base "
+            f"sample n = {n} is too small for them to mean anything; raise --n (a power of two, {max(4 * n, 256)} or "
+            "more) or [sobol] n")
+
+
 def sobol_table(folder: str | Path) -> str:
     """Text table of S1 and ST with their confidence intervals per output, level and parameter, the repetition
     noise's share of the variance per level, and, where noise dominates, what it means and what to change."""
@@ -188,4 +203,10 @@ def sobol_table(folder: str | Path) -> str:
                          f"1/repetitions (now {repetitions}): raise [study] repetitions or the hold time, or choose "
                          "levels away from the switch between the strongly modulated and the almost periodic response, "
                          "where the response is chaotic.")
+    indices = [float(r[key]) for r in rows for key in ("S1", "ST")]
+    conf = [float(r[f"{key}_conf"]) for r in rows for key in ("S1", "ST")]
+    outside = outside_unit_interval(indices, conf)
+    if outside:
+        n = int(meta.get("summary", {}).get("base_sample", meta["study"]["sobol"]["n"]))
+        lines.append(f"warning: {sample_size_advice(outside, len(indices), n)}")
     return "\n".join(lines)
