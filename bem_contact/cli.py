@@ -327,7 +327,7 @@ def holes_in_contact_zone(data: dict[str, Any], holes: Any) -> str | None:
     interpolated heights; None otherwise."""
     import math
 
-    if holes is None or not data.get("contact_areas"):
+    if holes is None or len(data.get("contact_areas", ())) == 0:
         return None
     radius = math.sqrt(float(data["contact_areas"][-1]) / math.pi)
     if not holes.nearest <= radius:

@@ -263,7 +263,7 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                     client: Any = None) -> StudyResult:
     """Sobol' study: S1, ST (bootstrap CI) of the repetition-mean resonant levels per excitation level,
     with the share of their variance that is repetition noise."""
-    from uq.results import outside_unit_interval, sample_size_advice
+    from uq.results import sample_size_advice
     from uq.sobol import sobol_indices, sobol_sample
 
     model = _checked_model(study)
@@ -291,9 +291,9 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                 _warn(result, f"{o} at level {level:g}: not analysed: {res.message}")
             for k, pname in enumerate(res.names):
                 rows.append([o, level, pname, res.S1[k], res.S1_conf[k], res.ST[k], res.ST_conf[k]])
-            outside = outside_unit_interval([*res.S1, *res.ST], [*res.S1_conf, *res.ST_conf])
-            if outside:
-                _warn(result, f"{o} at level {level:g}: {sample_size_advice(outside, 2 * len(res.names), n)}")
+            advice = sample_size_advice([*res.S1, *res.ST], [*res.S1_conf, *res.ST_conf], n)
+            if advice and not res.message:
+                _warn(result, f"{o} at level {level:g}: {advice}")
             summary_rows.append([o, level, res.variance, res.noise_variance, res.noise_share, res.failed_runs,
                                  res.message])
             per_level[f"{o}@{level:g}"] = {"noise_share": res.noise_share, "failed_runs": res.failed_runs}

@@ -172,11 +172,25 @@ def outside_unit_interval(values: Sequence[float], conf: Sequence[float]) -> int
     return int(np.sum(np.isfinite(v) & ((v < -c) | (v > 1.0 + c))))
 
 
-def sample_size_advice(outside: int, total: int, n: int) -> str:
-    """The line that says indices outside [0, 1] beyond their CI mean too small a base sample n, and what to do."""
-    return (f"{outside} of {total} indices (S1, ST) lie outside [0, 1] beyond their confidence intervals: the base "
-            f"sample n = {n} is too small for them to mean anything; raise --n (a power of two, {max(4 * n, 256)} or "
-            "more) or [sobol] n")
+#: a confidence half-width above which an index says nothing (its interval spans most of [0, 1])
+UNDETERMINED_CONF = 0.5
+
+
+def undetermined(conf: Sequence[float]) -> int:
+    """How many Sobol' indices have a confidence half-width above UNDETERMINED_CONF (or none at all)."""
+    c = np.asarray(conf, dtype=float)
+    return int(np.sum(~np.isfinite(c) | (c > UNDETERMINED_CONF)))
+
+
+def sample_size_advice(values: Sequence[float], conf: Sequence[float], n: int) -> str | None:
+    """The line that says indices outside [0, 1] beyond their CI (`outside_unit_interval`) or with CIs wider than
+    +-UNDETERMINED_CONF mean too small a base sample n, and what to do; None when neither occurs."""
+    outside, wide = outside_unit_interval(values, conf), undetermined(conf)
+    if not (outside or wide):
+        return None
+    return (f"of {len(values)} indices (S1, ST) {outside} lie outside [0, 1] beyond their confidence intervals and "
+            f"{wide} have intervals wider than +-{UNDETERMINED_CONF:g}: the base sample n = {n} is too small for them "
+            f"to mean anything; raise --n (a power of two, {max(4 * n, 256)} or more) or [sobol] n")
 
 
 def sobol_table(folder: str | Path) -> str:
@@ -205,8 +219,8 @@ def sobol_table(folder: str | Path) -> str:
                          "where the response is chaotic.")
     indices = [float(r[key]) for r in rows for key in ("S1", "ST")]
     conf = [float(r[f"{key}_conf"]) for r in rows for key in ("S1", "ST")]
-    outside = outside_unit_interval(indices, conf)
-    if outside:
-        n = int(meta.get("summary", {}).get("base_sample", meta["study"]["sobol"]["n"]))
-        lines.append(f"warning: {sample_size_advice(outside, len(indices), n)}")
+    advice = sample_size_advice(indices, conf, int(meta.get("summary", {}).get("base_sample",
+                                                                               meta["study"]["sobol"]["n"])))
+    if advice:
+        lines.append(f"warning: {advice}")
     return "\n".join(lines)
