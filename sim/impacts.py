@@ -191,8 +191,9 @@ EXCITATION_TOLERANCE = 0.1
 
 def check_excitation_hz(given: float, x: np.ndarray, fs: float, max_hz: float, what: str) -> float:
     """A given excitation frequency (Hz), positive and within EXCITATION_TOLERANCE of the signal's dominant component
-    below max_hz (`estimate_excitation_hz` of x, e.g. the tip acceleration `what`); one SimulationInputError line
-    otherwise. A signal too short for the estimate is taken at its word."""
+    below max_hz (`estimate_excitation_hz` of x, e.g. the tip acceleration `what`; on a short signal within two
+    frequency bins fs / n); one SimulationInputError line otherwise. A signal too short for the estimate is taken at
+    its word."""
     given = float(given)
     if not np.isfinite(given) or given <= 0:
         raise SimulationInputError(f"the excitation frequency must be positive (Hz), got {given!r}")
@@ -200,7 +201,8 @@ def check_excitation_hz(given: float, x: np.ndarray, fs: float, max_hz: float, w
         dominant = estimate_excitation_hz(x, fs, max_hz)
     except SimulationInputError:
         return given
-    if abs(given / dominant - 1.0) > EXCITATION_TOLERANCE:
+    resolution = fs / x.size  # Hz: a short signal knows its frequency only to a few of these
+    if abs(given - dominant) > max(EXCITATION_TOLERANCE * dominant, 2.0 * resolution):
         raise SimulationInputError(
             f"--excitation-hz {given:g} Hz is far from the signal's dominant frequency {dominant:.4g} Hz (in {what}, "
             f"more than {EXCITATION_TOLERANCE:.0%} apart); omit --excitation-hz to use the estimate, or check the "

@@ -193,10 +193,12 @@ def _connect(address: str):
                          "check the address (e.g. tcp://HOST:8786) and that the scheduler is running") from None
 
 
-#: serial work (s, one core) above which local worker processes pay off: starting them and loading the kernels in
-#: each costs about PARALLEL_OVERHEAD_S (10-12 s measured on the 2-core development machine under load, README);
-#: on C cores the parallel run wins when work > overhead x C / (C - 1)
-PARALLEL_OVERHEAD_S = 10.0
+#: what starting local worker processes costs (s): on C cores they win when the serial work exceeds this x C / (C - 1).
+#: Measured on the 2-core development machine shared with other work (a response study of 2-128 runs, --jobs 1
+#: against 2): below about 20 s of serial work --jobs 2 took 8-12 s longer; at 63 runs (about 75 s serial) it
+#: took 62 s against 73 s; at 127 runs the two were within the load's noise (81 and 94 s). The break-even lies near
+#: 60 s of serial work, hence 30 s.
+PARALLEL_OVERHEAD_S = 30.0
 
 
 def choose_jobs(jobs: int | None, work_s: float, cores: int | None = None, stream: Any = None) -> int:
