@@ -207,37 +207,30 @@ def scanned_wall(args: argparse.Namespace) -> GapSource:
     return GapSource(gap_at=gap_at, label=label, facts=facts)
 
 
-#: a crater wider than this many times the chord of the sphere pressed to the crater's depth, 2 sqrt(2 R d - d^2),
-#: is implausible for its units (the paper-like crater: 1.27 in mm, its rim included; 4.0 read in cm, 6.4 in inches)
-CHORD_FACTOR = 2.5
+#: a crater deeper than this (m) is implausible: the paper's is about 20 um deep (Sect. 4.1, the sphere flattened by
+#: 0.02 mm), and 0.1 mm would already widen the 0.58 mm clearance by a sixth (the paper-like crater read in cm: 0.12 mm)
+MAX_CRATER_DEPTH = 0.1e-3
 
 
 def crater_units_check(diameter: float, depth: float, units: str, source: str) -> list[str]:
     """Whether a crater of `diameter` and `depth` (m, as read in `units`) can be the sphere's (R = 7.92 mm, Sect. 2):
-    wider than the sphere is refused (ScanError: the units are wrong), wider than CHORD_FACTOR times the sphere's chord
-    at that depth is one warning (returned as a list of lines); each names the unit that would fit."""
-    import math
-
+    wider than the sphere is refused (ScanError: the units are wrong), deeper than MAX_CRATER_DEPTH is one warning
+    (returned as a list of lines); each names the unit that would fit."""
     from scans import ScanError
     from scans.io import UNITS
 
-    def chord_ratio(scale: float) -> float:
-        d = depth * scale
-        return diameter * scale / (2.0 * math.sqrt(max(2.0 * SPHERE_RADIUS * d - d * d, 1e-30)))
-
     def fits(unit: str) -> bool:
         scale = UNITS[unit] / UNITS[units]
-        return diameter * scale <= 2.0 * SPHERE_RADIUS and chord_ratio(scale) <= CHORD_FACTOR
+        return diameter * scale <= 2.0 * SPHERE_RADIUS and depth * scale <= MAX_CRATER_DEPTH
 
     if diameter <= 0 or depth <= 0 or units not in UNITS or fits(units):
         return []
     better = next((u for u in ("mm", "um", "cm", "m", "in") if fits(u)), None)
     hint = f"; the file looks like it is in {better}: use --units {better}" if better else "; check --units"
-    what = (f"{source}: read in {units}, the crater is {diameter * 1e3:.3g} mm across and {depth * 1e6:.3g} um deep")
+    what = f"{source}: read in {units}, the crater is {diameter * 1e3:.3g} mm across and {depth * 1e6:.3g} um deep"
     if diameter > 2.0 * SPHERE_RADIUS:
         raise ScanError(f"{what}: wider than the {2e3 * SPHERE_RADIUS:.2f} mm sphere that made it{hint}")
-    return [f"{what}: {chord_ratio(1.0):.1f} times the sphere's chord at that depth (a dent of the {SPHERE_RADIUS * 1e3:g} "
-            f"mm sphere is at most about {CHORD_FACTOR:g} times){hint}"]
+    return [f"{what}: deeper than {MAX_CRATER_DEPTH * 1e3:g} mm, implausible for impacts of the sphere{hint}"]
 
 
 def _reference(denoise: float, smoothing: float) -> str:
