@@ -112,7 +112,12 @@ def test_a_read_only_disk_is_exit_3_before_any_work(tmp_path, model_file, capsys
     assert names(tmp_path) == ["three.toml"]  # no --out folder left behind
 
 
-def test_a_full_disk_keeps_the_computed_trace_in_a_named_fallback(tmp_path, model_file, capsys, monkeypatch):
+@pytest.mark.parametrize("command, stem", [
+    (["trace", "--level", "6", "--eta", "0.99", "--wait", "0.02", "--periods", "2"], "trace"),
+    (["sweep", "--level", "6", *FAST], "sweep"),
+])
+def test_a_full_disk_keeps_the_computed_results_in_a_named_fallback(tmp_path, model_file, capsys, monkeypatch, command,
+                                                                    stem):
     monkeypatch.chdir(tmp_path)
     spare = tmp_path / "spare"
     spare.mkdir()
@@ -125,12 +130,11 @@ def test_a_full_disk_keeps_the_computed_trace_in_a_named_fallback(tmp_path, mode
         return write_bytes(path, data)
 
     monkeypatch.setattr(sim.files, "write_bytes", full_in_res)
-    code = main(["trace", "--level", "6", "--eta", "0.99", "--wait", "0.02", "--periods", "2", "--model", model_file,
-                 "--out", "res"])
-    line = one_line(capsys, code, 3, "No space left on device", "res/trace.csv", "written to")
+    code = main([*command, "--model", model_file, "--out", "res"])
+    line = one_line(capsys, code, 3, "No space left on device", f"res/{stem}.csv", "written to")
     fallback = Path(line.split("written to ")[1].split(" instead")[0])
-    assert fallback.parent == spare and sorted(p.name for p in fallback.iterdir()) == ["trace.csv", "trace.json"]
-    assert json.loads((fallback / "trace.json").read_text())["periods"] == 2
+    assert fallback.parent == spare and sorted(p.name for p in fallback.iterdir()) == [f"{stem}.csv", f"{stem}.json"]
+    assert json.loads((fallback / f"{stem}.json").read_text())["seed"] == 0
     assert not (tmp_path / "res").exists()  # the empty folder is removed: nothing half-written there
 
 
