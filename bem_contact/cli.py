@@ -18,7 +18,8 @@ Gaussian filter (--denoise, default 90 um; 0 = the raw scan, whose noise peaks b
 
 `--json` prints one object in SI units (also `calibration.json` of `ies reproduce`): k_H, k_H_star (Eq. 8),
 k_H_ratio, k_H_error (N/m^1.5, |k_H(N) - k_H(N/2)|), fit_residual, crater_depth, rim_height, crater_diameter,
-clearance_min, clearance_max (m), grid, solver, sphere, placement, holes, warnings, the curve and its settings;
+clearance_min, clearance_max (m), grid, solver, sphere, placement, holes, holes_in_contact_zone (a warning when a
+filled hole lies where the sphere touches, else null), warnings, the curve and its settings;
 with --tangential k_t and k_t_mindlin (N/m), contact_radius (m), normal_force and normal_force_for_paper (N).
 
 `add_commands(subparsers)` registers the command with the front door (`uq.cli`), which hands
@@ -194,8 +195,10 @@ def settings_of(args: argparse.Namespace) -> CalibrationSettings:
 
 
 def run(args: argparse.Namespace) -> int:
-    """`ies calibrate`: calibrate, plot on request, print the summary (text or JSON)."""
-    from sim.common.files import dumps, report_written
+    """`ies calibrate`: calibrate, print the summary (text or JSON), plot on request."""
+    from pathlib import Path
+
+    from sim.common.files import check_writable, dumps, report_written, write_or_fallback
 
     if args.normal_force is not None and not args.tangential:
         from bem_contact.errors import ContactInputError
@@ -209,12 +212,21 @@ def run(args: argparse.Namespace) -> int:
         data = tangential(args.normal_force, args.grid)
         print(dumps(data) if args.json else _tangential_text(data))
         return 0
+    if args.plot:
+        check_writable(args.plot, "--plot")  # before the contact solves
     result, source, E_star = calibrate(settings_of(args))
     data = summary(result, source, E_star)
-    if args.plot and data.get("geometry") == "scan":
-        scan_plot(data, source, args.plot)
-    elif args.plot:
-        plot(data, source.label, args.plot)
-    print(dumps(data) if args.json else _text(data, source.label))
+    print(dumps(data) if args.json else _text(data, source.label), flush=True)  # first: a refused figure loses nothing
+    if args.plot:
+        target = Path(args.plot)
+
+        def draw(folder: Path) -> None:
+            path = target if folder == target.parent else folder / target.name
+            if data.get("geometry") == "scan":
+                scan_plot(data, source, path)
+            else:
+                plot(data, source.label, path)
+
+        write_or_fallback(draw, target.parent, "calibrate")
     report_written([args.plot] if args.plot else [], json_mode=args.json)
     return 0

@@ -107,6 +107,7 @@ def scanned_wall(settings: CalibrationSettings) -> GapSource:
     scan = read_scan(path, units=settings.units, pixel_size=settings.pixel_size)
     surface = level_scan(scan, imprint=settings.imprint)
     metrics = crater_metrics(surface)
+    unit_warning = crater_units_check(metrics.diameter, metrics.depth, settings.units, scan.source)
     flattening = settings.flattening * 1e-3
     sphere = Sphere(SPHERE_RADIUS, flattening if settings.sphere == "flattened" else 0.0)
     side = None if settings.side_mm is None else settings.side_mm * 1e-3
@@ -141,7 +142,7 @@ def scanned_wall(settings: CalibrationSettings) -> GapSource:
         "flattening": flattening,
         "clearance_min": clearance_min,
         "clearance_max": clearance_max,
-        "warnings": list(metrics.warnings) + _noise_warnings(contact.denoise, metrics),
+        "warnings": list(metrics.warnings) + _noise_warnings(contact.denoise, metrics) + unit_warning,
     }
     if settings.scan is None:
         facts["scan_note"] = (f"shipped example: synthetic crater {PAPER_CRATER.depth * 1e6:g} um deep, "
@@ -155,6 +156,32 @@ def scanned_wall(settings: CalibrationSettings) -> GapSource:
     label = f"{scan.source}{' (imprint, inverted)' if surface.imprint else ''}, {sphere.describe()}"
     facts["_contact"], facts["_metrics"] = contact, metrics  # for the plot; not in the JSON
     return GapSource(gap_at=gap_at, label=label, facts=facts)
+
+
+#: a crater deeper than this (m) is implausible: the paper's is about 20 um deep (Sect. 4.1, the sphere flattened by
+#: 0.02 mm), and 0.1 mm would already widen the 0.58 mm clearance by a sixth (the paper-like crater read in cm: 0.12 mm)
+MAX_CRATER_DEPTH = 0.1e-3
+
+
+def crater_units_check(diameter: float, depth: float, units: str, source: str) -> list[str]:
+    """Whether a crater of `diameter` and `depth` (m, as read in `units`) can be the sphere's (R = 7.92 mm, Sect. 2):
+    wider than the sphere is refused (ScanError: the units are wrong), deeper than MAX_CRATER_DEPTH is one warning
+    (returned as a list of lines); each names the unit that would fit."""
+    from scans import ScanError
+    from scans.io import UNITS
+
+    def fits(unit: str) -> bool:
+        scale = UNITS[unit] / UNITS[units]
+        return diameter * scale <= 2.0 * SPHERE_RADIUS and depth * scale <= MAX_CRATER_DEPTH
+
+    if diameter <= 0 or depth <= 0 or units not in UNITS or fits(units):
+        return []
+    better = next((u for u in ("mm", "um", "cm", "m", "in") if fits(u)), None)
+    hint = f"; the file looks like it is in {better}: use --units {better}" if better else "; check --units"
+    what = f"{source}: read in {units}, the crater is {diameter * 1e3:.3g} mm across and {depth * 1e6:.3g} um deep"
+    if diameter > 2.0 * SPHERE_RADIUS:
+        raise ScanError(f"{what}: wider than the {2e3 * SPHERE_RADIUS:.2f} mm sphere that made it{hint}")
+    return [f"{what}: deeper than {MAX_CRATER_DEPTH * 1e3:g} mm, implausible for impacts of the sphere{hint}"]
 
 
 def _reference(denoise: float, smoothing: float) -> str:
@@ -229,12 +256,32 @@ def summary(result, source: GapSource, E_star: float) -> dict[str, Any]:
                      "forces": "N", "contact_areas": "m^2", "dx": "m", "side": "m", "R": "m", "E_star": "Pa",
                      "fit_residual": "1 (||f - k_H delta^1.5|| / ||f||)", "k_H_ratio": "1 (k_H / k_H*, Eq. 8)"}
     if data.get("geometry") == "scan":
+        data["holes_in_contact_zone"] = holes_in_contact_zone(data, source.facts["_contact"].holes.get(data["grid"]))
+        if data["holes_in_contact_zone"]:
+            data["warnings"] = [*data["warnings"], data["holes_in_contact_zone"]]
         data["units"].update({k: "m" for k in ("crater_depth", "rim_height", "crater_diameter", "clearance_min",
                                                 "clearance_max", "clearance_nominal", "flattening", "noise",
                                                 "sphere_flattening_in_bem", "sphere_axis_point", "smoothing",
                                                 "denoise")})
         data["units"].update({"wall_tilt_deg": "deg", "flat_fraction": "1", "sphere_axis_direction": "1 (unit normal)"})
     return data
+
+
+def holes_in_contact_zone(data: dict[str, Any], holes: Any) -> str | None:
+    """A warning when a filled hole of the scan (`scans.raster.HoleReport`) lies inside the contact zone at the
+    largest indentation (radius sqrt(A / pi) from the largest contact area A, m^2), where k_H then rests on
+    interpolated heights; None otherwise."""
+    import math
+
+    if holes is None or len(data.get("contact_areas", ())) == 0:
+        return None
+    radius = math.sqrt(float(data["contact_areas"][-1]) / math.pi)
+    if not holes.nearest <= radius:
+        return None
+    return (f"a filled hole lies inside the contact zone: its nearest node is {holes.nearest * 1e6:.0f} um from the "
+            f"sphere's axis, the contact radius at {data['deltas'][-1] * 1e6:g} um indentation is {radius * 1e6:.0f} um; "
+            "k_H rests on interpolated heights there: rescan the crater without the dropout, or compare with the "
+            "hole elsewhere")
 
 
 def tangential(normal_force: float | None = None, grid: int | None = None) -> dict[str, Any]:

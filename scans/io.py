@@ -28,6 +28,8 @@ UNITS: dict[str, float] = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": 0
 MESH_SUFFIXES = {".stl": "stl", ".ply": "ply", ".obj": "obj", ".off": "off"}
 POINT_SUFFIXES = {".xyz", ".csv", ".txt", ".asc", ".pts"}
 ARRAY_SUFFIXES = {".npy", ".npz"}
+#: the names under which a .npz file may hold its height map
+HEIGHT_KEYS = ("height", "heights", "z", "h")
 SUPPORTED = sorted(set(MESH_SUFFIXES) | POINT_SUFFIXES | ARRAY_SUFFIXES)
 
 #: lateral size (m) of a plausible scanned patch of a cavity wall: from 0.1 mm to 1 m
@@ -169,7 +171,7 @@ def _read_mesh(path: Path, file_type: str) -> tuple[np.ndarray, np.ndarray | Non
 
 def _read_points_text(path: Path) -> np.ndarray:
     try:
-        text = path.read_bytes().decode("utf-8")
+        text = path.read_bytes().decode("utf-8-sig")  # without the byte-order mark spreadsheets write
     except UnicodeDecodeError:
         raise ScanError(f"{path.name}: not a text point cloud (binary bytes found); expected x y z columns") from None
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith(("#", "//", "%"))]
@@ -202,11 +204,10 @@ def _read_array(path: Path, pixel_size: float | None) -> tuple[np.ndarray, np.nd
             arrays = {"height": loaded}
     except Exception as exc:  # numpy raises ValueError, OSError, EOFError, TokenError, BadZipFile, ... on corrupt files
         raise ScanError(f"{path.name}: cannot read as {path.suffix} array ({_short(exc)}); the file is corrupt or truncated") from None
-    height = next((arrays[k] for k in ("height", "heights", "z", "h") if k in arrays), None)
-    if height is None and len(arrays) == 1:
-        height = next(iter(arrays.values()))
-    if height is None:
-        raise ScanError(f"{path.name}: no 'height' array (found {', '.join(arrays) or 'nothing'}); save with np.savez(f, height=..., pixel_size=...)")
+    height = next((arrays[k] for k in HEIGHT_KEYS if k in arrays), None)
+    if height is None:  # an array under another name may be anything (a mask, a colour channel): never guessed
+        raise ScanError(f"{path.name}: no 'height' array (found {', '.join(arrays) or 'nothing'}; a height map is read "
+                       f"only under {', '.join(HEIGHT_KEYS)}); save with np.savez(f, height=..., pixel_size=...)")
     height = np.asarray(height)
     if not np.issubdtype(height.dtype, np.number):
         raise ScanError(f"{path.name}: the array is not numeric")

@@ -62,13 +62,15 @@ class HoleReport:
     """Grid nodes the scan did not cover and how they were filled.
 
     n_holes: connected missing regions; n_nodes: missing nodes; largest: the largest region's size
-    across (m, equivalent-circle diameter); method: how they were filled.
+    across (m, equivalent-circle diameter); method: how they were filled; nearest: distance (m) from the grid's
+    centre (on a BEM grid the sphere's axis) to the nearest filled node, inf when there is none or it is unknown.
     """
 
     n_holes: int
     n_nodes: int
     largest: float
     method: str = "a quadratic fitted around each hole plus a harmonic (Laplace) correction"
+    nearest: float = float("inf")
 
     def describe(self) -> str:
         """One line for the command output."""

@@ -14,6 +14,7 @@ cloud or height map has no winding, so its +z axis is taken as the outward side.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -100,6 +101,10 @@ class LevelledSurface:
             if missing.all():
                 raise ScanError(f"{self.source}: the grid does not overlap the scan")
         filled, holes = fill_holes(height, dx)
+        if missing.any():  # how close the filled nodes come to the sphere's axis (node n // 2, n // 2)
+            jj, ii = np.nonzero(missing)
+            nearest = float(np.hypot(ii - n // 2, jj - n // 2).min() * dx)
+            holes = dataclasses.replace(holes, nearest=nearest)
         return filled, dx, holes
 
 

@@ -142,6 +142,10 @@ def modes_command(args: argparse.Namespace) -> int:
     from sim.hosts.modal_file import save_modal_model
     from sim.hosts.sources import host_model
 
+    if args.save:
+        from sim.common.files import check_writable
+
+        check_writable(args.save, "--save")  # before a solid model or a re-update takes minutes
     host = host_model(args)  # the row of sim.hosts.sources.HOST_SOURCES the options select
     model, rig, provenance, report = host.model, host.rig, host.provenance, host.report
     data = describe_modes(model, rig)
@@ -202,9 +206,10 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--perturbation", type=float, default=5e-4, metavar="REL",
                         help="half-width of the uniform random relative frequency offset (default 5e-4)")
     parser.add_argument("--perturb", default="start", choices=("start", "each-point"),
-                        help="what the offset perturbs: the first wait of each run, every hold at the nominal "
-                             "frequency (default, the paper's Sect. 5.1), or every point, each sample interpolated "
-                             "back onto the grid from the frequencies simulated")
+                        help="what the offset perturbs: start (default, the paper's Sect. 5.1): one offset per run, "
+                             "for a lead-in before the first point, then every point waits and holds at its nominal "
+                             "frequency; each-point: every point its own offset, each sample interpolated back onto "
+                             "the grid from the frequencies simulated")
     parser.add_argument("--integrator", default="exact", metavar="NAME",
                         help="time integrator: exact (default; closed-form free flight, located contacts) or ode3 (the paper's fixed step)")
     parser.add_argument("--dt-scale", dest="dt_scale", type=float, default=1.0, metavar="X",
@@ -219,6 +224,13 @@ def add_simulation_arguments(parser: argparse.ArgumentParser, *, default_reps: i
     parser.add_argument("--plot", type=figure_file, metavar="FILE",
                         help=f"write a {figure}-like plot (format by suffix: .png, .pdf, .svg, ...)")
     parser.add_argument("--out", metavar="DIR", help=f"write {stem}.csv (data) and {stem}.json (data + metadata)")
+    add_force_argument(parser)
+
+
+def add_force_argument(parser: argparse.ArgumentParser) -> None:
+    """--force: write into a non-empty --out folder (its files of the same names are replaced)."""
+    parser.add_argument("--force", action="store_true",
+                        help="write into a non-empty --out folder, replacing its files of the same names (default: refuse)")
 
 
 def parse_grid(text: str, option: str) -> tuple[float, float, int]:
@@ -247,13 +259,20 @@ def parse_levels(text: str) -> list[float]:
             raise SimulationInputError(f"--levels {text!r} is empty or reversed; give START < STOP and N >= 1")
         values = list(np.linspace(start, stop, n))
     else:
+        items = text.split(",")
+        if len(items) > 1 and any(not v.strip() for v in items):
+            raise SimulationInputError(f"--levels {text!r} has an empty entry; give numbers like 1.26,5.3,6.7")
         try:
-            values = [float(v) for v in text.split(",") if v.strip()]
+            values = [float(v) for v in items if v.strip()]
         except ValueError:
             raise SimulationInputError(
                 f"--levels must be numbers like 1.26,5.3,6.7 or a grid START:STOP:N, got {text!r}") from None
     if not values:
         raise SimulationInputError("--levels is empty; give at least one excitation level")
+    repeated = sorted({v for v in values if values.count(v) > 1})
+    if repeated:
+        raise SimulationInputError(f"--levels {text!r} repeats {', '.join(f'{v:g}' for v in repeated)}; give each "
+                                   "excitation level once (more repetitions: --reps)")
     return [check_level(v) for v in values]
 
 
@@ -300,18 +319,31 @@ def build_protocol(args: argparse.Namespace) -> Any:
 
 
 @contextmanager
-def output_folder(path: str | None) -> Iterator[Path | None]:
-    """--out DIR, created up front (a clear error if it cannot be a folder) and removed again if the command
-    fails before writing anything into it (no empty result folders after a bad input)."""
+def output_folder(path: str | None, force: bool = False) -> Iterator[Path | None]:
+    """--out DIR, created up front and proved writable (a clear error if it cannot be a folder, holds earlier
+    results and `force` is not given, or the disk refuses a file) and removed again if the command fails before
+    writing anything into it (no empty result folders after a bad input)."""
+    from sim.common.errors import ResourceFailure
+    from sim.common.files import RESOURCE_ERRNOS, check_writable
+
     if path is None:
         yield None
         return
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
         raise SimulationInputError(f"--out {folder} exists and is not a folder; choose another path")
+    if folder.is_dir() and not force and any(folder.iterdir()):
+        raise SimulationInputError(f"--out {folder} is not empty (earlier results?); choose another folder or pass "
+                                   "--force to replace its files")
     created = not folder.exists()
-    folder.mkdir(parents=True, exist_ok=True)
     try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        error = ResourceFailure if exc.errno in RESOURCE_ERRNOS else SimulationInputError
+        raise error(f"cannot create --out {folder} ({exc.strerror or exc}); choose another folder (nothing was "
+                    "computed)") from None
+    try:
+        check_writable(folder, "--out", folder=True)
         yield folder
     except BaseException:
         if created and not any(folder.iterdir()):
@@ -333,15 +365,23 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
 
     from tqdm import tqdm
 
+    from sim.common.files import check_writable
     from sim.integration.integrators import warm_up
+    from sim.stepped_sine.cost import announce, cost_per_simulated_second, simulated_seconds
     from sim.stepped_sine.protocol import sweep
 
     protocol = build_protocol(args)
     model, impactor = build_system(args)
+    if args.plot:
+        check_writable(args.plot, "--plot")
     total = len(levels) * args.reps * len(protocol.legs) * protocol.n_eta
     long_run = len(levels) > 1 or total * (protocol.wait + protocol.hold) > LONG_SWEEP_S
-    with output_folder(args.out) as folder:
+    with output_folder(args.out, args.force) as folder:
         warm_up(protocol.integrator, damped=impactor is not None and impactor.contact_law.dissipative)
+        per_run = simulated_seconds(protocol, float(model.omega[0]))
+        if len(levels) * args.reps * per_run > LONG_SWEEP_S:  # long enough to be worth the probe (< 1 s)
+            announce(len(levels) * args.reps, per_run, cost_per_simulated_second(model, impactor, max(levels), protocol),
+                     "lower --reps, the --eta points, --wait/--hold or the number of levels")
         with tqdm(total=total, desc=label, unit="pt", disable=not (long_run and sys.stderr.isatty()), leave=False,
                   file=sys.stderr, dynamic_ncols=True) as bar:
             results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed, progress=bar.update)
@@ -351,22 +391,27 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
 
 def write_results(folder: Path | None, stem: str, header: Sequence[str], rows: Any, data: dict) -> list[Path]:
     """With --out: the table as STEM.csv (data) and `data` as STEM.json (data + metadata); the paths written."""
-    from sim.common.files import dumps, write_csv, write_text
+    from sim.common.files import dumps, write_csv, write_or_fallback, write_text
 
     if folder is None:
         return []
-    return [write_csv(folder / f"{stem}.csv", header, rows), write_text(folder / f"{stem}.json", dumps(data) + "\n")]
+    rows = list(rows)
+    return write_or_fallback(lambda where: [write_csv(where / f"{stem}.csv", header, rows),
+                                            write_text(where / f"{stem}.json", dumps(data) + "\n")], folder, stem)
 
 
 def report(args: argparse.Namespace, data: dict, written: list, plot: Any, text: str) -> int:
-    """End of `ies sweep`/`ies overview`: draw `--plot` with plot(path), then print the JSON object (`--json`)
-    or the text table, and a `wrote PATH` line per file written; exit code 0."""
-    from sim.common.files import dumps, report_written
+    """End of `ies sweep`/`ies overview`: print the JSON object (`--json`) or the text table, draw `--plot` with
+    plot(path) (into a named fallback folder if the disk refuses it), and a `wrote PATH` line per file written;
+    exit code 0."""
+    from sim.common.files import dumps, report_written, write_or_fallback
 
+    print(dumps(data) if args.json else text, flush=True)  # the results first: a figure the disk refuses loses nothing
     if args.plot:
-        plot(args.plot)
+        target = Path(args.plot)
+        write_or_fallback(lambda where: plot(target if where == target.parent else where / target.name), target.parent,
+                          "plot")
         written.append(args.plot)
-    print(dumps(data) if args.json else text)
     report_written(written, json_mode=args.json)
     return 0
 
@@ -447,6 +492,7 @@ def add_trace_arguments(parser: argparse.ArgumentParser) -> None:
     add_run_arguments(parser)
     add_system_arguments(parser)
     parser.add_argument("--out", required=True, metavar="DIR", help="write trace.csv (the signals) and trace.json")
+    add_force_argument(parser)
     parser.add_argument("--json", action="store_true", help="print trace.json's object")
     parser.add_argument("--plot", type=figure_file, metavar="FILE",
                         help="write Figs. 4 (tip response, amplitudes, mean and max) and 9a (tip velocity, impacts) "
@@ -455,24 +501,35 @@ def add_trace_arguments(parser: argparse.ArgumentParser) -> None:
 
 def trace_command(args: argparse.Namespace) -> int:
     """`ies trace`: time histories of one stepped-sine point (Sects. 5.1, 5.5; Figs. 4, 9a)."""
-    from sim.common.files import dumps, report_written
+    from sim.analysis.trace import SAMPLE_COST_S, check_trace_settings, record_trace, trace_samples, write_trace
+    from sim.common.files import check_writable, dumps, report_written, write_or_fallback
     from sim.integration.integrators import warm_up
+    from sim.stepped_sine.cost import announce, check_trace_memory, cost_per_simulated_second, simulated_seconds
     from sim.stepped_sine.protocol import check_level
-    from sim.analysis.trace import check_trace_settings, record_trace, write_trace
 
     started = time.perf_counter()
     level = check_level(args.level)
     protocol = build_protocol(args)
     model, impactor = build_system(args)
     check_trace_settings(model, protocol, args.periods, args.fs)  # before the kernels compile
-    if args.plot and not Path(args.plot).resolve().parent.is_dir():
-        raise SimulationInputError(f"--plot {args.plot}: folder {Path(args.plot).parent} does not exist")
-    with output_folder(args.out) as folder:
+    samples = trace_samples(model, protocol, args.periods, args.fs)
+    check_trace_memory(samples, model.n_modes, "lower --periods or --fs")
+    if args.plot:
+        check_writable(args.plot, "--plot")
+    with output_folder(args.out, args.force) as folder:
         warm_up(protocol.integrator, damped=impactor is not None and impactor.contact_law.dissipative)
+        per_run = (simulated_seconds(protocol, float(model.omega[0]))
+                   + args.periods / (protocol.eta[-1] * model.frequencies_hz[0]))  # the recorded periods
+        announce(1, per_run,
+                 cost_per_simulated_second(model, impactor, level, protocol) + samples / per_run * SAMPLE_COST_S,
+                 "lower --periods, --fs, the --eta points or --wait/--hold")
         trace = record_trace(model, impactor, level, protocol, periods=args.periods, fs=args.fs, seed=args.seed)
         settings = {"integrator": protocol.integrator, "seed": args.seed, "protocol": dataclasses.asdict(protocol),
                     "fs_requested": args.fs, **system_data(model, impactor)}
-        data, written = write_trace(folder, trace, settings, args.plot, started)
+        plot = Path(args.plot) if args.plot else None
+        data, written = write_or_fallback(
+            lambda where: write_trace(where, trace, settings, plot if where == folder or plot is None else where / plot.name,
+                                      started), folder, "trace")
     if args.json:
         print(dumps(data))
         report_written(written, json_mode=True)

@@ -8,12 +8,14 @@ imports the contact stage), and turns the stages' errors into exit codes. It is 
 imports scans and bem_contact (their error classes and the calibration).
 
 User mistakes end with one line on stderr, ``ies <command>: error: <what and how to fix>``,
-and exit code 2; numerical failures and a batch cluster without workers exit with code 3. No traceback for either.
+and exit code 2; numerical failures, resource failures (a read-only or full disk, too little memory) and a
+batch cluster without workers exit with code 3. No traceback for either.
 """
 from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 from typing import Sequence
 
@@ -23,7 +25,8 @@ import sim.cli
 import uq.commands
 from bem_contact.errors import ContactInputError, ConvergenceError
 from scans.errors import ScanError
-from sim.common.errors import SimulationDiverged, SimulationInputError
+from sim.common.errors import ResourceFailure, SimulationDiverged, SimulationInputError
+from sim.common.files import RESOURCE_ERRNOS
 from uq.errors import ClusterUnavailable, StudyError
 
 USER_ERRORS = (ContactInputError, ScanError, SimulationInputError, StudyError)
@@ -41,7 +44,15 @@ STAGES = (
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse prints usage + message on error; we keep the one-line message and exit 2."""
+    """argparse prints usage + message on error; we keep the one-line message and exit 2.
+
+    A value that starts with a minus and a digit (``--g -0.5mm``, ``--level -6``) is taken as the option's value,
+    not as an option (argparse's own rule covers bare numbers only), so the value's own check refuses it clearly.
+    """
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
 
     def error(self, message: str) -> None:  # noqa: D401 - argparse API
         sys.stderr.write(f"{self.prog}: error: {message}\n")
@@ -93,18 +104,31 @@ def main(argv: Sequence[str] | None = None) -> int:
     except RESOURCE_FAILURES as exc:
         sys.stderr.write(f"{prog}: cluster failure: {exc}\n")
         return 3
-    except (FileNotFoundError, IsADirectoryError, NotADirectoryError, PermissionError) as exc:
-        where = f": {exc.filename}" if getattr(exc, "filename", None) else ""
-        sys.stderr.write(f"{prog}: error: {exc.strerror or exc}{where}\n")
-        return 2
-    except KeyboardInterrupt:
-        sys.stderr.write(f"{prog}: interrupted; finished results were kept (rerun with --resume where offered)\n")
-        return 130
     except BrokenPipeError:
         # e.g. `ies modes --json | head`; silence the second error at interpreter exit
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 0
+    except ResourceFailure as exc:
+        sys.stderr.write(f"{prog}: resource failure: {exc}\n")
+        return 3
+    except MemoryError:
+        sys.stderr.write(f"{prog}: resource failure: out of memory; ask for less (fewer periods, samples, levels or "
+                         "repetitions) or free memory\n")
+        return 3
+    except OSError as exc:
+        where = f": {exc.filename}" if getattr(exc, "filename", None) else ""
+        if exc.errno in RESOURCE_ERRNOS:
+            sys.stderr.write(f"{prog}: resource failure: {exc.strerror or exc}{where}; nothing more was written\n")
+            return 3
+        sys.stderr.write(f"{prog}: error: {exc.strerror or exc}{where}\n")
+        return 2
+    except KeyboardInterrupt:
+        if getattr(args, "resume", None) is not None:
+            sys.stderr.write(f"{prog}: interrupted; finished results were kept (rerun with --resume)\n")
+        else:
+            sys.stderr.write(f"{prog}: interrupted; no results were written (rerun the command)\n")
+        return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -26,7 +26,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import functools
-import os
 import sys
 from collections.abc import Callable
 from dataclasses import replace
@@ -48,6 +47,9 @@ REPRODUCE_HELP = ("reproduce the paper's Figs. 5 and 6 (nominal response), 7 and
 PLOT_HELP = "redraw a result folder's figures from its saved data (formats, style, levels) without recomputing"
 COMPARE_HELP = ("the Fig. 6 landmarks of several response studies side by side with the paper's: switch, optimum, "
                 "levels at 7.4 and 9, impacts, r and energy share at 7.4 (table and figure)")
+JOBS_HELP = ("local worker processes (1 runs in this process; default: the first run is timed here, then one worker per "
+             "CPU core if the rest takes longer than starting the workers, else serially; more than the cores warns)")
+
 
 def add_commands(subparsers: Any, *, calibrate: Calibrate) -> None:
     """Register `interval`, `sobol`, `response`, `reproduce`, `plot` and `compare` on the front door's subparsers (argparse);
@@ -72,8 +74,7 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     from uq.cluster import add_cluster_arguments
 
     parser.add_argument("--out", type=Path, metavar="DIR", help="output folder (default: the study's [study] output)")
-    parser.add_argument("--jobs", type=positive_int, default=os.cpu_count() or 1, metavar="N",
-                        help="local worker processes (default: the number of CPU cores; 1 runs in this process)")
+    parser.add_argument("--jobs", type=positive_int, default=None, metavar="N", help=JOBS_HELP)
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="run on a Dask cluster, e.g. tcp://host:8786 (needs dask.distributed)")
     parser.add_argument("--resume", action="store_true",
@@ -225,8 +226,7 @@ def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
                         help="reduced protocol (fewer levels, frequencies, repetitions, shorter holds); same trends")
     parser.add_argument("--out", type=Path, default=Path("ies-out/reproduce"), metavar="DIR",
                         help="output folder (default ies-out/reproduce)")
-    parser.add_argument("--jobs", type=positive_int, default=os.cpu_count() or 1, metavar="N",
-                        help="local worker processes (default: the number of CPU cores)")
+    parser.add_argument("--jobs", type=positive_int, default=None, metavar="N", help=JOBS_HELP)
     parser.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://host:8786")
     parser.add_argument("--resume", action="store_true", help="continue an interrupted reproduction in --out")
     from uq.cluster import add_cluster_arguments
@@ -401,6 +401,8 @@ def add_compare_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--style", metavar="NAME|FILE",
                         help="a matplotlib style (e.g. seaborn-v0_8-paper, grayscale) or a .mplstyle file")
     parser.add_argument("--json", action="store_true", help="print the rows as one JSON object instead of the table")
+    parser.add_argument("--force", action="store_true",
+                        help="write into a non-empty --out folder, replacing its files of the same names (default: refuse)")
 
 
 def compare_command(args: argparse.Namespace) -> int:
@@ -417,11 +419,20 @@ def compare_command(args: argparse.Namespace) -> int:
         read_response_folder,
     )
 
+    seen: dict[Path, Path] = {}
+    for folder in args.folders:
+        if folder.resolve() in seen:
+            raise SimulationInputError(f"{folder} is given twice (also as {seen[folder.resolve()]}); give each study's "
+                                       "folder once")
+        seen[folder.resolve()] = folder
     studies = [read_response_folder(folder) for folder in args.folders]
     rows = [compare_row(study) for study in studies]
     context = style(args.style)
     if args.out.exists() and not args.out.is_dir():
         raise SimulationInputError(f"--out {args.out} exists and is not a folder; choose another path")
+    if args.out.is_dir() and not args.force and any(args.out.iterdir()):
+        raise SimulationInputError(f"--out {args.out} is not empty (an earlier comparison?); choose another folder or "
+                                   "pass --force to replace its files")
     args.out.mkdir(parents=True, exist_ok=True)
     written = [write_csv(args.out / "compare.csv", COMPARE_COLUMNS,
                          [[row[key] for key in COMPARE_COLUMNS] for row in (*rows, PAPER_ROW)]),

@@ -351,7 +351,7 @@ def verification_model(problem: DesignProblem) -> Any:
     return IESModel(protocol=dict(problem.protocol), modal_file=problem.modal_file)
 
 
-def verify(problem: DesignProblem, spheres: Sequence[Sphere], model: Any, folder: Any, *, jobs: int,
+def verify(problem: DesignProblem, spheres: Sequence[Sphere], model: Any, folder: Any, *, jobs: int | None,
            scheduler: str | None, progress: bool, client: Any = None) -> list[Verified]:
     """Stage 2: every corner and nominal point of every design at every level and repetition, through the study
     runner (`uq.runner.run_tasks`: cached in `folder`/tasks, resumable)."""
@@ -427,8 +427,8 @@ def _um(a: float) -> str:
     return f"{a * 1e6:.3g}"
 
 
-def run_design(problem: DesignProblem, out: Any, *, jobs: int = 1, scheduler: str | None = None, resume: bool = False,
-               progress: bool = True, figures: bool = True, client: Any = None) -> DesignResult:
+def run_design(problem: DesignProblem, out: Any, *, jobs: int | None = 1, scheduler: str | None = None,
+               resume: bool = False, progress: bool = True, figures: bool = True, client: Any = None) -> DesignResult:
     """Screen, verify and write a design into the folder `out` (design.csv, design.json, design-levels.csv, the
     figures): checks everything before any simulation; `resume` continues an interrupted design."""
     from pathlib import Path

@@ -192,7 +192,7 @@ def study_key(study: Study, model: Any) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, *, resume: bool, jobs: int,
+def _run_points(study: Study, model: Any, points: list[dict], out: Path | None, *, resume: bool, jobs: int | None,
                 scheduler: str | None, progress: bool, client: Any) -> tuple[Any, StudyResult, dict, int, float]:
     """Connect to the cluster once (if any), then prepare the output folder and run every task of `points`.
 
@@ -235,7 +235,7 @@ def interval_designs(study: Study) -> list[Design]:
     return designs
 
 
-def run_interval_study(study: Study, *, out: Path | None = None, jobs: int = 1, scheduler: str | None = None,
+def run_interval_study(study: Study, *, out: Path | None = None, jobs: int | None = 1, scheduler: str | None = None,
                        resume: bool = False, progress: bool = True, client: Any = None) -> StudyResult:
     """Interval study (Figs. 7 and 8): bands of the repetition-mean resonant levels per excitation level."""
     model = _checked_model(study)
@@ -374,13 +374,14 @@ def _band_with_failures(design: Design, mean: np.ndarray, se: np.ndarray, z: flo
                 tested=cat("tested"), notes=notes)
 
 
-def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = None, jobs: int = 1,
+def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = None, jobs: int | None = 1,
                     scheduler: str | None = None, resume: bool = False, progress: bool = True,
                     client: Any = None) -> StudyResult:
     """Sobol' study: S1, ST (bootstrap CI) of the repetition-mean resonant levels per excitation level,
     with the share of their variance that is repetition noise; from Saltelli's sample of n (k + 2) points
     (`uq.sobol`), or with [sobol] method = "pce" from a polynomial-chaos surrogate of a Latin hypercube's points
     (`uq.surrogate`; its fit and smoothness verdict in surrogate.csv)."""
+    from uq.results import sample_size_advice
     from uq.sobol import sobol_indices, sobol_sample
     from uq.surrogate import pce_indices, pce_sample
 
@@ -418,6 +419,9 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                 _warn(result, f"{o} at level {level:g}: not analysed: {res.message}")
             for k, pname in enumerate(res.names):
                 rows.append([o, level, pname, res.S1[k], res.S1_conf[k], res.ST[k], res.ST_conf[k]])
+            advice = None if pce else sample_size_advice([*res.S1, *res.ST], [*res.S1_conf, *res.ST_conf], n)
+            if advice and not res.message:
+                _warn(result, f"{o} at level {level:g}: {advice}")
             summary_rows.append([o, level, res.variance, res.noise_variance, res.noise_share, res.failed_runs,
                                  res.message])
             per_level[f"{o}@{level:g}"] = {"noise_share": res.noise_share, "failed_runs": res.failed_runs}
@@ -492,7 +496,7 @@ RESULTS_NC = OutputFile("results.nc", "every study folder, ies design", "Every n
 ))
 
 
-def run_response_study(study: Study, *, out: Path | None = None, jobs: int = 1, scheduler: str | None = None,
+def run_response_study(study: Study, *, out: Path | None = None, jobs: int | None = 1, scheduler: str | None = None,
                        resume: bool = False, progress: bool = True, client: Any = None) -> StudyResult:
     """Response study (Figs. 5 and 6): the frequency response of the nominal point at every level (mean and max
     amplitude per eta with the spread of the runs, Sect. 5.2) and its resonant levels (Sect. 5.3), every
@@ -555,7 +559,7 @@ def _response_netcdf(study: Study, model: Any, folder: Path, point: dict, result
                   folder)
 
 
-def _run_response_series(study: Study, *, out: Path | None, jobs: int, scheduler: str | None, resume: bool,
+def _run_response_series(study: Study, *, out: Path | None, jobs: int | None, scheduler: str | None, resume: bool,
                          progress: bool, client: Any) -> StudyResult:
     """[response] series (Fig. 11): the response study once per value of the series' parameter, each in its own
     folder OUT/NAME=VALUE (resumable like any study), and OUT/study.json naming them."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -168,6 +169,34 @@ def band_table(folder: str | Path, output: str | None = None) -> str:
 NOISE_DOMINATES = 0.5
 
 
+def outside_unit_interval(values: Sequence[float], conf: Sequence[float]) -> int:
+    """How many Sobol' indices lie outside [0, 1] by more than their confidence half-width (an index is a share of
+    the variance: beyond its CI outside [0, 1] it says the base sample n is too small, not something about the model)."""
+    v, c = np.asarray(values, dtype=float), np.nan_to_num(np.asarray(conf, dtype=float))
+    return int(np.sum(np.isfinite(v) & ((v < -c) | (v > 1.0 + c))))
+
+
+#: a confidence half-width above which an index says nothing (its interval spans most of [0, 1])
+UNDETERMINED_CONF = 0.5
+
+
+def undetermined(conf: Sequence[float]) -> int:
+    """How many Sobol' indices have a confidence half-width above UNDETERMINED_CONF (or none at all)."""
+    c = np.asarray(conf, dtype=float)
+    return int(np.sum(~np.isfinite(c) | (c > UNDETERMINED_CONF)))
+
+
+def sample_size_advice(values: Sequence[float], conf: Sequence[float], n: int) -> str | None:
+    """The line that says indices outside [0, 1] beyond their CI (`outside_unit_interval`) or with CIs wider than
+    +-UNDETERMINED_CONF mean too small a base sample n, and what to do; None when neither occurs."""
+    outside, wide = outside_unit_interval(values, conf), undetermined(conf)
+    if not (outside or wide):
+        return None
+    return (f"of {len(values)} indices (S1, ST) {outside} lie outside [0, 1] beyond their confidence intervals and "
+            f"{wide} have intervals wider than +-{UNDETERMINED_CONF:g}: the base sample n = {n} is too small for them "
+            f"to mean anything; raise --n (a power of two, {max(4 * n, 256)} or more) or [sobol] n")
+
+
 def sobol_table(folder: str | Path) -> str:
     """Text table of S1 and ST with their confidence intervals per output, level and parameter, the repetition
     noise's share of the variance per level, and, where noise dominates, what it means and what to change."""
@@ -204,6 +233,13 @@ def sobol_table(folder: str | Path) -> str:
                          f"1/repetitions (now {repetitions}): raise [study] repetitions or the hold time, or choose "
                          "levels away from the switch between the strongly modulated and the almost periodic response, "
                          "where the response is chaotic.")
+    indices = [float(r[key]) for r in rows for key in ("S1", "ST")]
+    conf = [float(r[f"{key}_conf"]) for r in rows for key in ("S1", "ST")]
+    base_sample = meta.get("summary", {}).get("base_sample", meta["study"]["sobol"].get("n"))
+    # a surrogate's indices have no base sample n: its fit lines above say how far to trust them
+    advice = None if fits is not None or base_sample is None else sample_size_advice(indices, conf, int(base_sample))
+    if advice:
+        lines.append(f"warning: {advice}")
     return "\n".join(lines)
 
 

@@ -197,18 +197,44 @@ def _connect(address: str):
                          "check the address (e.g. tcp://HOST:8786) and that the scheduler is running") from None
 
 
-def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultStore, *, jobs: int = 1,
+#: what starting local worker processes costs (s): on C cores they win when the serial work exceeds this x C / (C - 1).
+#: Measured on the 2-core development machine shared with other work (a response study of 2-128 runs, --jobs 1
+#: against 2): below about 20 s of serial work --jobs 2 took 8-12 s longer; at 63 runs (about 75 s serial) it
+#: took 62 s against 73 s; at 127 runs the two were within the load's noise (81 and 94 s). The break-even lies near
+#: 60 s of serial work, hence 30 s.
+PARALLEL_OVERHEAD_S = 30.0
+
+
+def choose_jobs(jobs: int | None, work_s: float, cores: int | None = None, stream: Any = None) -> int:
+    """Worker processes for `work_s` seconds of remaining serial work: `jobs` as given (a warning line on `stream`,
+    stderr, when it exceeds the cores: the runs then compete for them), or with None one per core when the work
+    outweighs the workers' start (PARALLEL_OVERHEAD_S), else 1 (in this process)."""
+    cores = cores or os.cpu_count() or 1
+    stream = stream or sys.stderr
+    if jobs is not None:
+        if jobs > cores:
+            stream.write(f"warning: --jobs {jobs} is more than the {cores} CPU core(s): the runs compete for them and "
+                         f"take longer, not less; use --jobs {cores} or leave it out\n")
+        return jobs
+    if cores == 1:
+        return 1
+    return cores if work_s > PARALLEL_OVERHEAD_S * cores / (cores - 1) else 1
+
+
+def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultStore, *, jobs: int | None = 1,
               scheduler: str | None = None, progress: bool = True, client: Any = None) -> tuple[dict[Task, dict], int]:
     """Run every task whose result is not in `store`; return all results by task and how many ran now.
 
-    jobs: local worker processes (joblib/loky; 1 = in this process). scheduler: a Dask scheduler
-    address (`client` may be passed instead, e.g. in tests): every task is submitted to the cluster, whatever
-    its size. Each result is saved as it arrives, so an interruption (Ctrl-C, a killed process, a lost
-    scheduler) loses only the tasks in flight; a lost scheduler is one StudyError line that names `--resume`.
+    jobs: local worker processes (joblib/loky; 1 = in this process; None: `choose_jobs` after timing the first task
+    in this process, which also gives the cost estimate of the rest, `sim.stepped_sine.cost.announce_runs`).
+    scheduler: a Dask scheduler address (`client` may be passed instead, e.g. in tests): every task is submitted
+    to the cluster, whatever its size. Each result is saved as it arrives, so an interruption (Ctrl-C, a killed
+    process, a lost scheduler) loses only the tasks in flight; a lost scheduler is one StudyError line that names
+    `--resume`.
     """
     from tqdm import tqdm
 
-    if jobs < 1:
+    if jobs is not None and jobs < 1:
         raise StudyError(f"--jobs must be >= 1, got {jobs}")
     version = model.version()
     keyer = _keyer(model, seed, version)
@@ -232,10 +258,23 @@ def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultSt
     return {task: store.load(key) for task, key in keys.items()}, len(pending)
 
 
-def _run_and_store(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int, client: Any,
+def _run_and_store(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int | None, client: Any,
                    store: ResultStore, bar: Any, total: int) -> None:
     """Save each result as it arrives; a lost Dask scheduler becomes one StudyError line."""
+    from sim.stepped_sine.cost import announce_runs
+
     done = total - len(pending)
+    if client is None and pending:  # locally the first task runs here: its time sizes the rest
+        key, task = pending[0]
+        started = time.perf_counter()
+        store.save(key, task, evaluate(model, task, seed))
+        done += 1
+        bar.update(1)
+        pending = pending[1:]
+        per_run = time.perf_counter() - started
+        announce_runs(len(pending), per_run, "interrupt with Ctrl-C and rerun with --resume to go on; fewer levels, "
+                                             "repetitions or points make it shorter")
+        jobs = choose_jobs(jobs, len(pending) * per_run) if pending else 1
     try:
         for key, task, result in _dispatch(model, pending, seed, jobs, client):
             store.save(key, task, result)

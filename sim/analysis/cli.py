@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -177,6 +179,23 @@ def impact_times(path: str) -> Any:
     return np.sort(times)
 
 
+def impacts_within_signal(times: Any, signal_path: str, impacts_path: str) -> Any:
+    """The impact times (s) that lie within the signal's time span; none inside is one SimulationInputError line,
+    some outside one warning line on stderr (they are dropped)."""
+    from sim.analysis.signals import read_signal
+
+    t = read_signal(signal_path).t
+    inside = (times >= t[0]) & (times <= t[-1])
+    if not inside.any():
+        raise SimulationInputError(f"--impacts {impacts_path}: none of its {times.size} impact times "
+                                   f"({times[0]:.6g} to {times[-1]:.6g} s) lies within the signal ({t[0]:.6g} to "
+                                   f"{t[-1]:.6g} s); give the impacts of this signal (same time origin)")
+    if not inside.all():
+        sys.stderr.write(f"warning: {int((~inside).sum())} of the {times.size} impact times of {impacts_path} lie "
+                         f"outside the signal ({t[0]:.6g} to {t[-1]:.6g} s) and are ignored\n")
+    return times[inside]
+
+
 def modal_fit_command(args: argparse.Namespace) -> int:
     """`ies modal-fit`: Eq. 9 fitted between impacts, modal energies after each (Sect. 5.5)."""
     from sim.common.files import dumps, report_written
@@ -190,6 +209,8 @@ def modal_fit_command(args: argparse.Namespace) -> int:
         raise SimulationInputError(f"--threshold {args.threshold}: the fit needs one threshold factor, e.g. 1.0")
     if args.plot and not Path(args.plot).resolve().parent.is_dir():
         raise SimulationInputError(f"--plot {args.plot}: folder {Path(args.plot).parent} does not exist")
+    if given is not None:
+        given = impacts_within_signal(given, args.signal, args.impacts)
     settings = detection_settings(args)
     excitation = settings.pop("excitation_hz")
     fit = fit_modes(args.signal, model, given, excitation_hz=excitation, threshold=float(thresholds[0]),
@@ -213,7 +234,11 @@ def modal_fit_command(args: argparse.Namespace) -> int:
         print(f"{'mode':>4} {'mean E after impacts (J)':>25} {'mean share':>11}")
         for j in range(model.n_modes):
             print(f"{j + 1:4d} {energies[:, j].mean():25.4e} {share[:, j].mean():11.4f}")
-    print(f"share of modes 2..{model.n_modes} in the energy after impacts: {100 * fit.higher_share:.2f} %")
+    if math.isfinite(fit.higher_share):
+        print(f"share of modes 2..{model.n_modes} in the energy after impacts: {100 * fit.higher_share:.2f} %")
+    else:
+        print(f"share of modes 2..{model.n_modes} in the energy after impacts: not available (no well-posed window "
+              "between impacts; see the warnings)")
     for line in fit.warnings[:MAX_WARNINGS_SHOWN]:
         print(f"warning: {line}")
     if len(fit.warnings) > MAX_WARNINGS_SHOWN:

@@ -185,6 +185,31 @@ def estimate_excitation_hz(x: np.ndarray, fs: float, max_hz: float) -> float:
     return float(fit.x)
 
 
+#: largest relative difference between a given excitation frequency and the signal's dominant one
+EXCITATION_TOLERANCE = 0.1
+
+
+def check_excitation_hz(given: float, x: np.ndarray, fs: float, max_hz: float, what: str) -> float:
+    """A given excitation frequency (Hz), positive and within EXCITATION_TOLERANCE of the signal's dominant component
+    below max_hz (`estimate_excitation_hz` of x, e.g. the tip acceleration `what`; on a short signal within two
+    frequency bins fs / n); one SimulationInputError line otherwise. A signal too short for the estimate is taken at
+    its word."""
+    given = float(given)
+    if not np.isfinite(given) or given <= 0:
+        raise SimulationInputError(f"the excitation frequency must be positive (Hz), got {given!r}")
+    try:
+        dominant = estimate_excitation_hz(x, fs, max_hz)
+    except SimulationInputError:
+        return given
+    resolution = fs / x.size  # Hz: a short signal knows its frequency only to a few of these
+    if abs(given - dominant) > max(EXCITATION_TOLERANCE * dominant, 2.0 * resolution):
+        raise SimulationInputError(
+            f"--excitation-hz {given:g} Hz is far from the signal's dominant frequency {dominant:.4g} Hz (in {what}, "
+            f"more than {EXCITATION_TOLERANCE:.0%} apart); omit --excitation-hz to use the estimate, or check the "
+            "signal's time column (s)")
+    return given
+
+
 def detect_impacts(source: Signal | str | os.PathLike, thresholds=DEFAULT_THRESHOLDS, *,
                    excitation_hz: float | None = None, highpass_hz: float = HIGHPASS_HZ,
                    lowpass_hz: float = LOWPASS_HZ, min_separation: float = MIN_SEPARATION) -> ImpactDetection:
@@ -222,9 +247,8 @@ def detect_impacts(source: Signal | str | os.PathLike, thresholds=DEFAULT_THRESH
     if excitation_hz is None:
         excitation, estimated = estimate_excitation_hz(signal["a_tip"], fs, lowpass_hz), True
     else:
-        excitation, estimated = float(excitation_hz), False
-        if not np.isfinite(excitation) or excitation <= 0:
-            raise SimulationInputError(f"the excitation frequency must be positive (Hz), got {excitation_hz!r}")
+        excitation = check_excitation_hz(excitation_hz, signal["a_tip"], fs, lowpass_hz, "a_tip")
+        estimated = False
     walls = np.vstack([envelope(zero_phase_filter(signal[name], fs, highpass_hz, "highpass"))
                        for name in ("a_left", "a_right")])
     combined = walls.max(axis=0)

@@ -56,6 +56,7 @@ from sim.common.files import save_figure
 from sim.analysis.impacts import (
     LOWPASS_HZ,
     NOMINAL_THRESHOLD,
+    check_excitation_hz,
     detect_impacts,
     estimate_excitation_hz,
 )
@@ -231,7 +232,9 @@ def fit_modes(source: Signal | str | os.PathLike, model: ModalModel | str | os.P
             excitation = estimate_excitation_hz(signal["v_tip"], signal.fs, detection.get("lowpass_hz", LOWPASS_HZ))
             estimated = True
         else:
-            excitation, estimated = float(excitation_hz), False
+            excitation = check_excitation_hz(excitation_hz, signal["v_tip"], signal.fs,
+                                             detection.get("lowpass_hz", LOWPASS_HZ), "v_tip")
+            estimated = False
     if not np.isfinite(excitation) or excitation <= 0:
         raise SimulationInputError(f"the excitation frequency must be positive (Hz), got {excitation!r}")
     Omega = 2 * np.pi * excitation

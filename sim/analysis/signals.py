@@ -123,6 +123,7 @@ def read_signal(path: str | os.PathLike, required: Sequence[str] = ()) -> Signal
     if duplicated:
         raise SimulationInputError(f"{path}: column(s) {', '.join(duplicated)} appear more than once in the header")
     columns = [names.index(name) for name in wanted]
+    _check_row_lengths(text, skipped + 1, len(names), path)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # "input contained no data": reported below
@@ -131,9 +132,11 @@ def read_signal(path: str | os.PathLike, required: Sequence[str] = ()) -> Signal
     except ValueError as exc:
         text = str(exc).strip().splitlines()[-1]
         cell = re.search(r"could not convert string '(.*)' to float64 at row (\d+), column (\d+)", text)
-        if cell:
-            name = names[columns[int(cell.group(3)) - 1]]
-            text = f"'{cell.group(1)}' in column '{name}' at data row {int(cell.group(2)) + 1} is not a number"
+        if cell:  # numpy counts the file's columns from 1 (not the usecols list) and the data rows from 0
+            column = int(cell.group(3)) - 1
+            name = names[column] if column < len(names) else f"number {column + 1}"
+            value = f"'{cell.group(1)}'" if cell.group(1).strip() else "an empty cell"
+            text = f"{value} in column '{name}' at data row {int(cell.group(2)) + 1} is not a number"
         raise SimulationInputError(f"{path}: {text}; every cell must be a number") from None
     if data.shape[0] == 0:
         raise SimulationInputError(f"{path}: the header has no data rows below it")
@@ -153,6 +156,21 @@ def _require(names, required: Sequence[str], source: str) -> None:
     if missing:
         needs = ", ".join(dict.fromkeys(("t", *required)))
         raise SimulationInputError(f"{source}: missing column(s) {', '.join(missing)}; the analysis needs {needs}")
+
+
+def _check_row_lengths(text: str, first: int, n_columns: int, path: Path) -> None:
+    """Every data row (from line index `first`, comments and blank lines aside) has the header's `n_columns` cells;
+    a row with more is most often a decimal comma (0,5 for 0.5), which would shift that row's columns."""
+    for number, line in enumerate(text.splitlines()[first:], start=1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        cells = line.count(",") + 1
+        if cells != n_columns:
+            data_row = number - sum(1 for ln in text.splitlines()[first:first + number - 1]
+                                    if not ln.strip() or ln.lstrip().startswith("#"))
+            hint = (" (a decimal comma, e.g. 0,5 for 0.5? write numbers with a point)" if cells > n_columns else "")
+            raise SimulationInputError(f"{path}: data row {data_row} has {cells} cells but the header names "
+                                       f"{n_columns} columns{hint}; every row needs one cell per column")
 
 
 def _header(handle) -> tuple[str | None, int]:

@@ -124,6 +124,19 @@ def check_trace_settings(model: ModalModel, protocol: SteppedSine, periods: int,
     samples_per_period(float(fs), lowest)
 
 
+#: wall time of one recorded sample (s): the integrator stops at every sampling instant (2.4-3.0 us), the signal
+#: columns (3.0-3.5 us) and the CSV row of 11 cells (50 us); measured with the exact integrator on the seed rig, 1e5 and 1e6
+#: samples (2-core development machine)
+SAMPLE_COST_S = 55e-6
+
+
+def trace_samples(model: ModalModel, protocol: SteppedSine, periods: int, fs: float) -> int:
+    """How many samples `record_trace` will record: periods x M + 1, M = round(fs / f_exc) at the grid's lowest
+    excitation frequency (the most samples per period; fs in Hz)."""
+    lowest = protocol.eta[0] * float(model.omega[0]) * (1.0 - protocol.perturbation)
+    return int(periods) * samples_per_period(float(fs), lowest) + 1
+
+
 def record_trace(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *,
                  periods: int = DEFAULT_PERIODS, fs: float = DEFAULT_FS, seed: int = 0, rep: int = 0,
                  nominal: Nominal = Nominal()) -> Trace:

@@ -21,24 +21,30 @@ import math
 import os
 import secrets
 import sys
+import tempfile
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Iterable, Iterator, Sequence
+from typing import Any, Callable, Iterable, Iterator, Sequence, TypeVar
 
 import numpy as np
 
 #: mode of a new file before the umask is applied (what `open(path, "w")` uses)
 NEW_FILE_MODE = 0o666
+#: errno values of a machine that cannot take a file (read-only or full disk, quota, too large, I/O): exit code 3
+RESOURCE_ERRNOS = (errno.EROFS, errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO)
+
+T = TypeVar("T")
 
 
 def read_text(path: str | os.PathLike, kind: str, fmt: str, hint: str = "") -> str:
-    """The UTF-8 text of a user's input file; a missing file, a folder or a binary file is one line
-    (SimulationInputError) naming the file, its `kind` (e.g. "modal file"), the format `fmt` and a `hint`."""
+    """The UTF-8 text of a user's input file, without the byte-order mark spreadsheets write; a missing file, a
+    folder or a binary file is one line (SimulationInputError) naming the file, its `kind` (e.g. "modal file"), the
+    format `fmt` and a `hint`."""
     from sim.common.errors import SimulationInputError
 
     path = Path(path)
     try:
-        return path.read_bytes().decode("utf-8")
+        return path.read_bytes().decode("utf-8-sig")
     except FileNotFoundError:
         raise SimulationInputError(f"{kind} {path} not found{hint}") from None
     except IsADirectoryError:
@@ -62,13 +68,72 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
                                    "choose another path")
     if target.is_dir():
         raise IsADirectoryError(errno.EISDIR, f"cannot write {target}: it is a folder; give a file name")
-    tmp = _new_temporary_file(folder, target)
+    try:
+        tmp = _new_temporary_file(folder, target)
+    except OSError as exc:
+        raise _naming(exc, target) from None
     try:
         yield tmp
         os.replace(tmp, target)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise _naming(exc, target) from None  # the user's file, not the hidden temporary one
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+
+
+def _naming(exc: OSError, target: Path) -> OSError:
+    """The same error (type, errno, reason) naming `target` instead of a temporary file."""
+    if exc.errno is None:
+        return exc
+    return type(exc)(exc.errno, exc.strerror or os.strerror(exc.errno), str(target))
+
+
+def check_writable(path: str | os.PathLike, option: str, *, folder: bool = False) -> None:
+    """Prove before any work that a file can be written at `path` (a file, or with `folder` a folder that
+    exists): a temporary file is created in its folder and removed again. A missing folder or a folder in
+    place of the file is one SimulationInputError line (exit 2); a read-only or full disk one
+    ResourceFailure line (exit 3), both naming `option` (e.g. "--plot") and saying nothing was computed."""
+    from sim.common.errors import ResourceFailure, SimulationInputError
+
+    target = Path(path)
+    where = target if folder else (target.parent if str(target.parent) else Path("."))
+    if not where.is_dir():
+        raise SimulationInputError(f"{option} {path}: folder {where} does not exist; create it or choose another path "
+                                   "(nothing was computed)")
+    if not folder and target.is_dir():
+        raise SimulationInputError(f"{option} {path} is a folder; give a file name (nothing was computed)")
+    try:
+        _new_temporary_file(where, target if not folder else where / "probe").unlink()
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        if exc.errno in RESOURCE_ERRNOS:
+            raise ResourceFailure(f"cannot write {option} {path} ({reason}); choose another folder (nothing was "
+                                  "computed)") from None
+        raise SimulationInputError(f"cannot write {option} {path} ({reason}); choose another folder (nothing was "
+                                   "computed)") from None
+
+
+def write_or_fallback(write: Callable[[Path], T], folder: str | os.PathLike, what: str) -> T:
+    """`write(folder)` for results that took long to compute; if the disk refuses them (read-only, full:
+    RESOURCE_ERRNOS), `write` into a new folder ``ies-WHAT-*`` in the system's temporary folder and raise one
+    ResourceFailure line naming it, so that nothing computed is lost."""
+    from sim.common.errors import ResourceFailure
+
+    try:
+        return write(Path(folder))
+    except OSError as exc:
+        if exc.errno not in RESOURCE_ERRNOS:
+            raise
+        failed = f"cannot write {exc.filename or folder} ({exc.strerror or exc})"
+    spare = Path(tempfile.mkdtemp(prefix=f"ies-{what}-"))
+    try:
+        write(spare)
+    except OSError as again:
+        raise ResourceFailure(f"{failed}, nor into the fallback {spare} ({again.strerror or again}); the results "
+                              "are lost: free space or choose another --out") from None
+    raise ResourceFailure(f"{failed}; the results were written to {spare} instead")
 
 
 def _new_temporary_file(folder: Path, target: Path) -> Path:

@@ -69,7 +69,12 @@ def kind_of(folder: Path) -> ResultKind:
         raise SimulationInputError(f"{folder} is not a folder; give a result folder (--out of ies sweep, overview, trace, "
                                    "interval, sobol or reproduce)")
     for kind in KINDS:
-        if kind.detect(folder):
+        try:
+            found = kind.detect(folder)
+        except (ValueError, KeyError, TypeError, AttributeError) as exc:  # a corrupt study.json, say
+            raise SimulationInputError(f"{folder}: a data file is corrupt or incomplete ({type(exc).__name__}); rerun "
+                                       "the command that wrote it") from None
+        if found:
             return kind
     raise SimulationInputError(f"{folder} holds no result that can be redrawn (known: "
                                f"{', '.join(kind.name for kind in KINDS)}); give the --out folder of a finished run")
@@ -79,7 +84,14 @@ def redraw(folder: Path, options: PlotOptions) -> list[Path]:
     """Redraw the figures of a result folder (`kind_of`) from its data in the style of `options`."""
     kind = kind_of(folder)
     with style(options.style):
-        return kind.redraw(folder, options)
+        try:
+            return kind.redraw(folder, options)
+        except SimulationInputError:
+            raise
+        except (ValueError, KeyError, TypeError, IndexError) as exc:  # json.JSONDecodeError, UnicodeDecodeError, ...
+            where = f" at line {exc.lineno}" if hasattr(exc, "lineno") else ""
+            raise SimulationInputError(f"{folder}: its {kind.name} data are corrupt or incomplete ({type(exc).__name__}"
+                                       f"{where}); rerun the command that wrote them") from None
 
 
 def style(name: str | None) -> ContextManager[None]:
