@@ -6,3 +6,17 @@ from hypothesis import settings
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
+
+
+def pytest_sessionstart(session) -> None:
+    """Compile (or load) the integrators' kernels once, quietly, before the tests: a cold numba cache would otherwise
+    put the first run's "compiling ..." notice on the stderr of whichever command test comes first, and the tests
+    that check a command's one-line messages would depend on their order. The notice itself is tested in
+    tests/sim/test_warm_up.py."""
+    import io
+
+    from sim.integration.integrators import available, warm_up
+
+    for name in available():
+        for damped in (False, True):
+            warm_up(name, damped=damped, stream=io.StringIO())
