@@ -118,7 +118,8 @@ def test_the_readme_worked_example_finds_a_clearance_no_worse_than_the_papers(tm
     data = json.loads((tmp_path / "example" / "design.json").read_text())
     best, paper = data["recommendation"], data["baseline"]
     print(f"\n{printed}\nworked example: {seconds:.0f} s")
-    # pinned (README): the paper's sphere at 0.58 mm; worst case 2.47 mm over 0.66-6.6 um
+    # pinned (README): the paper's sphere at 0.58 mm; worst case 2.44 mm over 0.66-6.6 um (15 %: chaotic runs)
     assert best["material"] == "brass" and best["radius_m"] == pytest.approx(7.92e-3)
     assert best["clearance_m"] == pytest.approx(0.58e-3, abs=0.1e-3)
+    assert best["worst_m"] == pytest.approx(2.44e-3, rel=0.15)
     assert best["worst_m"] <= paper["worst_m"]
