@@ -139,3 +139,17 @@ def test_the_screening_is_worst_over_the_damping_interval_and_ranks_designs():
     assert np.all(screened.tip >= low_damping.tip - 1e-15)
     chosen = d.candidates(problem, screened)
     assert chosen[0] == screened.designs[int(np.argmin(screened.worst))]
+
+
+def test_a_host_whose_first_mode_does_not_move_the_walls_is_refused(tmp_path, capsys):
+    from sim.hosts.modal_file import save_modal_model
+    from sim.model.system import ModalModel
+
+    still = ModalModel(frequencies_hz=np.array([117.4, 2494.0]), damping_ratios=np.array([0.00085, 0.0005]),
+                       phi_wall_left=np.array([0.0, 0.95]), phi_wall_right=np.array([0.0, 0.95]),
+                       phi_tip=np.array([1.0, 0.8]), participation=np.array([0.95, 0.35]), source="walls at a node")
+    path = save_modal_model(still, tmp_path / "node.toml")
+    out = tmp_path / "out"
+    assert exit_code(["design", "--excitation", "2um:8um", "--model", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "the host model cannot be designed for" in err and len(err.splitlines()) == 1 and not out.exists()
