@@ -290,13 +290,16 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
                         help="Hertz constant k_H in N/m^1.5, or with a unit: 282e3N/mm^1.5 (default 282e3 N/mm^1.5 = "
                              "8.918e9 N/m^1.5)")
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
-    parser.add_argument("--contact-law", dest="contact_law", choices=("hertz", "hertz-damped"), default=None,  # sim.model.contact_law.CONTACT_LAWS
-                        help="normal contact law at both walls: hertz (Eq. 4, elastic, default) or hertz-damped (Eq. 10; "
-                             "needs the model's beam mass; the exact integrator then takes every contact by "
-                             "Dormand-Prince)")
+    from sim.model.contact_law import LAWS
+
+    laws = "; ".join(f"{name} ({law.summary}"
+                     + (")" if law.collocation else ", the exact integrator takes its contacts by Dormand-Prince)")
+                     for name, law in LAWS.items())
+    parser.add_argument("--contact-law", dest="contact_law", choices=tuple(LAWS), default=None,
+                        help=f"normal contact law at both walls (default {next(iter(LAWS))}): {laws}")
     parser.add_argument("--r-cont", dest="r_cont", type=float, default=None, metavar="R",
-                        help="r_cont,diss of Eq. 10 in (0, 1]: the coefficient of restitution the damped law is designed "
-                             "for (1 = elastic, bit for bit); implies --contact-law hertz-damped (default there 0.99)")
+                        help="r_cont,diss of Eq. 10 in (0, 1]: the coefficient of restitution a damped law is designed "
+                             "for (1 = elastic, bit for bit); implies the damped law (default there 0.99)")
     parser.add_argument("--friction", type=friction_coefficient, default=0.0, metavar="MU",
                         help="Coulomb coefficient of dry friction between the sphere and the cavity floor (Appendix C; "
                              "0 = off, the default; the paper: 0.07); needs --integrator ode3 and the model's phi_floor")
@@ -419,11 +422,9 @@ def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
 
 def contact_law(args: argparse.Namespace) -> Any:
     """The `sim.model.contact_law.ContactLaw` of --contact-law and --r-cont (--r-cont alone implies the damped law)."""
-    from sim.model.contact_law import DEFAULT_R_CONT, ContactLaw
+    from sim.model.contact_law import contact_law_of
 
-    name = args.contact_law or ("hertz-damped" if args.r_cont is not None else "hertz")
-    r_cont = args.r_cont if args.r_cont is not None else (DEFAULT_R_CONT if name == "hertz-damped" else 1.0)
-    return ContactLaw(name, r_cont)
+    return contact_law_of(args.contact_law, args.r_cont)
 
 
 def system_data(model: Any, impactor: Any) -> dict:

@@ -72,11 +72,11 @@ class IESModel:
     variant: Mapping[str, float] = field(default_factory=dict)
     rig: Any = field(default=None, compare=False, repr=False)
     banded_outputs: tuple[str, ...] = ("mean", "max")
-    contact_law: str = "hertz"
+    contact_law: str | None = None
 
     parameters = ("D", "g", "k_H")
     #: parameters a study may add to Table 2's (they enter a task's point, and so its key, only when listed):
-    #: r_cont,diss of the damped contact law (Eq. 10; listing it implies contact_law = "hertz-damped"), and the
+    #: r_cont,diss of the damped contact law (Eq. 10; listing it implies the damped law, `sim.model.contact_law.DEFAULT_DAMPED_LAW`), and the
     #: friction coefficient mu and tangential stiffness k_t (N/m) of dry friction at the floor (Appendix C; ode3)
     optional_parameters = ("r_cont", "friction", "k_t")
     #: the resonant levels, the regime (1 = APR) and the scattering measures of `sim.stepped_sine.measures` at the resonant
@@ -134,8 +134,10 @@ class IESModel:
         from sim.model.system import system_arrays
 
         point = {"g": 1e-3, "k_H": 1e9, **params}
-        if self.contact_law == "hertz" and point.get("friction", 0.0) == 0.0:
-            return
+        from sim.model.contact_law import law_named
+
+        if not law_named(self._law_name()).takes_r_cont and point.get("friction", 0.0) == 0.0:
+            return  # only Eq. 10 (the beam mass) and friction (the floor values) ask more of the model
         try:
             system_arrays(self._rig(), self._impactor(point))
         except SimulationInputError as exc:
@@ -160,16 +162,22 @@ class IESModel:
                 raise StudyError(f"[variant] {exc}") from None
         return rig
 
+    def _law_name(self) -> str:
+        """The study's contact law (`sim.model.contact_law.LAWS`; None: its DEFAULT_LAW)."""
+        from sim.model.contact_law import DEFAULT_LAW
+
+        return self.contact_law if self.contact_law is not None else DEFAULT_LAW
+
     def _impactor(self, params: Mapping[str, float]):
         """The sphere of Eqs. 3-6 with this run's g and k_H, its mass scaled by [variant] sphere_mass_factor, the
         study's contact law (Eq. 10 with this run's r_cont when damped) and this run's friction (Appendix C)."""
-        from sim.model.contact_law import DEFAULT_R_CONT, ContactLaw
+        from sim.model.contact_law import contact_law_of, law_named
         from sim.model.friction import K_T_PAPER
         from sim.model.system import SPHERE_MASS, Impactor
 
         mass = SPHERE_MASS * self.variant.get("sphere_mass_factor", 1.0)
-        law = (ContactLaw(self.contact_law, params.get("r_cont", DEFAULT_R_CONT)) if self.contact_law != "hertz"
-               else ContactLaw())
+        name = self._law_name()
+        law = contact_law_of(name, params.get("r_cont") if law_named(name).takes_r_cont else None)
         return Impactor(mass=mass, clearance=params["g"], k_H=params["k_H"], contact_law=law,
                         friction=params.get("friction", 0.0), k_t=params.get("k_t", K_T_PAPER))
 
@@ -196,7 +204,9 @@ class IESModel:
         """Settings that define a task's computation (part of its cache key; the built-in rig is covered by
         version, a modal file by its content)."""
         out = {"class": type(self).__name__, "protocol": dict(self.protocol), "n_modes": self.n_modes}
-        if self.contact_law != "hertz":
+        from sim.model.contact_law import DEFAULT_LAW
+
+        if self._law_name() != DEFAULT_LAW:  # the default law is not in the key (keys from before the choice)
             out["contact_law"] = self.contact_law
         if self.variant:
             out["variant"] = dict(self.variant)
@@ -360,11 +370,11 @@ class FunctionModel:
 
 def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, parameters: tuple[str, ...] = (),
                modal_model: str | Path | None = None, variant: Mapping[str, float] | None = None,
-               outputs: tuple[str, ...] = (), contact_law: str = "hertz") -> Any:
+               outputs: tuple[str, ...] = (), contact_law: str | None = None) -> Any:
     """The model named by a study's ``model`` key ("ies", "ishigami" or "module:function"); modal_model: a
     modal-model file replacing the built-in rig of "ies"; variant: the [variant] table of "ies"; outputs: the
     outputs of "ies" whose bands and indices the study computes (default: the resonant mean and max);
-    contact_law: the normal contact law of "ies" ("hertz", Eq. 4, or "hertz-damped", Eq. 10)."""
+    contact_law: the normal contact law of "ies" (a name in `sim.model.contact_law.LAWS`; None: its default)."""
     if spec == "ies":
         unknown = [name for name in outputs if name not in IESModel.outputs]
         if unknown:
@@ -372,7 +382,9 @@ def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, paramete
         return IESModel(dict(protocol or {}), modal_file=None if modal_model is None else str(modal_model),
                         variant=dict(variant or {}), **({"banded_outputs": tuple(outputs)} if outputs else {}),
                         contact_law=contact_law)
-    if contact_law != "hertz":
+    from sim.model.contact_law import DEFAULT_LAW
+
+    if contact_law not in (None, DEFAULT_LAW):
         raise StudyError("[study] contact_law only applies to model = \"ies\" (the simulator)")
     if outputs:
         raise StudyError("[study] outputs only applies to model = \"ies\" (the simulator)")
