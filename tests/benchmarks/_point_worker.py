@@ -18,7 +18,7 @@ MU = float(sys.argv[6]) if len(sys.argv) > 6 else 0.0
 
 import numpy as np  # noqa: E402
 
-from sim import exact, ode3  # noqa: E402
+from sim.integration import exact, ode3  # noqa: E402
 from sim.hosts.rig import seed_rig_model  # noqa: E402
 from sim.model.system import Impactor, a_base_star, a_noabs_star, system_arrays  # noqa: E402
 

@@ -65,13 +65,13 @@ def _set_probe(path: Path, old: str, new: str) -> None:
 
 @pytest.mark.slow
 def test_an_edit_of_a_callee_file_reaches_the_cached_caller(tmp_path):
-    package = tmp_path / "sim"
-    shutil.copytree(SIM_DIR, package, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(SIM_DIR, tmp_path / "sim", ignore=shutil.ignore_patterns("__pycache__"))
+    package = tmp_path / "sim" / "integration"
     (package / "flight.py").write_text((package / "flight.py").read_text() + PROBE_CALLEE.format(value=1.0))
     (package / "exact.py").write_text((package / "exact.py").read_text() + PROBE_CALLER)
     (tmp_path / "plain_callee.py").write_text(PLAIN_CALLEE.format(value=1.0))
     (tmp_path / "plain_caller.py").write_text(PLAIN_CALLER)
-    run_sim = "from sim import exact; print(exact.probe_caller())"
+    run_sim = "from sim.integration import exact; print(exact.probe_caller())"
     run_plain = "import plain_caller; print(plain_caller.probe_caller())"
 
     assert _run(tmp_path, run_sim) == "1.0"
