@@ -290,13 +290,13 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
                         help="Hertz constant k_H in N/m^1.5, or with a unit: 282e3N/mm^1.5 (default 282e3 N/mm^1.5 = "
                              "8.918e9 N/m^1.5)")
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
-    from sim.model.contact_law import LAWS
+    from sim.model.contact_law import DEFAULT_LAW, LAWS
 
     laws = "; ".join(f"{name} ({law.summary}"
                      + (")" if law.collocation else ", the exact integrator takes its contacts by Dormand-Prince)")
                      for name, law in LAWS.items())
     parser.add_argument("--contact-law", dest="contact_law", choices=tuple(LAWS), default=None,
-                        help=f"normal contact law at both walls (default {next(iter(LAWS))}): {laws}")
+                        help=f"normal contact law at both walls (default {DEFAULT_LAW}): {laws}")
     parser.add_argument("--r-cont", dest="r_cont", type=float, default=None, metavar="R",
                         help="r_cont,diss of Eq. 10 in (0, 1]: the coefficient of restitution a damped law is designed "
                              "for (1 = elastic, bit for bit); implies the damped law (default there 0.99)")

@@ -573,15 +573,20 @@ def _log_release(Y, t, p, T, cst, log, i):
 
 
 @kernel(refcounts=False)
-def _advance(y, run):
-    """Advance y (phase 0) over the periods of run.out; returns (status, period of failure).
+def _advance(y, given, law):
+    """Advance y (phase 0) over the periods of given.out; returns (status, period of failure). given: the `Run`
+    whose constants carry no law (None); law: the contact law (`sim.model.contact_law.Law`), an argument of its own
+    because inside the tuple numba would type all of `given` in Python at every call (~0.5 ms, 5 % of a point);
+    the kernels below get the `Run` with it.
 
     Each period from phase 0: free flight (`_fly`), contacts (`collocation.contact` from an onset if
     run.use_collocation, `dopri5.contact` wherever that falls back), then the period's |c_1| and onset count
     (`_fundamental`). A contact may go on into the next period. One kernel for all periods (a call from Python
     per period would unbox every array of `run` again), compiled without reference counts (`sim.integration.jit`): the
     kernels it calls inherit that, except `collocation._build`, which allocates."""
-    cst, grid, colloc, dp, use_collocation = run.cst, run.grid, run.colloc, run.dp, run.use_collocation
+    cst = flight.Constants(given.cst.modes, given.cst.par, law)
+    run = Run(cst, given.grid, given.out, given.work, given.dp, given.colloc, given.use_collocation, given.recorder)
+    grid, colloc, dp, use_collocation = run.grid, run.colloc, run.dp, run.use_collocation
     work = run.work
     Y, X0, scratch, counters = work.Y, work.X0, work.scratch, work.counters
     amplitudes, impacts, record = run.out.amplitudes, run.out.impacts, run.out.record
@@ -776,10 +781,9 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     use_collocation = contacts == "collocation" and fixed_contact_step <= 0.0 and sys.law.collocation
     recorder = Recorder(Y=np.zeros(work.Y.size), Ynew=np.zeros(work.Y.size),
                         dp=dopri5.work(work.Y.size, np.zeros_like(work.counters), ledger is not None))
-    run = Run(cst, grid, out, work, dopri5.work(work.Y.size, work.counters, ledger is not None),
-              collocation.context(cst),
-              use_collocation, recorder)
-    status, period = _advance(y, run)
+    run = Run(cst._replace(law=None), grid, out, work, dopri5.work(work.Y.size, work.counters, ledger is not None),
+              collocation.context(cst), use_collocation, recorder)
+    status, period = _advance(y, run, sys.law)
     if stats is not None:
         for name, value in zip(COUNT._fields, work.counters):
             stats[name] = stats.get(name, 0) + int(value)

@@ -370,15 +370,17 @@ def _friction_step(y, t, h, model, slider, stages, rows):
 
 
 @kernel(fastmath=_FAST)
-def _advance(y, sys, steps, out):
-    """Advance y in place over the periods of `out`, N ode3 steps each; returns (status, step index of a failure)."""
+def _advance(y, sys, steps, out, law):
+    """Advance y in place over the periods of `out`, N ode3 steps each; returns (status, step index of a failure).
+    sys: the `SystemArrays` without their law (None); law: the contact law, an argument of its own (inside the
+    tuple numba would type all of `sys` in Python at every call)."""
     lay = state_layout(sys.omega.size)
     N = steps.N
     Omega, a_base = steps.Omega, steps.a_base
     co = Coefficients(w2=sys.omega * sys.omega, c=2.0 * sys.D * sys.omega, gamma=sys.gamma, phi_l=sys.phi_l, phi_r=sys.phi_r,
                       f_modal=sys.gamma * (a_base * Omega * Omega), f_sphere=a_base * Omega * Omega, m_a=sys.m_a,
                       k_H=sys.k_H, g=sys.g, c_damp=sys.c_damp, phi_f=sys.phi_f, k_t=sys.k_t, slip_force=sys.slip_force,
-                      law=sys.law, Omega=Omega)
+                      law=law, Omega=Omega)
     model = Model(co, lay)
     ny = lay.acc
     friction = co.slip_force > 0.0  # the friction step (Appendix C)
@@ -516,8 +518,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     out = integrator_output(n_periods, sys.omega.size, record_arr, None)
     stored_start = stored_energy(y, sys) if ledger is not None else math.nan
     kernel_sys = sys._replace(m_a=float(sys.m_a), k_H=float(sys.k_H), g=float(sys.g), c_damp=float(sys.c_damp),
-                              k_t=float(sys.k_t), slip_force=float(sys.slip_force))
-    status, where = _advance(y, kernel_sys, steps, out)
+                              k_t=float(sys.k_t), slip_force=float(sys.slip_force), law=None)
+    status, where = _advance(y, kernel_sys, steps, out, sys.law)
     if status != _OK:
         t = where * h
         why = "non-finite state" if status == _NONFINITE else "an indentation larger than the clearance"

@@ -28,7 +28,7 @@ one (in `SystemArrays.law`, `sim.integration.flight.Constants.law`) is compiled,
 and `wall_force`, `wall_stiffness`, `wall_dissipation` and `uses_rate` resolve to that law's kernels at compile
 time, inlined into the caller (its fastmath flags apply): a law that is not used is not in the machine code, and
 the elastic law computes no approach rate. The on-disk cache of the integrators follows edits of this file
-(`sim.integration.jit.KERNEL_MODULES`) and, through the hash, of a law registered elsewhere (a test).
+(`sim.integration.jit.FINGERPRINT_FILES`) and, through the hash, of a law registered elsewhere (a test).
 """
 from __future__ import annotations
 
@@ -36,8 +36,9 @@ import hashlib
 import inspect
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable, NamedTuple
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -176,7 +177,7 @@ def _calling(kernel: Callable | None, arguments: str, passed: str, default: str 
     it into the caller's IR without a free variable (which its inliner warns about)."""
     namespace = {"kernel": kernel}
     body = f"kernel({passed})" if kernel is not None else default
-    exec(f"def implementation({arguments}):\n    return {body}\n", namespace)  # text of this module only
+    exec(f"def implementation({arguments}):\n    return {body}\n", namespace)  # noqa: S102 (text of this module)
     return namespace["implementation"]
 
 
@@ -327,9 +328,9 @@ class ContactLaw:
         if isinstance(r, bool) or not isinstance(r, (int, float)) or not math.isfinite(r) or not 0.0 < r <= 1.0:
             raise SimulationInputError(f"r_cont must lie in (0, 1] (1 = elastic, e.g. 0.99), got {r!r}")
         if not law.takes_r_cont and r != 1.0:
-            damped = ", ".join(name for name, other in LAWS.items() if other.takes_r_cont)
-            raise SimulationInputError(f"r_cont = {r!r} needs a contact law with damping ({damped}); {self.name!r} "
-                                       "takes no r_cont")
+            damped = " or ".join(repr(name) for name, other in LAWS.items() if other.takes_r_cont)
+            raise SimulationInputError(f"r_cont = {r!r} needs the contact law {damped}; {self.name!r} takes no r_cont "
+                                       "(it is elastic, r_cont = 1)")
         object.__setattr__(self, "r_cont", float(r))
 
     @property

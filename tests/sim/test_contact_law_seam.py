@@ -107,7 +107,8 @@ def test_the_toy_law_runs_a_stepped_sine_point_like_scipy(spring, integrator):
     run_step, options = (exact.run_step, {}) if integrator == "exact" else (ode3.run_step, {"dt_scale": 0.05})
     y0, y, amplitudes, impacts, ledger, Omega, a_base = short_point(run_step, sys, model, **options)
     T = 2 * math.pi / Omega
-    y_ref, onsets, _, _ = reference_run(y0, 2 * T, Omega, a_base, sys, rtol=1e-12)
+    pieces: list = []
+    y_ref, onsets, _, _ = reference_run(y0, 2 * T, Omega, a_base, sys, rtol=1e-12, pieces=pieces)
     assert onsets.size >= 3 and impacts.sum() == np.count_nonzero(onsets > T) > 0  # contacts in the wait and the hold
     n = model.n_modes
     scale = np.concatenate([np.abs(y_ref[:n]).max() * np.ones(n), np.abs(y_ref[n:2 * n]).max() * np.ones(n),
@@ -117,6 +118,15 @@ def test_the_toy_law_runs_a_stepped_sine_point_like_scipy(spring, integrator):
     # ode3 its order; at the paper's step 0.6)
     tolerance = 1e-6 if integrator == "exact" else 1e-2
     assert error < tolerance, f"{integrator}: largest relative deviation from DOP853 {error:.2e}"
+    # the point's measure: |c_1| of the tip over the hold, c_1 = (2/T) int q_tip e^{-i Omega t} dt (Sect. 5)
+    t = np.linspace(T, 2 * T, 40001)
+    q = np.empty_like(t)
+    for start, stop, dense in pieces:
+        inside = (t >= start) & (t <= stop)
+        if inside.any():
+            q[inside] = sys.phi_tip @ dense(t[inside])[:model.n_modes]
+    c_1 = 2.0 / T * np.trapezoid(q * np.exp(-1j * Omega * t), t)
+    assert amplitudes[0] == pytest.approx(abs(c_1), rel=1e-5 if integrator == "exact" else 1e-2)
     # the energy balance closes with the law's potential (its stored energy) and no contact dissipation
     assert np.all(ledger.contact == 0.0)
     assert abs(ledger.balance_error) < (1e-7 if integrator == "exact" else 1e-3)
