@@ -163,15 +163,17 @@ def modes_command(args: argparse.Namespace) -> int:
 def add_system_arguments(parser: argparse.ArgumentParser) -> None:
     """Model and impactor options: --model, --no-impactor, --contact-law and one option per parameter of
     `sim.model.parameters.PARAMETERS` that has one (Table 2's D, g, k_H; r_cont, friction, k_t)."""
-    from sim.model.contact_law import CONTACT_LAWS
     from sim.model.parameters import PARAMETERS
 
     parser.add_argument("--model", metavar="FILE", help="modal-model file (default: the built-in model of the seed rig)")
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
-    parser.add_argument("--contact-law", dest="contact_law", choices=CONTACT_LAWS, default=None,
-                        help="normal contact law at both walls: hertz (Eq. 4, elastic, default) or hertz-damped (Eq. 10; "
-                             "needs the model's beam mass; the exact integrator then takes every contact by "
-                             "Dormand-Prince)")
+    from sim.model.contact_law import DEFAULT_LAW, LAWS
+
+    laws = "; ".join(f"{name} ({law.summary}"
+                     + (")" if law.collocation else ", the exact integrator takes its contacts by Dormand-Prince)")
+                     for name, law in LAWS.items())
+    parser.add_argument("--contact-law", dest="contact_law", choices=tuple(LAWS), default=None,
+                        help=f"normal contact law at both walls (default {DEFAULT_LAW}): {laws}")
     for name, parameter in PARAMETERS.items():
         option = parameter.option
         if option is not None:
@@ -377,7 +379,7 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
     total = len(levels) * args.reps * len(protocol.legs) * protocol.n_eta
     long_run = len(levels) > 1 or total * (protocol.wait + protocol.hold) > LONG_SWEEP_S
     with output_folder(args.out, args.force) as folder:
-        warm_up(protocol.integrator, damped=impactor is not None and impactor.contact_law.dissipative)
+        warm_up(protocol.integrator, law="hertz" if impactor is None else impactor.contact_law.law.name)
         per_run = simulated_seconds(protocol, float(model.omega[0]))
         if len(levels) * args.reps * per_run > LONG_SWEEP_S:  # long enough to be worth the probe (< 1 s)
             announce(len(levels) * args.reps, per_run, cost_per_simulated_second(model, impactor, max(levels), protocol),
@@ -517,7 +519,7 @@ def trace_command(args: argparse.Namespace) -> int:
     if args.plot:
         check_writable(args.plot, "--plot")
     with output_folder(args.out, args.force) as folder:
-        warm_up(protocol.integrator, damped=impactor is not None and impactor.contact_law.dissipative)
+        warm_up(protocol.integrator, law="hertz" if impactor is None else impactor.contact_law.law.name)
         per_run = (simulated_seconds(protocol, float(model.omega[0]))
                    + args.periods / (protocol.eta[-1] * model.frequencies_hz[0]))  # the recorded periods
         announce(1, per_run,

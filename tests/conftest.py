@@ -16,7 +16,8 @@ def pytest_sessionstart(session) -> None:
     import io
 
     from sim.integration.integrators import available, warm_up
+    from sim.model.contact_law import LAWS
 
     for name in available():
-        for damped in (False, True):
-            warm_up(name, damped=damped, stream=io.StringIO())
+        for law in LAWS:
+            warm_up(name, law=law, stream=io.StringIO())

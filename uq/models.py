@@ -118,7 +118,7 @@ class IESModel:
     variant: Mapping[str, float] = field(default_factory=dict)
     rig: "ModalModel | None" = field(default=None, compare=False, repr=False)
     banded_outputs: tuple[str, ...] = ("mean", "max")
-    contact_law: str = "hertz"
+    contact_law: str | None = None
 
     #: the resonant levels, the regime (1 = APR) and the scattering measures of `sim.stepped_sine.measures` at the resonant
     #: mean's eta (Sect. 5.5, Appendix D)
@@ -190,6 +190,10 @@ class IESModel:
         from sim.model.system import build_system
 
         point = {"g": 1e-3, "k_H": 1e9, **params}
+        from sim.model.contact_law import law_named
+
+        if not law_named(self._law_name()).takes_r_cont and point.get("friction", 0.0) == 0.0:
+            return  # only Eq. 10 (the beam mass) and friction (the floor values) ask more of the model
         try:
             build_system(self._rig(), self._settings(point), integrator=self._stepped_sine().integrator)
         except SimulationInputError as exc:
@@ -210,6 +214,12 @@ class IESModel:
             except SimulationInputError as exc:
                 raise StudyError(f"[variant] {exc}") from None
         return rig
+
+    def _law_name(self) -> str:
+        """The study's contact law (`sim.model.contact_law.LAWS`; None: its DEFAULT_LAW)."""
+        from sim.model.contact_law import DEFAULT_LAW
+
+        return self.contact_law if self.contact_law is not None else DEFAULT_LAW
 
     def _settings(self, params: Mapping[str, float]) -> "SystemSettings":
         """What this run's parameters feed (`sim.model.parameters.system_settings`): the sphere of Eqs. 3-6 with its
@@ -236,7 +246,11 @@ class IESModel:
         """Compile the integrator's kernels in this process (`sim.integration.integrators.warm_up`; minutes on a first run)."""
         from sim.integration.integrators import warm_up
 
-        warm_up(self._stepped_sine().integrator, damped=self.contact_law == "hertz-damped")
+        from sim.model.contact_law import law_named
+
+        law = law_named(self._law_name())
+        for name in dict.fromkeys((law.name, law.elastic or law.name)):  # r_cont = 1 runs the elastic law's kernels
+            warm_up(self._stepped_sine().integrator, law=name)
 
     def with_rig(self) -> "IESModel":
         """This model carrying the rig's modal model (built here, used unchanged by every worker)."""
@@ -246,7 +260,9 @@ class IESModel:
         """Settings that define a task's computation (part of its cache key; the built-in rig is covered by
         version, a modal file by its content)."""
         out = {"class": type(self).__name__, "protocol": dict(self.protocol), "n_modes": self.n_modes}
-        if self.contact_law != "hertz":
+        from sim.model.contact_law import DEFAULT_LAW
+
+        if self._law_name() != DEFAULT_LAW:  # the default law is not in the key (keys from before the choice)
             out["contact_law"] = self.contact_law
         if self.variant:
             out["variant"] = dict(self.variant)
@@ -410,11 +426,11 @@ class FunctionModel:
 
 def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, parameters: tuple[str, ...] = (),
                modal_model: str | Path | None = None, variant: Mapping[str, float] | None = None,
-               outputs: tuple[str, ...] = (), contact_law: str = "hertz") -> ResponseModel:
+               outputs: tuple[str, ...] = (), contact_law: str | None = None) -> ResponseModel:
     """The model named by a study's ``model`` key ("ies", "ishigami" or "module:function"); modal_model: a
     modal-model file replacing the built-in rig of "ies"; variant: the [variant] table of "ies"; outputs: the
     outputs of "ies" whose bands and indices the study computes (default: the resonant mean and max);
-    contact_law: the normal contact law of "ies" ("hertz", Eq. 4, or "hertz-damped", Eq. 10)."""
+    contact_law: the normal contact law of "ies" (a name in `sim.model.contact_law.LAWS`; None: its default)."""
     if spec == "ies":
         unknown = [name for name in outputs if name not in IESModel.outputs]
         if unknown:
@@ -422,7 +438,9 @@ def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, paramete
         return IESModel(dict(protocol or {}), modal_file=None if modal_model is None else str(modal_model),
                         variant=dict(variant or {}), **({"banded_outputs": tuple(outputs)} if outputs else {}),
                         contact_law=contact_law)
-    if contact_law != "hertz":
+    from sim.model.contact_law import DEFAULT_LAW
+
+    if contact_law not in (None, DEFAULT_LAW):
         raise StudyError("[study] contact_law only applies to model = \"ies\" (the simulator)")
     if outputs:
         raise StudyError("[study] outputs only applies to model = \"ies\" (the simulator)")

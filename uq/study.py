@@ -340,7 +340,9 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
     for _, one in study.series_studies():
         _parse_contact_law({"contact_law": contact_law}, one.space)  # every value in range
     model = study.make_model()  # unknown model -> one line now
-    if modal_model is not None or variant or contact_law != "hertz":
+    from sim.model.contact_law import DEFAULT_LAW
+
+    if modal_model is not None or variant or contact_law != DEFAULT_LAW:
         model.check()  # an unreadable modal file -> one line now
     if "friction" in space.names:  # every mu of the study: >= 0, and > 0 needs ode3 and the floor values
         k_t = space["k_t"].min if "k_t" in space.names else model.optional_parameter("k_t").nominal
@@ -422,15 +424,15 @@ def _parse_series(table: Any, kind: str, space: ParameterSpace) -> tuple[str, tu
 
 
 def _parse_contact_law(head: Mapping[str, Any], space: ParameterSpace) -> str:
-    """[study] contact_law (Eq. 4 "hertz" or Eq. 10 "hertz-damped"); [parameters.r_cont] implies the damped law,
-    and its values must lie in (0, 1]."""
-    from sim.model.contact_law import CONTACT_LAWS, ContactLaw
+    """[study] contact_law (a law of `sim.model.contact_law.LAWS`: Eq. 4 "hertz" or Eq. 10 "hertz-damped");
+    [parameters.r_cont] implies the damped law, and its values must lie in (0, 1]."""
     from sim.common.errors import SimulationInputError
+    from sim.model.contact_law import DEFAULT_DAMPED_LAW, DEFAULT_LAW, LAWS, ContactLaw
 
     listed = "r_cont" in space.names
-    law = head.get("contact_law", "hertz-damped" if listed else "hertz")
-    if law not in CONTACT_LAWS:
-        raise StudyError(f"[study] contact_law must be one of {', '.join(CONTACT_LAWS)}, got {law!r}")
+    law = head.get("contact_law", DEFAULT_DAMPED_LAW if listed else DEFAULT_LAW)
+    if law not in LAWS:
+        raise StudyError(f"[study] contact_law must be one of {', '.join(LAWS)}, got {law!r}")
     if listed:
         r = space["r_cont"]
         for value in (r.min, r.nominal, r.max):

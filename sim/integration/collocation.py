@@ -22,6 +22,10 @@ for its force polynomial) evaluated at d. The s nodal forces and d are solved to
 method with c_w = 0 at the step's end. Contacts this cannot treat (too short, too long, crossing the end
 of a period or a record instant, a failed Newton iteration) fall back to the Dormand-Prince contact.
 
+The force and its derivative at the nodes are the contact law's (`sim.model.contact_law`, inlined per law); the
+first guesses of the step lengths are those of a Hertz impact, so only laws that say `collocation=True` (Eq. 4)
+come here; the exact integrator takes the contacts of the others by Dormand-Prince.
+
 Accuracy: the force is interpolated by a polynomial of degree s - 1 in u, so a step has the order of
 its interpolation (about s + 1 for the modal response, 2 s for the force impulse, Gauss quadrature);
 with s = 10 a whole impact has a rebound error near 1e-10 (tests/sim/test_collocation.py).
@@ -38,6 +42,7 @@ from numpy.polynomial import legendre, polynomial
 from sim.integration.flight import (ONSET, REGULAR, RELEASE, Constants, closing_at, copy_into, rotate, state_layout, time_map,
                         transition)
 from sim.integration.jit import kernel
+from sim.model.contact_law import wall_force, wall_stiffness
 
 #: Gauss nodes per collocation step.
 NODES = 10
@@ -411,17 +416,24 @@ def _free_closing(step, Y, ct, st, wall, cst, out, rate):
 
 
 @kernel(inline="always")
-def _forces(delta, F, D, kH, s):
-    """Hertz law (Eq. 4) at the nodes: F = k_H delta^1.5, D = dF/d delta."""
+def _forces(delta, F, D, spring, s):
+    """The contact law at the nodes: F = its force (Eq. 4: k_H delta^1.5), D = dF/d delta; spring = (law, k, c)
+    of `_spring` (a law that collocation takes: its force does not depend on the rate, `Law.collocation`)."""
+    law, k_law, c_law = spring
     for k in range(s):
         d = delta[k]
         if d > 0.0:
-            r = math.sqrt(d)
-            F[k] = kH * d * r
-            D[k] = 1.5 * kH * r
+            F[k] = wall_force(law, d, 0.0, k_law, c_law)
+            D[k] = wall_stiffness(law, d, k_law)
         else:
             F[k] = 0.0
             D[k] = 0.0
+
+
+@kernel(inline="always")
+def _spring(cst):
+    """(law, k, c): the contact law of `cst` and its constants (`sim.model.contact_law.Law`)."""
+    return cst.law, cst.par.k_H, cst.par.c_damp
 
 
 @kernel(inline="always")
@@ -447,7 +459,7 @@ def _collocation_equations(step, chom, delta, F, D, A, rhs):
 
 
 @kernel
-def _newton(step, ws, kH):
+def _newton(step, ws, spring):
     """Solve delta_i = chom_i - sum_k W_ik F(delta_k) for the nodal indentations (row delta of ws holds the guess).
 
     Returns the number of iterations, or -1 if Newton's method did not converge."""
@@ -455,7 +467,7 @@ def _newton(step, ws, kH):
     rows, A = ws.rows, ws.A
     chom, delta, F, D, rhs = rows[ROW.chom], rows[ROW.delta], rows[ROW.F], rows[ROW.D], rows[ROW.rhs]
     for it in range(40):
-        _forces(delta, F, D, kH, s)
+        _forces(delta, F, D, spring, s)
         scale = _collocation_equations(step, chom, delta, F, D, A, rhs)
         if not _solve_in_place(A, rhs, s):
             return -1
@@ -466,7 +478,7 @@ def _newton(step, ws, kH):
         if not change <= 1e3 * scale:
             return -1
         if change <= _NEWTON_TOL * scale:
-            _forces(delta, F, D, kH, s)
+            _forces(delta, F, D, spring, s)
             return it + 1
     return -1
 
@@ -789,7 +801,7 @@ def _forward_step(step, Y, ct, st, wall, ratio, ws, cst):
     _free_closing(step, Y, ct, st, wall, cst, chom, False)
     for i in range(s):
         delta[i] = ratio[i] * chom[i]
-    if _newton(step, ws, cst.par.k_H) < 0:
+    if _newton(step, ws, _spring(cst)) < 0:
         return False
     for i in range(s):
         if not delta[i] > 0.0:
@@ -817,7 +829,6 @@ def _release_step(step, end, d, wall, ratio, ws, cst):
     Ys = rows[ROW.Ys]
     Yd = rows[ROW.Ynew]  # dY/dt at the start (free while the release step runs)
     Om = par.Omega
-    kH = par.k_H
     sgn = 1.0 if wall == 0 else -1.0
     oW = off.W
     d_lo = -0.3 * end.h
@@ -840,7 +851,7 @@ def _release_step(step, end, d, wall, ratio, ws, cst):
         cb, sb = rotate(end.cos, end.sin, -Om * d)
         _free_closing(step, Ys, cb, sb, wall, cst, chom, False)
         _free_closing(step, Yd, cb, sb, wall, cst, dchom, True)
-        _forces(delta, F, D, kH, s)
+        _forces(delta, F, D, _spring(cst), s)
         # the collocation equations at the nodes, then c_w = 0 at the end, and the column of d (d/dd = -d/dt_start)
         scale = max(_collocation_equations(step, chom, delta, F, D, A, rhs), abs(chom[s]))
         rhs[s] = chom[s]
@@ -863,7 +874,7 @@ def _release_step(step, end, d, wall, ratio, ws, cst):
         if not d_lo <= d <= d_hi:
             return 2, d
         if change <= _NEWTON_TOL * scale:
-            _forces(delta, F, D, kH, s)
+            _forces(delta, F, D, _spring(cst), s)
             for i in range(s):
                 if not delta[i] > 0.0:
                     return 1, d

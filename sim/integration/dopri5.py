@@ -18,6 +18,7 @@ import numpy as np
 from sim.integration import flight
 from sim.integration.flight import COUNT, GRAZE, NONFINITE, OK, ONSET, OVERLAP, REGULAR, RELEASE, STALLED
 from sim.integration.jit import kernel
+from sim.model.contact_law import uses_rate, wall_dissipation, wall_force
 
 
 class ButcherTableau(NamedTuple):
@@ -49,27 +50,26 @@ DOPRI5 = ButcherTableau(
 class Work(NamedTuple):
     """Scratch of the Dormand-Prince contact: K (7 x size) the stage derivatives, `stage` the state of a
     stage, `end` the state at a step's end, `memo` the two step-length laws of `contact`, `counters` (int64,
-    indexed by `sim.integration.flight.COUNT`); `damped`: () for the elastic law (Eq. 4), (True,) with Eq. 10's damping;
-    `book`: (True,) when the energy bookkeeping's integrals (G_j, Dc) are carried, () when not (no ledger).
+    indexed by `sim.integration.flight.COUNT`); `book`: (True,) when the energy bookkeeping's integrals (G_j, Dc) are
+    carried, () when not (no ledger).
 
-    `damped` and `book` are types, not values: the kernels are compiled once per combination, and a contact
-    carries no trace of what it does not compute (a branch on par.c_damp inside the stages made elastic runs 4 %
-    slower, measured)."""
+    `book` is a type, not a value, like the contact law (`sim.integration.flight.Constants.law`): the kernels are
+    compiled once per combination, and a contact carries no trace of what it does not compute (a branch on
+    par.c_damp inside the stages made elastic runs 4 % slower, measured)."""
 
     K: np.ndarray
     stage: np.ndarray
     end: np.ndarray
     memo: np.ndarray
     counters: np.ndarray
-    damped: tuple
     book: tuple
 
 
-def work(size: int, counters: np.ndarray, damped: bool = False, book: bool = True) -> Work:
-    """A fresh `Work` for deviation states of length `size`, counting into `counters`; damped: the contact law
-    has Eq. 10's damping (par.c_damp > 0); book: carry the energy bookkeeping's integrals."""
+def work(size: int, counters: np.ndarray, book: bool = True) -> Work:
+    """A fresh `Work` for deviation states of length `size`, counting into `counters`; book: carry the energy
+    bookkeeping's integrals."""
     return Work(K=np.zeros((7, size)), stage=np.zeros(size), end=np.zeros(size), memo=np.zeros(2),
-                counters=counters, damped=(True,) if damped else (), book=(True,) if book else ())
+                counters=counters, book=(True,) if book else ())
 
 
 # No fastmath: reassociation lets each compiled specialisation round differently, and the chaotic response
@@ -93,9 +93,10 @@ def _wall_rate(ct, st, Y, left, cst):
 
 @kernel(inline="always", fastmath=_FAST)
 def rhs(ct, st, Y, out, cst, book):
-    """Eqs. 3-7 with the elastic law (Eq. 4) in the deviation coordinates at cos, sin(Omega t) = ct, st, plus the
-    integrands of F_l, F_r and, when booking (`Work.book`), of each mode's contact work G_j
-    (`sim.integration.flight.StateLayout`); the contact's dissipation Dc is `_damping`'s (Eq. 10): here it stays 0."""
+    """Eqs. 3-7 with the contact law cst.law (`sim.model.contact_law`) in the deviation coordinates at cos,
+    sin(Omega t) = ct, st, plus the integrands of F_l, F_r and, when booking (`Work.book`), of each mode's contact
+    work G_j and of the law's dissipation Dc (`sim.integration.flight.StateLayout`; it stays 0 for a conservative
+    law, whose approach rates are not computed)."""
     md, par = cst.modes, cst.par
     lay = flight.state_layout(md.size)
     g = par.g
@@ -106,9 +107,18 @@ def rhs(ct, st, Y, out, cst, book):
         x = Y[lay.x + j]
         dl += md[j].phi_l * x
         dr += md[j].phi_r * x
-    kH = par.k_H
-    fl = kH * dl * math.sqrt(dl) if dl > 0.0 else 0.0
-    fr = -kH * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
+    law = cst.law
+    rate_l = rate_r = 0.0
+    if uses_rate(law):  # a compile-time constant per law
+        if dl > 0.0:
+            rate_l = _wall_rate(ct, st, Y, True, cst)
+        if dr < 0.0:
+            rate_r = -_wall_rate(ct, st, Y, False, cst)
+        if len(book) > 0:
+            out[lay.Dc] = (wall_dissipation(law, dl, rate_l, par.k_H, par.c_damp)
+                           + wall_dissipation(law, -dr, rate_r, par.k_H, par.c_damp))
+    fl = wall_force(law, dl, rate_l, par.k_H, par.c_damp)
+    fr = -wall_force(law, -dr, rate_r, par.k_H, par.c_damp)
     for j in range(lay.n):
         v = Y[lay.v + j]
         out[lay.x + j] = v
@@ -121,50 +131,6 @@ def rhs(ct, st, Y, out, cst, book):
     out[lay.F_l + 1] = -fl * st
     out[lay.F_r] = fr * ct
     out[lay.F_r + 1] = -fr * st
-
-
-@kernel(inline="always", fastmath=_FAST)
-def _damping(ct, st, Y, out, cst):
-    """Add the damping of Eq. 10 to the right-hand side `out` of `rhs` (par.c_damp > 0): d_H delta' on each wall
-    while it approaches, in the modes', the sphere's and the Fourier and contact-work integrands, and its power
-    as the integrand of Dc. (Apart from `rhs`: inside it, even untaken, this made the elastic contacts 5 % slower.)"""
-    md, par = cst.modes, cst.par
-    lay = flight.state_layout(md.size)
-    z = Y[lay.z]
-    dl = par.W_l_re * ct - par.W_l_im * st - z - par.g
-    dr = par.W_r_re * ct - par.W_r_im * st - z + par.g
-    for j in range(lay.n):
-        dl += md[j].phi_l * Y[lay.x + j]
-        dr += md[j].phi_r * Y[lay.x + j]
-    fl = fr = p_contact = 0.0
-    if dl > 0.0:
-        rate = _wall_rate(ct, st, Y, True, cst)
-        if rate > 0.0:
-            fl = par.c_damp * math.sqrt(math.sqrt(dl)) * rate
-            p_contact += fl * rate
-    if dr < 0.0:
-        rate = -_wall_rate(ct, st, Y, False, cst)
-        if rate > 0.0:
-            fr = -par.c_damp * math.sqrt(math.sqrt(-dr)) * rate
-            p_contact -= fr * rate
-    for j in range(lay.n):
-        out[lay.v + j] -= md[j].phi_l * fl + md[j].phi_r * fr
-        out[lay.G + j] += (md[j].phi_l * fl + md[j].phi_r * fr) * Y[lay.v + j]
-    out[lay.zd] += (fl + fr) * par.inv_m_a
-    out[lay.F_l] += fl * ct
-    out[lay.F_l + 1] -= fl * st
-    out[lay.F_r] += fr * ct
-    out[lay.F_r + 1] -= fr * st
-    out[lay.Dc] = p_contact
-
-
-@kernel(inline="always", fastmath=_FAST)
-def forces(ct, st, Y, out, cst, damped, book):
-    """The right-hand side of the contact (`rhs`) with the damping of Eq. 10 when the law has it (damped, book:
-    `Work.damped`, `Work.book`; for () their branches are removed at compile time)."""
-    rhs(ct, st, Y, out, cst, book)
-    if len(damped) > 0:
-        _damping(ct, st, Y, out, cst)
 
 
 @kernel(inline="always")
@@ -187,11 +153,12 @@ def _combine(Y, K, d, row, out, m):
 
 
 @kernel(inline="always", fastmath=_FAST)
-def _stage(Y, K, tmp, d, row, k, phase, cst, damped, book):
-    """Stage k: its state Y + sum_j row[j] d[j] K[j] in tmp, and K[k] = F there, at cos, sin(Omega t) = phase.
-    Only the mechanical state: the right-hand side does not depend on the carried integrals."""
+def _stage(Y, work, d, row, k, phase, cst):
+    """Stage k: its state Y + sum_j row[j] d[j] K[j] in work.stage, and K[k] = F there, at cos, sin(Omega t) =
+    phase. Only the mechanical state: the right-hand side does not depend on the carried integrals."""
+    K, tmp = work.K, work.stage
     _combine(Y, K, d, row, tmp, flight.state_layout(cst.modes.size).acc)
-    forces(phase[0], phase[1], tmp, K[k], cst, damped, book)
+    rhs(phase[0], phase[1], tmp, K[k], cst, work.book)
 
 
 @kernel(inline="always", fastmath=_FAST)
@@ -216,7 +183,7 @@ def step(Y, ct0, st0, s, kind, work, cst):
     """
     md, par = cst.modes, cst.par
     lay = flight.state_layout(md.size)
-    K, tmp, Ynew = work.K, work.stage, work.end
+    K, Ynew = work.K, work.end
     c, a = DOPRI5.c, DOPRI5.a
     Om = par.Omega
     _, d1 = _warp(kind, c[0], s)
@@ -226,15 +193,15 @@ def step(Y, ct0, st0, s, kind, work, cst):
     p5, d5 = _warp(kind, c[4], s)
     _, d6 = _warp(kind, c[5], s)
     d = (d1, d2, d3, d4, d5, d6, d6)
-    _stage(Y, K, tmp, d, a[1], 1, flight.rotate(ct0, st0, Om * p2), cst, work.damped, work.book)
-    _stage(Y, K, tmp, d, a[2], 2, flight.rotate(ct0, st0, Om * p3), cst, work.damped, work.book)
-    _stage(Y, K, tmp, d, a[3], 3, flight.rotate(ct0, st0, Om * p4), cst, work.damped, work.book)
-    _stage(Y, K, tmp, d, a[4], 4, flight.rotate(ct0, st0, Om * p5), cst, work.damped, work.book)
+    _stage(Y, work, d, a[1], 1, flight.rotate(ct0, st0, Om * p2), cst)
+    _stage(Y, work, d, a[2], 2, flight.rotate(ct0, st0, Om * p3), cst)
+    _stage(Y, work, d, a[3], 3, flight.rotate(ct0, st0, Om * p4), cst)
+    _stage(Y, work, d, a[4], 4, flight.rotate(ct0, st0, Om * p5), cst)
     ct, st = flight.rotate(ct0, st0, Om * s)
-    _stage(Y, K, tmp, d, a[5], 5, (ct, st), cst, work.damped, work.book)
+    _stage(Y, work, d, a[5], 5, (ct, st), cst)
     # the carried integrals up to G always (Fourier), G and Dc only when booking (else they stay 0)
     _combine(Y, K, d, DOPRI5.b, Ynew, Y.size if len(work.book) > 0 else lay.G)
-    forces(ct, st, Ynew, K[6], cst, work.damped, work.book)
+    rhs(ct, st, Ynew, K[6], cst, work.book)
     err = 0.0
     for j in range(lay.n):
         err = max(err, abs(_error(K, d, lay.x + j)) * md[j].err_x)
@@ -343,7 +310,7 @@ def contact(Y, t, t_stop, h, at_onset, work, cst):
     Om = par.Omega
     ct = math.cos(Om * t)  # the phase at t, carried along by rotations
     st = math.sin(Om * t)
-    forces(ct, st, Y, K[0], cst, work.damped, work.book)
+    rhs(ct, st, Y, K[0], cst, work.book)
     cl, cld, cr, crd = flight.closing_at(Y, ct, st, cst)
     wall_left = cl > cr  # the wall in contact (or about to be)
     open_l = cl <= 0.0

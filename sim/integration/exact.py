@@ -290,17 +290,19 @@ def _to_state(Y, t, y_out, cst):
 # `sim.integration.collocation`, `sim.integration.dopri5`), the period's Fourier coefficient; and the period loop
 # ----------------------------------------------------------------------------------------------------------
 @kernel
-def _fly(p, t, released, onsets, cst, grid, work, record, recorder):
+def _fly(p, t, released, onsets, cst, grid, work, recording_to):
     """Free flight of period p from t (Eq. 9) until a contact onset or the period's end. From a release at t
     the flight to the next grid point is searched; from there the flight goes on one grid step at a time in
     closed form, each step accepted if certified contact-free, else searched. The state is recorded at the
-    record instants passed (`_record_flight`). More than _MAX_ONSETS_PER_PERIOD onsets so far (onsets) stop
+    record instants passed into recording_to = (record, recorder) (`_record_flight`). More than
+    _MAX_ONSETS_PER_PERIOD onsets so far (onsets) stop
     the run at the first grid point reached.
 
     Returns (status, t, wall, tau): an onset at wall 0/1 at t + tau (its state in work.scratch), t the release
     or the grid point the searched step starts from, or wall -1 at the period's end. t is a grid point unless
     released.
     """
+    record, recorder = recording_to
     md, par = cst.modes, cst.par
     lay = state_layout(md.size)
     Y, Ynew, A, scratch, counters = work.Y, work.Ynew, work.A, work.scratch, work.counters
@@ -571,15 +573,20 @@ def _log_release(Y, t, p, T, cst, log, i):
 
 
 @kernel(refcounts=False)
-def _advance(y, run):
-    """Advance y (phase 0) over the periods of run.out; returns (status, period of failure).
+def _advance(y, given, law):
+    """Advance y (phase 0) over the periods of given.out; returns (status, period of failure). given: the `Run`
+    whose constants carry no law (None); law: the contact law (`sim.model.contact_law.Law`), an argument of its own
+    because inside the tuple numba would type all of `given` in Python at every call (~0.5 ms, 5 % of a point);
+    the kernels below get the `Run` with it.
 
     Each period from phase 0: free flight (`_fly`), contacts (`collocation.contact` from an onset if
     run.use_collocation, `dopri5.contact` wherever that falls back), then the period's |c_1| and onset count
     (`_fundamental`). A contact may go on into the next period. One kernel for all periods (a call from Python
     per period would unbox every array of `run` again), compiled without reference counts (`sim.integration.jit`): the
     kernels it calls inherit that, except `collocation._build`, which allocates."""
-    cst, grid, colloc, dp, use_collocation = run.cst, run.grid, run.colloc, run.dp, run.use_collocation
+    cst = flight.Constants(given.cst.modes, given.cst.par, law)
+    run = Run(cst, given.grid, given.out, given.work, given.dp, given.colloc, given.use_collocation, given.recorder)
+    grid, colloc, dp, use_collocation = run.grid, run.colloc, run.dp, run.use_collocation
     work = run.work
     Y, X0, scratch, counters = work.Y, work.X0, work.scratch, work.counters
     amplitudes, impacts, record = run.out.amplitudes, run.out.impacts, run.out.record
@@ -639,7 +646,7 @@ def _advance(y, run):
                 in_contact = False
                 _log_release(Y, t, p, grid.T, cst, log, open_impact)
                 open_impact = -1
-            status, t, wall, tau = _fly(p, t, released, onsets, cst, grid, work, record, run.recorder)
+            status, t, wall, tau = _fly(p, t, released, onsets, cst, grid, work, (record, run.recorder))
             if status != OK:
                 return status, p
             if wall < 0:
@@ -711,7 +718,7 @@ def _prepare(Omega: float, a_base: float, sys: SystemArrays, N: int, rtol: float
     phase = Omega * hg * np.arange(N + 1)
     T = 2.0 * math.pi / Omega
     grid = Grid(N=N, T=T, h=hg, M=samples, dt=T / samples, rot=np.vstack([np.cos(phase), np.sin(phase)]))
-    return Constants(modes=md, par=par), grid
+    return Constants(modes=md, par=par, law=sys.law), grid
 
 
 def _work(cst: Constants) -> Work:
@@ -740,8 +747,9 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     fixed_contact_step: > 0 replaces the error control in contacts by this fixed step in s (order studies;
     Dormand-Prince only).
     contacts: "collocation" (default: `sim.integration.collocation`, Dormand-Prince where it falls back) or "dopri5"
-    (every contact by the Dormand-Prince 5(4) pair with error control at rtol). With the damped contact law
-    (Eq. 10, sys.c_damp > 0) every contact takes the Dormand-Prince pair: collocation solves Eq. 4 only.
+    (every contact by the Dormand-Prince 5(4) pair with error control at rtol). With a contact law that collocation
+    does not take (`sim.model.contact_law.Law.collocation`: the damped law of Eq. 10) every contact takes the
+    Dormand-Prince pair.
     stats: optional dict that receives the kernel's counters (the fields of `sim.integration.flight.Counters`: grid
     steps, searches, contact steps, ...).
     ledger: optional `sim.integration.energy.Ledger` that receives the energy bookkeeping per period (exact closed forms,
@@ -769,15 +777,13 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     work = _work(cst)
     out = integrator_output(n_periods, sys.omega.size, record_arr, ledger)
     stored_start = stored_energy(y, sys) if ledger is not None else math.nan
-    # collocation solves the elastic law (Eq. 4); the damped law (Eq. 10) takes the Dormand-Prince contact
-    use_collocation = contacts == "collocation" and fixed_contact_step <= 0.0 and sys.c_damp == 0.0
-    damped = sys.c_damp > 0.0
+    # collocation solves the laws that say so (Eq. 4); the others (Eq. 10) take the Dormand-Prince contact
+    use_collocation = contacts == "collocation" and fixed_contact_step <= 0.0 and sys.law.collocation
     recorder = Recorder(Y=np.zeros(work.Y.size), Ynew=np.zeros(work.Y.size),
-                        dp=dopri5.work(work.Y.size, np.zeros_like(work.counters), damped, ledger is not None))
-    run = Run(cst, grid, out, work, dopri5.work(work.Y.size, work.counters, damped, ledger is not None),
-              collocation.context(cst),
-              use_collocation, recorder)
-    status, period = _advance(y, run)
+                        dp=dopri5.work(work.Y.size, np.zeros_like(work.counters), ledger is not None))
+    run = Run(cst._replace(law=None), grid, out, work, dopri5.work(work.Y.size, work.counters, ledger is not None),
+              collocation.context(cst), use_collocation, recorder)
+    status, period = _advance(y, run, sys.law)
     if stats is not None:
         for name, value in zip(COUNT._fields, work.counters):
             stats[name] = stats.get(name, 0) + int(value)

@@ -21,6 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 from sim.integration.jit import kernel
+from sim.model.contact_law import Law
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -144,11 +145,13 @@ def run_record(**values: float) -> np.void:
 
 
 class Constants(NamedTuple):
-    """The constants of one run of the exact integrator: a `MODE` record per mode and the `RUN` record (the
-    state layout is `state_layout(modes.size)`)."""
+    """The constants of one run of the exact integrator: a `MODE` record per mode, the `RUN` record (the
+    state layout is `state_layout(modes.size)`) and the contact law (`sim.model.contact_law.Law`: the kernels are
+    compiled per law; its constants k, c are par.k_H, par.c_damp)."""
 
     modes: np.ndarray
     par: np.void
+    law: Law
 
 
 class Output(NamedTuple):

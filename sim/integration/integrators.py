@@ -59,20 +59,21 @@ COMPILE_MINUTES = {"exact": 2, "ode3": 1}
 NOTICE_AFTER_S = 5.0
 
 
-def _run_tiny_system(run_step: RunStep, *, damped: bool = False) -> None:
+def _run_tiny_system(run_step: RunStep, *, law: str = "hertz") -> None:
     """Short runs of a tiny impacting system (2 modes, the sphere sent into a wall) in every form a stepped-sine
     run calls the integrator (`sim.stepped_sine.protocol.run_sweep`): without the energy ledger (lead-in, wait)
-    and with it (hold), with the elastic law or, when `damped`, Eq. 10's damped law. numba compiles one
-    specialisation per form, so each kernel a worker will call is compiled (or loaded) here, in the parent."""
+    and with it (hold), with the contact law `law` (a name of `sim.model.contact_law.LAWS`; a law that takes r_cont
+    with r_cont = 0.9). numba compiles one specialisation per form and law, so each kernel a worker will call is
+    compiled (or loaded) here, in the parent."""
     from sim.integration.energy import Ledger
-    from sim.model.contact_law import ContactLaw
+    from sim.model.contact_law import contact_law_of, law_named
 
     model = ModalModel(frequencies_hz=np.array([100.0, 20000.0]), damping_ratios=np.array([0.01, 0.01]),
                        phi_wall_left=np.array([1.0, 0.5]), phi_wall_right=np.array([1.0, 0.5]),
                        phi_tip=np.array([1.0, 0.5]), participation=np.array([1.0, 0.3]), source="warm-up",
                        beam_mass=1.0)
-    law = ContactLaw("hertz-damped", 0.9) if damped else ContactLaw()
-    sys = system_arrays(model, Impactor(contact_law=law))
+    contact = contact_law_of(law, 0.9 if law_named(law).takes_r_cont else None)
+    sys = system_arrays(model, Impactor(contact_law=contact))
     for ledger in (None, Ledger()):
         y = np.zeros(2 * model.n_modes + 2)
         y[-1] = 0.5  # m/s: the sphere meets a wall within the first period
@@ -82,13 +83,14 @@ def _run_tiny_system(run_step: RunStep, *, damped: bool = False) -> None:
             run_step(y, 3, 2.0 * np.pi * 100.0, 1e-5, sys, None, ledger=ledger)
 
 
-def warm_up(name: str, *, damped: bool = False, stream: TextIO | None = None) -> float:
+def warm_up(name: str, *, law: str = "hertz", stream: TextIO | None = None) -> float:
     """Compile (or load from numba's on-disk cache) the kernels of the integrator `name` in this process by one
     short run of a tiny system, before any timed or progress-reported work. When that takes longer than
     NOTICE_AFTER_S (a cold cache), one line ``compiling ... kernels (first run only, about N min) ...`` goes to
     `stream` (stderr) while it happens, and one line with the time when it is done. Returns the seconds spent
-    (0 when this process has warmed the integrator before). damped: the run uses Eq. 10's damped contact law."""
-    if (name, damped) in _WARM:
+    (0 when this process has warmed the integrator with this law before). law: the run's contact law (its name in
+    `sim.model.contact_law.LAWS`; the kernels are compiled per law)."""
+    if (name, law) in _WARM:
         return 0.0
     run_step = get_integrator(name)
     stream = stream or _sys.stderr
@@ -102,15 +104,15 @@ def warm_up(name: str, *, damped: bool = False, stream: TextIO | None = None) ->
     started = time.perf_counter()
     notice.start()
     try:
-        _run_tiny_system(run_step, damped=damped)
+        _run_tiny_system(run_step, law=law)
     finally:
         notice.cancel()
     elapsed = time.perf_counter() - started
-    _WARM.add((name, damped))
+    _WARM.add((name, law))
     if elapsed > NOTICE_AFTER_S:
         stream.write(f"kernels compiled in {elapsed:.0f} s; later runs load them from the cache\n")
     return elapsed
 
 
 #: integrators warmed up in this process (the kernels' argument types do not depend on dt_scale)
-_WARM: set[tuple[str, bool]] = set()
+_WARM: set[tuple[str, str]] = set()

@@ -29,6 +29,13 @@ without counts, so a breach of the first rule is an error, not a leak; a kernel 
 `refcounts=True`. numba's cache keys a kernel on its signature alone, so a kernel that hands arrays back
 (`sim.integration.collocation._step_table`) must only ever be called from kernels without counts.
 
+`_nrt` is a private option of numba (tested with the versions pyproject.toml allows, 0.59 to 0.68). A numba that
+does not know it (`nrt_option_supported`) would refuse every such kernel at its first call; `kernel` then compiles
+it with reference counts (correct, some percent slower in the exact integrator) and says so once per process.
+
+The contact laws (`sim.model.contact_law`) are compiled inlined into the kernels, per law: their file is part of
+the fingerprint (`FINGERPRINT_FILES`).
+
 Where the cache folder cannot be written to (a read-only install: numba then uses its user cache folder;
 NUMBA_CACHE_DIR if set), nothing is deleted and numba itself decides (an install brings new files with new
 modification times, which numba's own key already catches). A process that was started before an edit and
@@ -38,6 +45,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import sys
 from pathlib import Path
 from typing import Callable
 
@@ -49,16 +57,34 @@ KERNEL_MODULES = ("jit", "flight", "dopri5", "collocation", "exact", "ode3")
 FINGERPRINT_FILE = "sim-kernels.sha256"
 
 _SOURCE_DIR = Path(__file__).resolve().parent
+#: Sources inlined into the kernels without kernels (cached files) of their own: the contact laws.
+FINGERPRINT_FILES = (_SOURCE_DIR.parent / "model" / "contact_law.py",)
 _checked_folders: set[str] = set()
+#: The message `kernel` writes (once) when numba refuses the `_nrt` option.
+NRT_FALLBACK_NOTICE = ("numba {version} does not take the option _nrt: the kernels of sim are compiled with "
+                       "reference counts (correct, somewhat slower)\n")
+_fallback_said = False
 
 
 def fingerprint() -> str:
-    """SHA-256 (hex) of the names and contents of the source files of KERNEL_MODULES."""
+    """SHA-256 (hex) of the names and contents of the source files of KERNEL_MODULES and FINGERPRINT_FILES."""
     digest = hashlib.sha256()
     for stem in KERNEL_MODULES:
         digest.update(stem.encode() + b"\0")
         digest.update((_SOURCE_DIR / f"{stem}.py").read_bytes())
+    for path in FINGERPRINT_FILES:
+        digest.update(path.name.encode() + b"\0")
+        digest.update(path.read_bytes())
     return digest.hexdigest()
+
+
+def nrt_option_supported() -> bool:
+    """True if the installed numba knows the private `_nrt` option (a kernel without reference counts)."""
+    try:
+        from numba.core.cpu import CPUTargetOptions
+    except ImportError:
+        return False
+    return hasattr(CPUTargetOptions, "_nrt")
 
 
 def discard_stale_kernels(cache_folder: str | os.PathLike) -> bool:
@@ -98,10 +124,16 @@ def kernel(function: Callable | None = None, *, refcounts: bool | None = None, *
     refcounts: False compiles the kernel, and every kernel it calls that does not say otherwise, without
     numba's reference counts (see the module docstring: such kernels may not allocate, copy slices or hand
     arrays back); True keeps them for a kernel that allocates and may be called from one without; None
-    (default): numba's default, inherited from the calling kernel.
+    (default): numba's default, inherited from the calling kernel. A numba without the option
+    (`nrt_option_supported`) compiles every kernel with counts, and this says so once per process on stderr.
     """
+    global _fallback_said
     if refcounts is not None:
-        options["_nrt"] = refcounts
+        if nrt_option_supported():
+            options["_nrt"] = refcounts
+        elif not _fallback_said:
+            _fallback_said = True
+            sys.stderr.write(NRT_FALLBACK_NOTICE.format(version=numba.__version__))
 
     def decorate(py_function: Callable) -> Callable:
         dispatcher = numba.njit(cache=True, **options)(py_function)

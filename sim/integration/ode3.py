@@ -5,8 +5,8 @@ Eqs. 3-7 in the relative coordinates of `sim.model.system` (y = [s, s', u_a, u_a
     s_j''  = -2 D_j w_j s_j' - w_j^2 s_j - phi_l,j f_l - phi_r,j f_r + gamma_j a_base Omega^2 cos(Omega t)
     u_a''  = (f_l + f_r) / m_a + a_base Omega^2 cos(Omega t)
 
-with the Hertz forces of Eqs. 4-6 (`sim.model.system.contact_forces`), or the damped law of Eq. 10 (each force
-gains c_damp delta^0.25 delta' while its wall approaches). The scheme is the explicit 3-stage
+with the wall forces of the contact law sys.law (`sim.model.contact_law`: Eq. 4, or the damped law of Eq. 10, whose
+force gains c_damp delta^0.25 delta' while its wall approaches), compiled per law. The scheme is the explicit 3-stage
 Bogacki-Shampine tableau without error control, exactly MATLAB's fixed-step ``ode3``:
 
     k1 = f(t, y),  k2 = f(t + h/2, y + h/2 k1),  k3 = f(t + 3h/4, y + 3h/4 k2),
@@ -33,7 +33,7 @@ call like y.
 Energy bookkeeping (Sect. 5.5, `sim.integration.energy.Ledger`) by the scheme's own quadrature: the work of the base
 excitation a_base Omega^2 cos(Omega t) (gamma^T s' + m_a u_a') and each mode's dissipation 2 D_j omega_j s_j'^2
 are integrated like extra components of the state (the Bogacki-Shampine weights on the stage values), as is
-the damped law's dissipation c_damp delta^0.25 delta'^2 (Eq. 10, in approach), the slider's mu N |u'| of
+the contact law's dissipation (Eq. 10: c_damp delta^0.25 delta'^2 in approach), the slider's mu N |u'| of
 dry friction, and
 the Fourier coefficients of tip and walls by the trapezoidal rule. Its energy balance closes only to the
 scheme's truncation error (third order in h). ode3 keeps no impact records.
@@ -49,6 +49,7 @@ from sim.common.errors import SimulationDiverged, SimulationInputError
 from sim.integration.energy import Ledger, integrator_output, stored_energy
 from sim.integration.flight import LEDGER, state_layout
 from sim.integration.jit import kernel
+from sim.model.contact_law import Law, uses_rate, wall_dissipation, wall_force
 from sim.model.system import SystemArrays, check_run_step
 
 #: Sect. 3.2: the highest retained mode's period is sampled with 15 time levels.
@@ -85,14 +86,16 @@ def check_stability(sys: SystemArrays, h: float) -> None:
 
     Each mode's eigenvalue lambda = omega (-D + i sqrt(1 - D^2)) must satisfy |R(h lambda)| <= 1; the
     contact is checked as the sphere on a rigid wall linearised at delta = 0.1 g:
-    k = 1.5 k_H delta^0.5, lambda = i sqrt(k / m_a). On the imaginary axis the limit is h omega <= sqrt(3).
+    k = the law's stiffness there (Eq. 4: 1.5 k_H delta^0.5), lambda = i sqrt(k / m_a). On the imaginary axis the
+    limit is h omega <= sqrt(3).
     """
     candidates = [(float(w), float(d), f"mode {j + 1} ({w / (2 * math.pi):.6g} Hz)")
                   for j, (w, d) in enumerate(zip(sys.omega, sys.D))]
     if sys.k_H > 0:
         delta = STABILITY_INDENTATION_FRACTION * sys.g
-        w_contact = math.sqrt(1.5 * sys.k_H * math.sqrt(delta) / sys.m_a)
-        candidates.append((w_contact, 0.0, f"the Hertz contact ({w_contact / (2 * math.pi):.6g} Hz at delta = {delta:.3g} m)"))
+        w_contact = math.sqrt(sys.law.stiffness.py_func(delta, sys.k_H) / sys.m_a)
+        candidates.append((w_contact, 0.0, f"the {sys.law.name} contact ({w_contact / (2 * math.pi):.6g} Hz at "
+                                           f"delta = {delta:.3g} m)"))
     if sys.slip_force > 0:  # the sphere stuck to the floor by the Jenkins spring (Appendix C)
         w_stick = math.sqrt(sys.k_t / sys.m_a)
         candidates.append((w_stick, 0.0, f"the friction spring k_t ({w_stick / (2 * math.pi):.6g} Hz)"))
@@ -123,7 +126,8 @@ class Steps(NamedTuple):
 class Coefficients(NamedTuple):
     """Eqs. 3-7 as the kernel evaluates them: w2 = omega^2, c = 2 D omega (1/s), gamma = phi^T M b, the wall values phi_l, phi_r,
     the base forcing amplitudes f_modal = gamma a_base Omega^2 and f_sphere = a_base Omega^2, m_a, k_H, g, and
-    c_damp of Eq. 10 (0: elastic)."""
+    c_damp of Eq. 10 (0: elastic), the friction's phi_f, k_t and slip force (Appendix C), the contact law (its
+    kernels inlined per law) and Omega (rad/s)."""
 
     w2: np.ndarray
     c: np.ndarray
@@ -139,6 +143,15 @@ class Coefficients(NamedTuple):
     phi_f: np.ndarray
     k_t: float
     slip_force: float
+    law: Law
+    Omega: float
+
+
+class Model(NamedTuple):
+    """What a step's kernels read: the `Coefficients` and the state layout (`sim.integration.flight.state_layout`)."""
+
+    co: Coefficients
+    lay: tuple
 
 
 @kernel(inline="always", fastmath=_FAST)
@@ -175,58 +188,48 @@ def _floor_relative(y, co, lay):
 
 @kernel(inline="always", fastmath=_FAST)
 def _deriv(y, cos_t, co, lay, out):
-    """Right-hand side of Eqs. 3-7 in relative coordinates with the elastic law of Eq. 4 (module docstring)."""
+    """Right-hand side of Eqs. 3-7 in relative coordinates with the contact law co.law (module docstring) into out;
+    returns the power (W) the contacts dissipate (0 for a conservative law, whose approach rates are not computed)."""
     dl, dr = _indentations(y, co, lay)
-    fl = co.k_H * dl * math.sqrt(dl) if dl > 0.0 else 0.0
-    fr = -co.k_H * (-dr) * math.sqrt(-dr) if dr < 0.0 else 0.0
+    rate_l = rate_r = 0.0
+    if uses_rate(co.law):  # a compile-time constant: the elastic law's kernels have no trace of this
+        if dl > 0.0:
+            rate_l = _approach_rate(y, co.phi_l, co, lay)
+        if dr < 0.0:
+            rate_r = -_approach_rate(y, co.phi_r, co, lay)
+    fl = wall_force(co.law, dl, rate_l, co.k_H, co.c_damp)
+    fr = -wall_force(co.law, -dr, rate_r, co.k_H, co.c_damp)
+    p_contact = 0.0
+    if uses_rate(co.law):
+        p_contact = (wall_dissipation(co.law, dl, rate_l, co.k_H, co.c_damp)
+                     + wall_dissipation(co.law, -dr, rate_r, co.k_H, co.c_damp))
     for j in range(lay.n):
         out[lay.x + j] = y[lay.v + j]
         out[lay.v + j] = (-co.c[j] * y[lay.v + j] - co.w2[j] * y[lay.x + j] - co.phi_l[j] * fl - co.phi_r[j] * fr
                           + co.f_modal[j] * cos_t)
     out[lay.z] = y[lay.zd]
     out[lay.zd] = (fl + fr) / co.m_a + co.f_sphere * cos_t
+    return p_contact
 
 
 @kernel(inline="always", fastmath=_FAST)
-def _beyond_hertz(y, co, lay, out, slider_z, sense):
-    """Add to `out` (the derivative of `_deriv`) the forces beyond Eq. 4: the damping of Eq. 10 while a wall
-    approaches, and the friction force f_t of the slider at slider_z in phase `sense` (0 stick, +-1 slip; + f_t on
-    the sphere, - phi_f,j f_t on the modes, Appendix C). Returns the powers (W) the contacts and the slider
-    dissipate. (A separate function: inside `_deriv`, even untaken, these branches made the elastic steps 2.4x
+def _friction(y, co, lay, out, slider):
+    """Add to `out` (the derivative of `_deriv`) the friction force f_t of the slider slider = (z, sense) (sense 0
+    stick, +-1 slip; + f_t on the sphere, - phi_f,j f_t on the modes, Appendix C). Returns the power (W) the slider
+    dissipates. (A separate function: inside `_deriv`, even untaken, such branches made the elastic steps 2.4x
     slower.)"""
-    dl, dr = _indentations(y, co, lay)
-    f_sphere = 0.0  # the extra force on the sphere; the modes take -phi_w f for each wall's share
-    p_contact = 0.0
-    if co.c_damp > 0.0:
-        if dl > 0.0:
-            rate = _approach_rate(y, co.phi_l, co, lay)
-            if rate > 0.0:
-                damping = co.c_damp * math.sqrt(math.sqrt(dl)) * rate
-                f_sphere += damping
-                p_contact += damping * rate
-                for j in range(lay.n):
-                    out[lay.v + j] -= co.phi_l[j] * damping
-        if dr < 0.0:
-            rate = -_approach_rate(y, co.phi_r, co, lay)
-            if rate > 0.0:
-                damping = co.c_damp * math.sqrt(math.sqrt(-dr)) * rate
-                f_sphere -= damping
-                p_contact += damping * rate
-                for j in range(lay.n):
-                    out[lay.v + j] += co.phi_r[j] * damping
+    slider_z, sense = slider
+    u, ud = _floor_relative(y, co, lay)
     p_friction = 0.0
-    if co.slip_force > 0.0:
-        u, ud = _floor_relative(y, co, lay)
-        if sense == 0.0:
-            ft = -co.k_t * (u - slider_z)
-        else:
-            ft = -sense * co.slip_force
-            p_friction = -ft * ud
-        f_sphere += ft
-        for j in range(lay.n):
-            out[lay.v + j] -= co.phi_f[j] * ft
-    out[lay.zd] += f_sphere / co.m_a
-    return p_contact, p_friction
+    if sense == 0.0:
+        ft = -co.k_t * (u - slider_z)
+    else:
+        ft = -sense * co.slip_force
+        p_friction = -ft * ud
+    for j in range(lay.n):
+        out[lay.v + j] -= co.phi_f[j] * ft
+    out[lay.zd] += ft / co.m_a
+    return p_friction
 
 
 @kernel(inline="always", fastmath=_FAST)
@@ -251,11 +254,12 @@ def _book(y, cos_t, weight, co, lay, ledger_row):
 
 
 @kernel(inline="always", fastmath=_FAST)
-def _stage(y, cos_t, weight, co, lay, out, slider_z, sense, row, book):
-    """A stage of the general step: the derivative with the forces beyond Eq. 4 into `out`, and with `book` its
-    integrands (weight: the stage's quadrature weight, s) into the ledger row."""
-    _deriv(y, cos_t, co, lay, out)
-    p_contact, p_friction = _beyond_hertz(y, co, lay, out, slider_z, sense)
+def _stage(y, cos_t, weight, model, out, slider, row, book):
+    """A stage of the friction step: the derivative with the slider's force (slider = (z, sense)) into `out`, and
+    with `book` its integrands (weight: the stage's quadrature weight, s) into the ledger row."""
+    co, lay = model
+    p_contact = _deriv(y, cos_t, co, lay, out)
+    p_friction = _friction(y, co, lay, out, slider)
     if book:
         _book(y, cos_t, weight, co, lay, row)
         row[LEDGER.contact] += weight * p_contact
@@ -263,21 +267,22 @@ def _stage(y, cos_t, weight, co, lay, out, slider_z, sense, row, book):
 
 
 @kernel(inline="always", fastmath=_FAST)
-def _bs_step(y, t, L, Omega, co, lay, slider_z, sense, stages, row, book):
-    """One Bogacki-Shampine step of length L (s) from (t, y) with the slider in its phase: the state at t + L in
-    stages[3] (y unchanged); with `book` the bookkeeping's integrands into `row` (weights scaled to L)."""
+def _bs_step(y, t, L, model, slider, stages, row, book):
+    """One Bogacki-Shampine step of length L (s) from (t, y) with the slider (z, sense) in its phase: the state at
+    t + L in stages[3] (y unchanged); with `book` the bookkeeping's integrands into `row` (weights scaled to L)."""
     k1, k2, k3, yt = stages[0], stages[1], stages[2], stages[4]
-    ny = lay.acc
+    Omega = model.co.Omega
+    ny = model.lay.acc
     c0 = math.cos(Omega * t)
     c1 = math.cos(Omega * (t + 0.5 * L))
     c2 = math.cos(Omega * (t + 0.75 * L))
-    _stage(y, c0, L * 2.0 / 9.0, co, lay, k1, slider_z, sense, row, book)
+    _stage(y, c0, L * 2.0 / 9.0, model, k1, slider, row, book)
     for i in range(ny):
         yt[i] = y[i] + 0.5 * L * k1[i]
-    _stage(yt, c1, L / 3.0, co, lay, k2, slider_z, sense, row, book)
+    _stage(yt, c1, L / 3.0, model, k2, slider, row, book)
     for i in range(ny):
         yt[i] = y[i] + 0.75 * L * k2[i]
-    _stage(yt, c2, L * 4.0 / 9.0, co, lay, k3, slider_z, sense, row, book)
+    _stage(yt, c2, L * 4.0 / 9.0, model, k3, slider, row, book)
     end = stages[3]
     for i in range(ny):
         end[i] = y[i] + L * (2.0 / 9.0 * k1[i] + 1.0 / 3.0 * k2[i] + 4.0 / 9.0 * k3[i])
@@ -298,17 +303,20 @@ _MAX_TRANSITIONS_PER_STEP = 8
 
 
 @kernel(fastmath=_FAST)
-def _general_step(y, t, h, Omega, co, lay, slider_z, sense, stages, row, trial_row):
-    """Advance y in place over one ode3 step (t, t + h) with the forces beyond Eq. 4 (`_beyond_hertz`), in
-    sub-steps that end on each located stick/slip transition of dry friction (module docstring), booked into `row`
-    (`trial_row`: scratch of the same length). Returns the slider's new (z, sense)."""
+def _friction_step(y, t, h, model, slider, stages, rows):
+    """Advance y in place over one ode3 step (t, t + h) with dry friction (`_friction`; slider = (z, sense)), in
+    sub-steps that end on each located stick/slip transition (module docstring), booked into rows[0] (rows[1]:
+    scratch of the same length). Returns the slider's new (z, sense)."""
+    co, lay = model
+    row, trial_row = rows
+    slider_z, sense = slider
     ny = lay.acc
     end = stages[3]
     left = h
     located = 0
-    while co.slip_force > 0.0:  # without friction (the damped law alone) the step has no transitions
+    while True:
         trial_row[:] = 0.0
-        _bs_step(y, t, left, Omega, co, lay, slider_z, sense, stages, trial_row, True)
+        _bs_step(y, t, left, model, (slider_z, sense), stages, trial_row, True)
         if located == _MAX_TRANSITIONS_PER_STEP or _phase_event(end, co, lay, slider_z, sense) <= 0.0:
             break  # the rest of the step in this phase
         located += 1
@@ -323,7 +331,7 @@ def _general_step(y, t, h, Omega, co, lay, slider_z, sense, stages, row, trial_r
             L = (lo * g_hi - hi * g_lo) / (g_hi - g_lo)
             if not lo < L < hi:
                 L = 0.5 * (lo + hi)
-            _bs_step(y, t, L, Omega, co, lay, slider_z, sense, stages, trial_row, False)
+            _bs_step(y, t, L, model, (slider_z, sense), stages, trial_row, False)
             g = _phase_event(end, co, lay, slider_z, sense)
             if g > 0.0:
                 hi, g_hi = L, g
@@ -336,7 +344,7 @@ def _general_step(y, t, h, Omega, co, lay, slider_z, sense, stages, row, trial_r
                     g_hi *= 0.5
                 side = -1
         # the sub-step to the transition (its far side), booked; then the new phase from there
-        _bs_step(y, t, hi, Omega, co, lay, slider_z, sense, stages, row, True)
+        _bs_step(y, t, hi, model, (slider_z, sense), stages, row, True)
         for i in range(ny):
             y[i] = end[i]
         u, _ = _floor_relative(y, co, lay)
@@ -351,11 +359,8 @@ def _general_step(y, t, h, Omega, co, lay, slider_z, sense, stages, row, trial_r
         left -= hi
         if left <= 1e-13 * h:
             return slider_z, sense
-    if co.slip_force == 0.0:  # no transitions: the step booked directly
-        _bs_step(y, t, left, Omega, co, lay, slider_z, sense, stages, row, True)
-    else:
-        for i in range(row.size):
-            row[i] += trial_row[i]
+    for i in range(row.size):
+        row[i] += trial_row[i]
     for i in range(ny):
         y[i] = end[i]
     if sense != 0.0:  # in slip the slider follows the sphere at the limit
@@ -365,16 +370,20 @@ def _general_step(y, t, h, Omega, co, lay, slider_z, sense, stages, row, trial_r
 
 
 @kernel(fastmath=_FAST)
-def _advance(y, sys, steps, out):
-    """Advance y in place over the periods of `out`, N ode3 steps each; returns (status, step index of a failure)."""
+def _advance(y, sys, steps, out, law):
+    """Advance y in place over the periods of `out`, N ode3 steps each; returns (status, step index of a failure).
+    sys: the `SystemArrays` without their law (None); law: the contact law, an argument of its own (inside the
+    tuple numba would type all of `sys` in Python at every call)."""
     lay = state_layout(sys.omega.size)
     N = steps.N
     Omega, a_base = steps.Omega, steps.a_base
     co = Coefficients(w2=sys.omega * sys.omega, c=2.0 * sys.D * sys.omega, gamma=sys.gamma, phi_l=sys.phi_l, phi_r=sys.phi_r,
                       f_modal=sys.gamma * (a_base * Omega * Omega), f_sphere=a_base * Omega * Omega, m_a=sys.m_a,
-                      k_H=sys.k_H, g=sys.g, c_damp=sys.c_damp, phi_f=sys.phi_f, k_t=sys.k_t, slip_force=sys.slip_force)
+                      k_H=sys.k_H, g=sys.g, c_damp=sys.c_damp, phi_f=sys.phi_f, k_t=sys.k_t, slip_force=sys.slip_force,
+                      law=law, Omega=Omega)
+    model = Model(co, lay)
     ny = lay.acc
-    general = co.c_damp > 0.0 or co.slip_force > 0.0  # Eq. 10 or friction: the general step
+    friction = co.slip_force > 0.0  # the friction step (Appendix C)
     slider = sys.slider
     slider_z, sense = slider[0], slider[1]
     stages = np.empty((5, ny))  # the friction step's k1, k2, k3, end state and stage state
@@ -408,20 +417,22 @@ def _advance(y, sys, steps, out):
         lim = rim = 0.0
         onsets = 0
         for k in range(N):
-            if general:
-                slider_z, sense = _general_step(y, k * h, h, Omega, co, lay, slider_z, sense, stages, row, trial_row)
+            if friction:
+                slider_z, sense = _friction_step(y, k * h, h, model, (slider_z, sense), stages, (row, trial_row))
             else:
                 # the Bogacki-Shampine stages of the module docstring (Sect. 3.2)
-                _deriv(y, cos_stage[0, k], co, lay, k1)
+                p1 = _deriv(y, cos_stage[0, k], co, lay, k1)
                 _book(y, cos_stage[0, k], b1, co, lay, row)
                 for i in range(ny):
                     yt[i] = y[i] + 0.5 * h * k1[i]
-                _deriv(yt, cos_stage[1, k], co, lay, k2)
+                p2 = _deriv(yt, cos_stage[1, k], co, lay, k2)
                 _book(yt, cos_stage[1, k], b2, co, lay, row)
                 for i in range(ny):
                     yt[i] = y[i] + 0.75 * h * k2[i]
-                _deriv(yt, cos_stage[2, k], co, lay, k3)
+                p3 = _deriv(yt, cos_stage[2, k], co, lay, k3)
                 _book(yt, cos_stage[2, k], b3, co, lay, row)
+                if uses_rate(co.law):  # the contact law's dissipation (compiled only for a law that has one)
+                    row[LEDGER.contact] += b1 * p1 + b2 * p2 + b3 * p3
                 for i in range(ny):
                     y[i] += b1 * k1[i] + b2 * k2[i] + b3 * k3[i]
             # measures at the new step point t_{k+1}
@@ -507,8 +518,8 @@ def run_step(y: np.ndarray, n_periods: int, Omega: float, a_base: float, sys: Sy
     out = integrator_output(n_periods, sys.omega.size, record_arr, None)
     stored_start = stored_energy(y, sys) if ledger is not None else math.nan
     kernel_sys = sys._replace(m_a=float(sys.m_a), k_H=float(sys.k_H), g=float(sys.g), c_damp=float(sys.c_damp),
-                              k_t=float(sys.k_t), slip_force=float(sys.slip_force))
-    status, where = _advance(y, kernel_sys, steps, out)
+                              k_t=float(sys.k_t), slip_force=float(sys.slip_force), law=None)
+    status, where = _advance(y, kernel_sys, steps, out, sys.law)
     if status != _OK:
         t = where * h
         why = "non-finite state" if status == _NONFINITE else "an indentation larger than the clearance"

@@ -24,7 +24,8 @@ from sim.model.system import Impactor, ModalModel, SystemArrays, system_arrays
 def reference_run(y0: np.ndarray, t_end: float, Omega: float, a_base: float, sys: SystemArrays, *, rtol: float = 1e-12,
                   atol_scale: float = 1e-16, pieces: list | None = None,
                   t0: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Eqs. 3-7 with the Hertz law at both walls under q_base = a_base cos(Omega t) (SI units), by DOP853 from
+    """Eqs. 3-7 with the contact law sys.law at both walls (Eq. 4 by default; its force as written in
+    `sim.model.contact_law`, evaluated in Python) under q_base = a_base cos(Omega t) (SI units), by DOP853 from
     y0 at t0 (s; phase Omega t0) to t_end (s), restarted at every contact event; returns (y(t_end), onset
     times (s), release times (s), rebound speeds (m/s)).
 
@@ -36,6 +37,7 @@ def reference_run(y0: np.ndarray, t_end: float, Omega: float, a_base: float, sys
     n = sys.omega.size
     w2 = sys.omega**2
     c = 2 * sys.D * sys.omega
+    force = sys.law.force.py_func
 
     def rhs(t, y):
         s = y[:n]
@@ -43,8 +45,8 @@ def reference_run(y0: np.ndarray, t_end: float, Omega: float, a_base: float, sys
         u = y[2 * n]
         dl = sys.phi_l @ s - u - sys.g
         dr = sys.phi_r @ s - u + sys.g
-        fl = sys.k_H * dl**1.5 if dl > 0 else 0.0
-        fr = -sys.k_H * (-dr) ** 1.5 if dr < 0 else 0.0
+        fl = force(dl, sys.phi_l @ sd - y[2 * n + 1], sys.k_H, sys.c_damp) if dl > 0 else 0.0
+        fr = -force(-dr, y[2 * n + 1] - sys.phi_r @ sd, sys.k_H, sys.c_damp) if dr < 0 else 0.0
         acc = a_base * Omega**2 * math.cos(Omega * t)
         out = np.empty_like(y)
         out[:n] = sd

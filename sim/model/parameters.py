@@ -48,18 +48,6 @@ class SystemSettings:
     friction: float = 0.0
     k_t: float = K_T_PAPER
 
-    @property
-    def law_name(self) -> str:
-        """The contact law: the given one, else "hertz-damped" when r_cont is given, else "hertz"."""
-        return self.contact_law or ("hertz-damped" if self.r_cont is not None else "hertz")
-
-    @property
-    def law_r_cont(self) -> float:
-        """r_cont of the law: the given one, else DEFAULT_R_CONT for the damped law and 1 (elastic) for Eq. 4."""
-        if self.r_cont is not None:
-            return self.r_cont
-        return DEFAULT_R_CONT if self.law_name == "hertz-damped" else 1.0
-
 
 _SETTINGS_FIELDS = tuple(f.name for f in fields(SystemSettings))
 

@@ -43,7 +43,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from sim.model.contact_law import ContactLaw
+from sim.model.contact_law import HERTZ, ContactLaw, Law, contact_law_of
 from sim.common.errors import SimulationInputError
 from sim.model.parameters import (CLEARANCE_NOMINAL, D1_NOMINAL, K_H_NOMINAL, K_T_PAPER,  # noqa: F401 (re-exported)
                                  SPHERE_MASS, SystemSettings)
@@ -184,6 +184,8 @@ class SystemArrays(NamedTuple):
     Friction (Appendix C): phi_f the mode values at the cavity floor (1/sqrt(kg)), k_t (N/m), slip_force = mu m_a g
     (N; 0: off), and slider = [z, sense]: the slider's position relative to the base (m) and the phase (0 stick,
     +-1 slip in that sense), advanced in place by the integrator like y (a fresh system starts relaxed, in stick).
+    law: the registered normal contact law (`sim.model.contact_law.Law`; k_H and c_damp are its constants k and c);
+    the kernels are compiled per law.
     """
 
     omega: np.ndarray
@@ -200,6 +202,7 @@ class SystemArrays(NamedTuple):
     k_t: float = 0.0
     slip_force: float = 0.0
     slider: np.ndarray = np.zeros(2)
+    law: Law = HERTZ
 
 
 def damping_factor(model: ModalModel, impactor: Impactor) -> float:
@@ -221,6 +224,7 @@ def system_arrays(model: ModalModel, impactor: Impactor) -> SystemArrays:
         phi_r=as_f8(model.phi_wall_right), phi_tip=as_f8(model.phi_tip), gamma=as_f8(model.participation),
         m_a=float(impactor.mass), k_H=float(impactor.k_H), g=float(impactor.clearance),
         c_damp=damping_factor(model, impactor), phi_f=phi_f, k_t=k_t, slip_force=slip_force, slider=slider,
+        law=impactor.contact_law.law,
     )
 
 
@@ -240,7 +244,7 @@ def build_impactor(settings: SystemSettings) -> Impactor:
     """The sphere of Eqs. 3-6 from `sim.model.parameters.SystemSettings` (what the parameters of `PARAMETERS` feed):
     mass (kg), g (m), k_H (N/m^1.5), the contact law (Eq. 4, or Eq. 10 with r_cont) and friction (Appendix C).
     Every value is checked here, one line each (`Impactor`, `ContactLaw`)."""
-    law = ContactLaw(settings.law_name, settings.law_r_cont)
+    law = contact_law_of(settings.contact_law, settings.r_cont)
     return Impactor(mass=settings.mass, clearance=settings.clearance, k_H=settings.k_H, contact_law=law,
                     friction=settings.friction, k_t=settings.k_t)
 
@@ -266,16 +270,23 @@ def build_system(model: ModalModel, settings: SystemSettings, *,
     return model, impactor
 
 
-def contact_forces(s: np.ndarray, u_a: float, sys: SystemArrays) -> tuple[float, float]:
-    """Eq. 4-6 in relative coordinates (q_base cancels): returns (f_l, f_r) in N.
+def contact_forces(s: np.ndarray, u_a: float, sys: SystemArrays, s_dot: np.ndarray | None = None,
+                   u_a_dot: float = 0.0) -> tuple[float, float]:
+    """Eqs. 4-6 (or the law of sys.law) in relative coordinates (q_base cancels): returns (f_l, f_r) in N.
 
-    delta_l = phi_l^T s - u_a - g,  delta_r = phi_r^T s - u_a + g.
-    Reference implementation for tests; kernels inline the same law.
+    delta_l = phi_l^T s - u_a - g,  delta_r = phi_r^T s - u_a + g; the rates from s_dot (1/s units of s) and u_a_dot
+    (m/s) for a law that depends on them (zero when not given). The law's own force (`sim.model.contact_law`),
+    evaluated in Python: the kernels inline the same function.
     """
+    force = sys.law.force.py_func
     delta_l = float(sys.phi_l @ s) - u_a - sys.g
     delta_r = float(sys.phi_r @ s) - u_a + sys.g
-    f_l = sys.k_H * delta_l**1.5 if delta_l > 0 else 0.0
-    f_r = -sys.k_H * (-delta_r) ** 1.5 if delta_r < 0 else 0.0
+    rate_l = rate_r = 0.0
+    if s_dot is not None:
+        rate_l = float(sys.phi_l @ s_dot) - u_a_dot
+        rate_r = float(sys.phi_r @ s_dot) - u_a_dot
+    f_l = force(delta_l, rate_l, sys.k_H, sys.c_damp) if delta_l > 0 else 0.0
+    f_r = -force(-delta_r, -rate_r, sys.k_H, sys.c_damp) if delta_r < 0 else 0.0
     return f_l, f_r
 
 

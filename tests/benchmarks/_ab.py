@@ -23,17 +23,29 @@ def worker(tree: Path, eta: float, prepare: float | None, *options: str) -> subp
     return proc
 
 
-def pairs(workers: dict[str, subprocess.Popen], repeats: int) -> dict[str, list[float]]:
-    """CPU seconds per point of each worker, `repeats` rounds of one point each, in turn; the workers are closed."""
+def pairs(workers: dict[str, subprocess.Popen], repeats: int,
+          states: dict[str, str] | None = None) -> dict[str, list[float]]:
+    """CPU seconds per point of each worker, `repeats` rounds of one point each, in turn (the first worker first in
+    odd rounds, last in even ones); the workers are closed. states: receives each worker's `state` at the end."""
     times: dict[str, list[float]] = {name: [] for name in workers}
     try:
-        for _ in range(repeats):
-            for name, proc in workers.items():
+        for round_ in range(repeats):
+            order = list(workers.items())
+            for name, proc in order if round_ % 2 == 0 else order[::-1]:
                 proc.stdin.write("run\n")
                 proc.stdin.flush()
                 times[name].append(float(proc.stdout.readline()))
+        if states is not None:
+            states.update({name: state(proc) for name, proc in workers.items()})
     finally:
         for proc in workers.values():
             proc.stdin.close()
             proc.wait()
     return times
+
+
+def state(proc: subprocess.Popen) -> str:
+    """The bytes (hex) of the end state and hold amplitudes of the worker's last point."""
+    proc.stdin.write("state\n")
+    proc.stdin.flush()
+    return proc.stdout.readline().strip()

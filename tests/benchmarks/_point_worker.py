@@ -1,7 +1,8 @@
 """A worker process for same-run A/B timings of one stepped-sine point (tests/benchmarks/test_energy_speed.py,
 test_contact_law_speed.py): imports `sim` from the tree given on the command line, prepares the start state, then
 answers every line "run" on stdin with the CPU seconds of one point (3 s wait + 5 s hold at a_base/a_base* = 7.4),
-with the energy bookkeeping and impact measures where the tree has them (`sim.integration.energy.Ledger`).
+with the energy bookkeeping and impact measures where the tree has them (`sim.integration.energy.Ledger`), and the
+line "state" with the bytes (hex) of the last point's end state and hold amplitudes (bit-for-bit comparisons).
 
 Arguments: TREE ETA PREPARE [INTEGRATOR [R_CONT [MU]]]: PREPARE "-" starts from the base velocity, else a down-sweep
 from that eta; INTEGRATOR exact (default) or ode3; R_CONT < 1: the damped contact law of Eq. 10; MU > 0: dry friction
@@ -17,7 +18,7 @@ MU = float(sys.argv[6]) if len(sys.argv) > 6 else 0.0
 
 import numpy as np  # noqa: E402
 
-from sim import exact, ode3  # noqa: E402
+from sim.integration import exact, ode3  # noqa: E402
 from sim.hosts.rig import seed_rig_model  # noqa: E402
 from sim.model.system import Impactor, a_base_star, a_noabs_star, system_arrays  # noqa: E402
 
@@ -50,6 +51,9 @@ else:
         integrator.run_step(y0, int(round(8.0 * Om / (2 * np.pi))), Om, a_base, sys_)
 
 
+last: list[np.ndarray] = []
+
+
 def one_point() -> float:
     Omega = ETA * model.omega[0]
     periods = Omega / (2 * np.pi)
@@ -58,18 +62,23 @@ def one_point() -> float:
     started = time.thread_time()
     integrator.run_step(y, n_wait, Omega, a_base, sys_, None)
     if Ledger is None:
-        integrator.run_step(y, n_hold, Omega, a_base, sys_, None)
+        amplitudes, _ = integrator.run_step(y, n_hold, Omega, a_base, sys_, None)
     else:
         ledger = Ledger()
         amplitudes, impacts = integrator.run_step(y, n_hold, Omega, a_base, sys_, None, ledger=ledger)
         if point_measures is not None:
             point_measures(amplitudes, impacts, a_noabs_star(model, a_base), ledger)
-    return time.thread_time() - started
+    elapsed = time.thread_time() - started
+    last[:] = [y, amplitudes]
+    return elapsed
 
 
 one_point()  # compile or load the kernels, build the collocation tables
 print("ready", flush=True)
 for line in sys.stdin:
-    if line.strip() != "run":
+    if line.strip() == "state":
+        print(b"".join(a.tobytes() for a in last).hex(), flush=True)
+    elif line.strip() == "run":
+        print(f"{one_point():.6f}", flush=True)
+    else:
         break
-    print(f"{one_point():.6f}", flush=True)

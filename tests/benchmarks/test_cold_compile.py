@@ -18,10 +18,10 @@ pytestmark = pytest.mark.benchmark
 ROOT = Path(__file__).resolve().parents[2]
 TARGET_S = 90.0
 WARM_ALL = """
-from uq.commands import FIGURES, study_file
+from uq.paper_figures import PAPER_FIGURES, figures_of_all
 from uq.study import load_study
-for figure in FIGURES:
-    load_study(study_file(figure, True)).make_model().warm_up()
+for figure in figures_of_all():
+    load_study(PAPER_FIGURES[figure].study_file(True)).make_model().warm_up()
 """
 
 

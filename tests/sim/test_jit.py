@@ -66,11 +66,10 @@ def _set_probe(path: Path, old: str, new: str) -> None:
 
 @pytest.mark.slow
 def test_an_edit_of_a_callee_file_reaches_the_cached_caller(tmp_path):
-    package = tmp_path / "sim"
-    shutil.copytree(SIM_DIR, package, ignore=shutil.ignore_patterns("__pycache__"))
-    kernels = package / "integration"
-    (kernels / "flight.py").write_text((kernels / "flight.py").read_text() + PROBE_CALLEE.format(value=1.0))
-    (kernels / "exact.py").write_text((kernels / "exact.py").read_text() + PROBE_CALLER)
+    shutil.copytree(SIM_DIR, tmp_path / "sim", ignore=shutil.ignore_patterns("__pycache__"))
+    package = tmp_path / "sim" / "integration"
+    (package / "flight.py").write_text((package / "flight.py").read_text() + PROBE_CALLEE.format(value=1.0))
+    (package / "exact.py").write_text((package / "exact.py").read_text() + PROBE_CALLER)
     (tmp_path / "plain_callee.py").write_text(PLAIN_CALLEE.format(value=1.0))
     (tmp_path / "plain_caller.py").write_text(PLAIN_CALLER)
     run_sim = "from sim.integration import exact; print(exact.probe_caller())"
@@ -90,12 +89,77 @@ def test_an_edit_of_a_callee_file_reaches_the_cached_caller(tmp_path):
 
 
 def test_every_module_with_kernels_is_fingerprinted():
-    """A kernel module missing from KERNEL_MODULES would not invalidate its callers' caches."""
-    with_kernels = {path.relative_to(SIM_DIR).with_suffix("").as_posix() for path in SIM_DIR.rglob("*.py")
+    """A kernel module missing from KERNEL_MODULES (or, for the inlined contact laws, FINGERPRINT_FILES) would not
+    invalidate its callers' caches."""
+    integration = SIM_DIR / "integration"
+    with_kernels = {path.resolve() for path in SIM_DIR.rglob("*.py")
                     if re.search(r"^@(kernel|njit|numba\.njit)\b", path.read_text(), re.MULTILINE)}
-    assert with_kernels <= {f"integration/{stem}" for stem in jit.KERNEL_MODULES}  # all kernels live in one folder
-    assert all((KERNEL_DIR / f"{stem}.py").is_file() for stem in jit.KERNEL_MODULES)
-    assert "njit" not in "".join((KERNEL_DIR / f"{stem}.py").read_text() for stem in jit.KERNEL_MODULES if stem != "jit")
+    fingerprinted = {(integration / f"{stem}.py").resolve() for stem in jit.KERNEL_MODULES} | {
+        path.resolve() for path in jit.FINGERPRINT_FILES}
+    assert with_kernels <= fingerprinted
+    assert all(path.is_file() for path in fingerprinted)
+    assert SIM_DIR / "model" / "contact_law.py" in with_kernels
+    assert "njit" not in "".join((integration / f"{stem}.py").read_text() for stem in jit.KERNEL_MODULES
+                                 if stem != "jit")
+
+
+def test_the_installed_numba_lies_in_the_supported_range():
+    """pyproject.toml states the numba versions the kernels are tested with (they use the private `_nrt` option):
+    a lower and an upper bound, and the installed numba inside them."""
+    import tomllib
+
+    import numba
+    from packaging.requirements import Requirement
+    from packaging.version import Version
+
+    pyproject = tomllib.loads((SIM_DIR.parent / "pyproject.toml").read_text())
+    (spec,) = [Requirement(r).specifier for r in pyproject["project"]["dependencies"] if Requirement(r).name == "numba"]
+    assert {s.operator for s in spec} == {">=", "<"}
+    assert Version(numba.__version__) in spec
+    assert Version("0.58") not in spec and Version("99.0") not in spec
+    assert jit.nrt_option_supported()  # the numbas of the range know the option
+
+
+KERNELS_WITHOUT_COUNTS = '''import numpy as np
+
+from sim.integration.jit import kernel
+
+
+@kernel(refcounts=False)
+def total(x):
+    s = 0.0
+    for v in x:
+        s += v
+    return s
+
+
+@kernel(refcounts=False)
+def twice(x):
+    return 2.0 * total(x)
+'''
+
+
+def test_a_numba_that_refuses_the_nrt_option_still_compiles_the_kernels(tmp_path, monkeypatch, capsys):
+    """numba's `_nrt` is private: a numba without it refuses such a kernel at its first call. Simulated by removing
+    the option from numba's table; `kernel` then compiles with reference counts, and says so once."""
+    import importlib
+
+    import numba
+    import numpy as np
+    from numba.core.cpu import CPUTargetOptions
+
+    owner = next(cls for cls in CPUTargetOptions.__mro__ if "_nrt" in vars(cls))
+    monkeypatch.delattr(owner, "_nrt")
+    with pytest.raises(KeyError, match="_nrt"):  # the refusal, as plain numba shows it
+        numba.njit(_nrt=False)(lambda x: x + 1.0)(1.0)
+    assert not jit.nrt_option_supported()
+    monkeypatch.setattr(jit, "_fallback_said", False)
+    (tmp_path / "nrt_probe_kernels.py").write_text(KERNELS_WITHOUT_COUNTS)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    probe = importlib.import_module("nrt_probe_kernels")
+    assert probe.twice(np.arange(4.0)) == 12.0
+    err = capsys.readouterr().err
+    assert err.count("does not take the option _nrt") == 1
 
 
 def test_a_folder_that_cannot_be_written_is_left_alone(tmp_path):
