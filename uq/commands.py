@@ -456,7 +456,7 @@ DESIGN_HELP = ("choose the clearance and the sphere (radius, material) for a hos
 #: option -> (key in a design study file's [design] table, default)
 DESIGN_OPTIONS = {"excitation": None, "clearance": "0.3mm:1.2mm:10", "radius": "7.92mm", "material": "brass",
                   "model": None, "objective": "mean", "damping": None, "clearance_tolerance": None,
-                  "k_H_factor": None, "candidates": 5, "reps": 3, "restitution": None, "baseline": None,
+                  "k_H_factor": None, "calibration": None, "candidates": 5, "reps": 3, "restitution": None, "baseline": None,
                   "block_width": None, "min_wall": None, "output": "ies-out/design"}
 
 
@@ -478,6 +478,9 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--clearance-tolerance", metavar="LOW:HIGH",
                         help="tolerance added to each clearance (default Table 2: 0:0.032mm)")
     parser.add_argument("--k-H-factor", metavar="LOW:HIGH", help="factor on Eq. 8's k_H (default Table 2: 1:1.518)")
+    parser.add_argument("--calibration", metavar="FILE",
+                        help="`ies calibrate --json` output: its k_H / k_H* becomes the upper end of the k_H factor "
+                             "(the crater's stiffening, as `ies reproduce` uses it)")
     parser.add_argument("--candidates", type=positive_int, metavar="N", help="screened designs to verify (default 5)")
     parser.add_argument("--reps", type=positive_int, metavar="N", help="repetitions per verification run (default 3)")
     parser.add_argument("--restitution", type=float, metavar="R",
@@ -540,6 +543,15 @@ def design_problem(args: argparse.Namespace) -> tuple[Any, Path, Any]:
     for name, key in (("block_width", "block_width"), ("min_wall", "min_wall")):
         if value(name) is not None:
             fields[key] = d.parse_range(value(name), "radius", count=1)[0]
+    if value("calibration") is not None:
+        if value("k_H_factor") is not None:
+            raise StudyError("give --calibration or --k-H-factor, not both: the calibration sets the factor's upper end")
+        from uq.space import K_H_STAR, calibrated_k_H
+
+        ratio = calibrated_k_H(value("calibration")) / K_H_STAR
+        if ratio < 1.0:
+            raise StudyError(f"--calibration: k_H / k_H* = {ratio:.3f} < 1; a crater should stiffen the contact")
+        fields["k_H_factor"] = (1.0, ratio)
     if value("restitution") is not None:
         fields["restitution"] = float(value("restitution"))
     if value("baseline") is not None:

@@ -153,3 +153,21 @@ def test_a_host_whose_first_mode_does_not_move_the_walls_is_refused(tmp_path, ca
     assert exit_code(["design", "--excitation", "2um:8um", "--model", str(path), "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert "the host model cannot be designed for" in err and len(err.splitlines()) == 1 and not out.exists()
+
+
+def test_a_calibration_sets_the_upper_end_of_the_k_H_factor(tmp_path, capsys):
+    import argparse
+
+    from uq.commands import add_design_arguments, design_problem
+    from uq.space import K_H_STAR
+
+    parser = argparse.ArgumentParser()
+    add_design_arguments(parser)
+    calibration = tmp_path / "cal.json"
+    calibration.write_text(json.dumps({"k_H": 1.4 * K_H_STAR}))
+    problem, _, _ = design_problem(parser.parse_args(["--excitation", "2um:8um", "--calibration", str(calibration)]))
+    assert problem.k_H_factor == pytest.approx((1.0, 1.4))
+    soft = tmp_path / "soft.json"
+    soft.write_text(json.dumps({"k_H": 0.9 * K_H_STAR}))
+    assert exit_code(["design", "--excitation", "2um:8um", "--calibration", str(soft), "--out", str(tmp_path / "o")]) == 2
+    assert "a crater should stiffen the contact" in capsys.readouterr().err
