@@ -15,9 +15,7 @@ def pytest_sessionstart(session) -> None:
     tests/sim/test_warm_up.py."""
     import io
 
-    from sim.integration.integrators import available, warm_up
+    from sim.integration.integrators import available, warm_up_all
     from sim.model.contact_law import LAWS
 
-    for name in available():
-        for law in LAWS:
-            warm_up(name, law=law, stream=io.StringIO())
+    warm_up_all([(name, law) for name in available() for law in LAWS], stream=io.StringIO())

@@ -243,14 +243,20 @@ class IESModel:
         return self._stepped_sine()
 
     def warm_up(self) -> None:
-        """Compile the integrator's kernels in this process (`sim.integration.integrators.warm_up`; minutes on a first run)."""
-        from sim.integration.integrators import warm_up
+        """Compile the kernels this study's runs use, in this process (`sim.integration.integrators.warm_up_all`;
+        minutes on a first run)."""
+        from sim.integration.integrators import warm_up_all
 
+        warm_up_all(self.kernel_variants())
+
+    def kernel_variants(self) -> list[tuple[str, str]]:
+        """(integrator, contact law) of every kernel specialisation this study's runs use: its law and, since
+        r_cont = 1 runs it, the law's elastic counterpart."""
         from sim.model.contact_law import law_named
 
         law = law_named(self._law_name())
-        for name in dict.fromkeys((law.name, law.elastic or law.name)):  # r_cont = 1 runs the elastic law's kernels
-            warm_up(self._stepped_sine().integrator, law=name)
+        integrator = self._stepped_sine().integrator
+        return [(integrator, name) for name in dict.fromkeys((law.name, law.elastic or law.name))]
 
     def with_rig(self) -> "IESModel":
         """This model carrying the rig's modal model (built here, used unchanged by every worker)."""

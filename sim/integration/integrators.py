@@ -9,12 +9,17 @@ starts (so that the bar's rate and ETA measure simulation only) and says so whil
 """
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib
+import io
+import os
+import subprocess
 import sys as _sys
 import threading
 import time
-from typing import Callable, TextIO
+from pathlib import Path
+from typing import Callable, Iterable, Iterator, TextIO
 
 import numpy as np
 
@@ -83,6 +88,26 @@ def _run_tiny_system(run_step: RunStep, *, law: str = "hertz") -> None:
             run_step(y, 3, 2.0 * np.pi * 100.0, 1e-5, sys, None, ledger=ledger)
 
 
+@contextlib.contextmanager
+def _announced(what: str, minutes: float, stream: TextIO) -> Iterator[None]:
+    """Say, once NOTICE_AFTER_S have passed, that `what` is being compiled (about `minutes` min), and when done how
+    long it took; silent when it is quick (the kernels came from the cache)."""
+    def say_so() -> None:
+        stream.write(f"compiling {what} (first run only, about {minutes:g} min) ...\n")
+        stream.flush()
+
+    notice = threading.Timer(NOTICE_AFTER_S, say_so)
+    started = time.perf_counter()
+    notice.start()
+    try:
+        yield
+    finally:
+        notice.cancel()
+    elapsed = time.perf_counter() - started
+    if elapsed > NOTICE_AFTER_S:
+        stream.write(f"kernels compiled in {elapsed:.0f} s; later runs load them from the cache\n")
+
+
 def warm_up(name: str, *, law: str = "hertz", stream: TextIO | None = None) -> float:
     """Compile (or load from numba's on-disk cache) the kernels of the integrator `name` in this process by one
     short run of a tiny system, before any timed or progress-reported work. When that takes longer than
@@ -93,25 +118,44 @@ def warm_up(name: str, *, law: str = "hertz", stream: TextIO | None = None) -> f
     if (name, law) in _WARM:
         return 0.0
     run_step = get_integrator(name)
-    stream = stream or _sys.stderr
-
-    def say_so() -> None:
-        stream.write(f"compiling the {name} integrator's kernels (first run only, about "
-                     f"{COMPILE_MINUTES.get(name, 2)} min) ...\n")
-        stream.flush()
-
-    notice = threading.Timer(NOTICE_AFTER_S, say_so)
     started = time.perf_counter()
-    notice.start()
-    try:
+    with _announced(f"the {name} integrator's kernels", COMPILE_MINUTES.get(name, 2), stream or _sys.stderr):
         _run_tiny_system(run_step, law=law)
-    finally:
-        notice.cancel()
-    elapsed = time.perf_counter() - started
     _WARM.add((name, law))
-    if elapsed > NOTICE_AFTER_S:
-        stream.write(f"kernels compiled in {elapsed:.0f} s; later runs load them from the cache\n")
-    return elapsed
+    return time.perf_counter() - started
+
+
+#: what a compiling child process runs: warm the integrator argv[1] for each law argv[2:]
+_CHILD = "import sys; from sim.integration.integrators import warm_up; [warm_up(sys.argv[1], law=law) for law in sys.argv[2:]]"
+
+
+def warm_up_all(pairs: Iterable[tuple[str, str]], *, stream: TextIO | None = None) -> float:
+    """`warm_up` every (integrator, law) of `pairs` in this process. With several integrators to warm and several
+    cores, their kernels are first compiled in parallel, one child process per integrator (into numba's on-disk
+    cache, so this process then only loads them): a first run's compilation then takes about as long as its
+    slowest integrator's instead of the sum. Returns the seconds spent."""
+    pending = [pair for pair in dict.fromkeys(pairs) if pair not in _WARM]
+    if not pending:
+        return 0.0
+    stream = stream or _sys.stderr
+    started = time.perf_counter()
+    laws: dict[str, list[str]] = {}
+    for name, law in pending:
+        laws.setdefault(name, []).append(law)
+    with _announced(f"the kernels of {', '.join(laws)}", max(COMPILE_MINUTES.get(n, 2) for n in laws), stream):
+        if len(laws) > 1 and (os.cpu_count() or 1) > 1:
+            for name in laws:
+                get_integrator(name)  # imports the kernels: a stale cache is discarded here, once (`sim.integration.jit`)
+            root = str(Path(__file__).resolve().parents[2])
+            env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))}
+            children = [subprocess.Popen([_sys.executable, "-c", _CHILD, name, *names], env=env,
+                                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                        for name, names in laws.items()]
+            for child in children:  # a child that fails leaves the work to this process, which reports any error
+                child.wait()
+        for name, law in pending:
+            warm_up(name, law=law, stream=io.StringIO())
+    return time.perf_counter() - started
 
 
 #: integrators warmed up in this process (the kernels' argument types do not depend on dt_scale)

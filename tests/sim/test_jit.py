@@ -13,7 +13,6 @@ import sim
 from sim.integration import jit
 
 SIM_DIR = Path(sim.__file__).resolve().parent
-KERNEL_DIR = SIM_DIR / "integration"
 
 PROBE_CALLEE = '''
 
@@ -77,11 +76,11 @@ def test_an_edit_of_a_callee_file_reaches_the_cached_caller(tmp_path):
 
     assert _run(tmp_path, run_sim) == "1.0"
     assert _run(tmp_path, run_plain) == "1.0"
-    cached = list((kernels / "__pycache__").glob("exact.probe_caller-*.nbi"))
+    cached = list((package / "__pycache__").glob("exact.probe_caller-*.nbi"))
     assert cached, "the caller was not cached: the scenario would not test the cache"
     assert _run(tmp_path, run_sim) == "1.0"  # loaded from the cache
 
-    _set_probe(kernels / "flight.py", "PROBE = 1.0", "PROBE = 2.0")
+    _set_probe(package / "flight.py", "PROBE = 1.0", "PROBE = 2.0")
     _set_probe(tmp_path / "plain_callee.py", "PROBE = 1.0", "PROBE = 2.0")
     assert _run(tmp_path, run_sim) == "2.0"
     assert _run(tmp_path, run_plain) == "1.0", (
