@@ -10,21 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sim.hosts.modal_file import save_modal_model
-from sim.model.system import ModalModel
 from uq.cli import main
 
-FAST = ["--eta", "0.98:1.0:3", "--wait", "0.02", "--hold", "0.03", "--reps", "1"]
-STUDIES = Path(__file__).resolve().parents[1] / "uq" / "studies"
+from tests.support import FAST, STUDIES
 
 
-@pytest.fixture
-def model_file(tmp_path):
-    """A three-mode model with the rig's scales (as tests/sim's fixture), as a file: fast sweeps."""
-    model = ModalModel(frequencies_hz=np.array([117.4, 2494.0, 19800.0]), damping_ratios=np.array([0.00085, 0.0005, 0.001]),
-                       phi_wall_left=np.array([1.05, 0.95, 0.6]), phi_wall_right=np.array([1.05, 0.95, 0.6]),
-                       phi_tip=np.array([1.0, 0.8, 0.3]), participation=np.array([0.95, 0.35, 0.1]), source="three modes")
-    return str(save_modal_model(model, tmp_path / "three.toml"))
 
 
 def refused(capsys, code: int, *phrases: str) -> str:
