@@ -27,7 +27,6 @@ import argparse
 import contextlib
 import functools
 import sys
-from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any, Callable, Iterator
@@ -454,13 +453,6 @@ def compare_command(args: argparse.Namespace) -> int:
 DESIGN_HELP = ("choose the clearance and the sphere (radius, material) for a host structure: the worst case of the "
                "resonant tip amplitude over an excitation range and the uncertain D, clearance and k_H, screened by "
                "the slow flow and verified by stepped-sine simulation (uq.design)")
-#: option -> (key in a design study file's [design] table, default)
-DESIGN_OPTIONS = {"excitation": None, "clearance": "0.3mm:1.2mm:10", "radius": "7.92mm", "material": "brass",
-                  "model": None, "objective": "mean", "damping": None, "clearance_tolerance": None,
-                  "k_H_factor": None, "calibration": None, "candidates": 5, "reps": 3, "restitution": None, "baseline": None,
-                  "block_width": None, "min_wall": None, "output": "ies-out/design"}
-
-
 def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("study", nargs="?", type=Path, metavar="STUDY.toml",
                         help="a design study file ([study] kind = \"design\", [design] with the options below as keys); "
@@ -494,72 +486,14 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def design_problem(args: argparse.Namespace) -> tuple[Any, Path, Any]:
-    """The design problem, output folder and [cluster] table (`uq.cluster`) of `ies design`'s options and study file
-    (options win)."""
-    import tomllib
-
+    """The design problem, output folder and [cluster] table of `ies design`'s study file and options (options win;
+    `uq.design.read_design_file`, `uq.design.problem_of`)."""
     from uq import design as d
-    from uq.errors import StudyError
 
-    table: dict[str, Any] = {}
-    cluster = None
-    protocol = dict(d.PROTOCOL)
-    if args.study is not None:
-        try:
-            data = tomllib.loads(args.study.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-            raise StudyError(f"cannot read design study {args.study}: {exc}") from None
-        if data.get("study", {}).get("kind") != "design":
-            raise StudyError(f"{args.study}: [study] kind must be \"design\" for ies design")
-        table = dict(data.get("design", {}))
-        if "cluster" in data:
-            from uq.cluster import parse_cluster_table
-
-            cluster = parse_cluster_table(data["cluster"])
-        unknown = sorted(set(table) - set(DESIGN_OPTIONS))
-        if unknown:
-            raise StudyError(f"{args.study}: unknown key(s) in [design]: {', '.join(unknown)}; known: "
-                             f"{', '.join(DESIGN_OPTIONS)}")
-        table.setdefault("output", data.get("study", {}).get("output", DESIGN_OPTIONS["output"]))
-        protocol.update(d.protocol_of(data.get("excitation", {}), f"{args.study}: [excitation]"))
-
-    def value(name: str) -> Any:
-        given = getattr(args, name, None)
-        return given if given is not None else table.get(name, DESIGN_OPTIONS[name])
-
-    if value("excitation") is None:
-        raise StudyError("--excitation is required: the operating base amplitudes, e.g. --excitation 0.66um:6.6um:10")
-    problem = d.DesignProblem(excitation=(), clearances=(), radii=(), modal_file=value("model"), protocol=protocol)
-    mode = d.host_mode(d.host_model(problem))
-    materials = tuple(m.strip().lower() for m in str(value("material")).split(",") if m.strip())
-    radii = d.parse_range(value("radius"), "radius", count=4)
-    fields: dict[str, Any] = dict(
-        excitation=d.parse_range(value("excitation"), "excitation", count=10, omega=mode.omega),
-        clearances=d.parse_range(value("clearance"), "clearance", count=10), radii=radii, materials=materials,
-        objective=value("objective"), candidates=int(value("candidates")), repetitions=int(value("reps")))
-    for name, key, quantity in (("damping", "D", None), ("clearance_tolerance", "clearance_tolerance", "clearance"),
-                                ("k_H_factor", "k_H_factor", None)):
-        if value(name) is not None:
-            fields[key] = d.parse_interval(value(name), "--" + name.replace("_", "-"), quantity)
-    for name, key in (("block_width", "block_width"), ("min_wall", "min_wall")):
-        if value(name) is not None:
-            fields[key] = d.parse_range(value(name), "radius", count=1)[0]
-    if value("calibration") is not None:
-        if value("k_H_factor") is not None:
-            raise StudyError("give --calibration or --k-H-factor, not both: the calibration sets the factor's upper end")
-        from uq.space import K_H_STAR, calibrated_k_H
-
-        ratio = calibrated_k_H(value("calibration")) / K_H_STAR
-        if ratio < 1.0:
-            raise StudyError(f"--calibration: k_H / k_H* = {ratio:.3f} < 1; a crater should stiffen the contact")
-        fields["k_H_factor"] = (1.0, ratio)
-    if value("restitution") is not None:
-        fields["restitution"] = float(value("restitution"))
-    if value("baseline") is not None:
-        fields["baseline"] = d.parse_baseline(value("baseline"), radii, materials)
-    problem = replace(problem, **fields)
-    problem.check()
-    return problem, Path(args.out or value("output")), cluster
+    file = d.read_design_file(args.study) if args.study is not None else d.DesignFile()
+    given = {name: getattr(args, name) for name in d.DESIGN_SETTINGS if getattr(args, name, None) is not None}
+    settings = {**d.DESIGN_SETTINGS, **file.settings, **given}
+    return d.problem_of(settings, file.protocol), Path(args.out or settings["output"]), file.cluster
 
 
 def design_command(args: argparse.Namespace) -> int:

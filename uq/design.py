@@ -219,8 +219,10 @@ def levels_of(model: Any, a_base: Sequence[float]) -> np.ndarray:
 
 
 def no_absorber(model: Any, a_base: Sequence[float], D: float) -> np.ndarray:
-    """Resonant tip amplitude (m) of the host alone at damping D (Sect. 5: phi_tip gamma a_base / (2 D))."""
-    return abs(model.phi_tip[0] * model.participation[0]) * np.asarray(a_base, dtype=float) / (2.0 * D)
+    """Resonant tip amplitude (m) of the host alone at damping D (Sect. 5's a_noabs* with D* = D)."""
+    from sim.model.system import Nominal, a_noabs_star
+
+    return a_noabs_star(model, np.asarray(a_base, dtype=float), Nominal(D1=D))
 
 
 def first_impacts(mode: Any, clearance: float) -> float:
@@ -251,7 +253,7 @@ def screen_designs(problem: DesignProblem, mode: Any) -> Screened:
     levels of a material are one vectorised call)."""
     import time
 
-    from sim.model.materials import material
+    from sim.model.materials import material, sphere_mass
     from sim.reduced.slow_flow import screen
 
     started = time.perf_counter()
@@ -260,7 +262,7 @@ def screen_designs(problem: DesignProblem, mode: Any) -> Screened:
     R = np.asarray(problem.radii, dtype=float)
     designs, tips, regimes, switches = [], [], [], []
     for name in problem.materials:
-        masses = 4.0 / 3.0 * math.pi * R**3 * material(name).density
+        masses = sphere_mass(R, material(name))
         worst_tip, worst_regime, switch = None, None, None
         for D in sorted(set(problem.D)):
             host = dataclasses.replace(mode, D=float(D))
@@ -771,3 +773,88 @@ def protocol_of(table: Mapping[str, Any], where: str) -> dict[str, Any]:
     except (TypeError, SimulationInputError) as exc:
         raise StudyError(f"{where}: {exc}") from None
     return settings
+
+
+# ---- a design's settings: options of `ies design` or keys of a design study file -------------------------------
+
+#: setting (the option `--NAME` with - for _, the key of a design study's [design] table) -> default
+DESIGN_SETTINGS: dict[str, Any] = {
+    "excitation": None, "clearance": "0.3mm:1.2mm:10", "radius": "7.92mm", "material": "brass", "model": None,
+    "objective": "mean", "damping": None, "clearance_tolerance": None, "k_H_factor": None, "calibration": None,
+    "candidates": 5, "reps": 3, "restitution": None, "baseline": None, "block_width": None, "min_wall": None,
+    "output": "ies-out/design"}
+
+
+@dataclass(frozen=True)
+class DesignFile:
+    """What a design study file (`[study] kind = "design"`) holds: its [design] settings (and [study] output), the
+    stepped sine of its [excitation] table over `PROTOCOL`, and its [cluster] table (`uq.cluster`) or None."""
+
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    protocol: Mapping[str, Any] = field(default_factory=lambda: dict(PROTOCOL))
+    cluster: Any = None
+
+
+def read_design_file(path: Any) -> DesignFile:
+    """Read and check a design study file; one line (StudyError) for an unreadable file, another kind or an unknown
+    key."""
+    import tomllib
+
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise StudyError(f"cannot read design study {path}: {exc}") from None
+    if data.get("study", {}).get("kind") != "design":
+        raise StudyError(f"{path}: [study] kind must be \"design\" for ies design")
+    settings = dict(data.get("design", {}))
+    unknown = sorted(set(settings) - set(DESIGN_SETTINGS))
+    if unknown:
+        raise StudyError(f"{path}: unknown key(s) in [design]: {', '.join(unknown)}; known: {', '.join(DESIGN_SETTINGS)}")
+    if "output" in data.get("study", {}):
+        settings.setdefault("output", data["study"]["output"])
+    cluster = None
+    if "cluster" in data:
+        from uq.cluster import parse_cluster_table
+
+        cluster = parse_cluster_table(data["cluster"])
+    return DesignFile(settings, {**PROTOCOL, **protocol_of(data.get("excitation", {}), f"{path}: [excitation]")},
+                      cluster)
+
+
+def problem_of(settings: Mapping[str, Any], protocol: Mapping[str, Any] = PROTOCOL) -> DesignProblem:
+    """The checked `DesignProblem` of a design's settings (`DESIGN_SETTINGS` keys; ranges and lengths as text with
+    units) and stepped sine; one line (StudyError) for anything wrong."""
+    value = {**DESIGN_SETTINGS, **settings}
+    if value["excitation"] is None:
+        raise StudyError("--excitation is required: the operating base amplitudes, e.g. --excitation 0.66um:6.6um:10")
+    problem = DesignProblem(excitation=(), clearances=(), radii=(), modal_file=value["model"], protocol=dict(protocol))
+    mode = host_mode(host_model(problem))
+    materials = tuple(m.strip().lower() for m in str(value["material"]).split(",") if m.strip())
+    radii = parse_range(value["radius"], "radius", count=4)
+    fields: dict[str, Any] = dict(
+        excitation=parse_range(value["excitation"], "excitation", count=10, omega=mode.omega),
+        clearances=parse_range(value["clearance"], "clearance", count=10), radii=radii, materials=materials,
+        objective=value["objective"], candidates=int(value["candidates"]), repetitions=int(value["reps"]))
+    for name, key, quantity in (("damping", "D", None), ("clearance_tolerance", "clearance_tolerance", "clearance"),
+                                ("k_H_factor", "k_H_factor", None)):
+        if value[name] is not None:
+            fields[key] = parse_interval(value[name], "--" + name.replace("_", "-"), quantity)
+    for name in ("block_width", "min_wall"):
+        if value[name] is not None:
+            fields[name] = parse_range(value[name], "radius", count=1)[0]
+    if value["calibration"] is not None:
+        if value["k_H_factor"] is not None:
+            raise StudyError("give --calibration or --k-H-factor, not both: the calibration sets the factor's upper end")
+        from uq.space import K_H_STAR, calibrated_k_H
+
+        ratio = calibrated_k_H(value["calibration"]) / K_H_STAR
+        if ratio < 1.0:
+            raise StudyError(f"--calibration: k_H / k_H* = {ratio:.3f} < 1; a crater should stiffen the contact")
+        fields["k_H_factor"] = (1.0, ratio)
+    if value["restitution"] is not None:
+        fields["restitution"] = float(value["restitution"])
+    if value["baseline"] is not None:
+        fields["baseline"] = parse_baseline(value["baseline"], radii, materials)
+    problem = dataclasses.replace(problem, **fields)
+    problem.check()
+    return problem

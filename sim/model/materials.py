@@ -12,6 +12,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+from numpy.typing import ArrayLike
+
 from sim.common.errors import SimulationInputError
 
 
@@ -43,9 +46,15 @@ def material(name: str) -> SphereMaterial:
         raise SimulationInputError(f"unknown sphere material {name!r}; choose one of {', '.join(MATERIALS)}") from None
 
 
-def sphere_mass(radius: float, mat: SphereMaterial) -> float:
-    """Mass (kg) of a solid sphere of `radius` (m): (4/3) pi R^3 rho."""
-    return 4.0 / 3.0 * math.pi * radius**3 * mat.density
+def ball_mass(radius: ArrayLike, density: float) -> np.ndarray | float:
+    """Mass (kg) of a solid sphere of `radius` (m, a number or an array) and `density` (kg/m^3): (4/3) pi R^3 rho."""
+    mass = 4.0 / 3.0 * math.pi * np.asarray(radius, dtype=float) ** 3 * float(density)
+    return float(mass) if mass.ndim == 0 else mass
+
+
+def sphere_mass(radius: ArrayLike, mat: SphereMaterial) -> np.ndarray | float:
+    """Mass (kg) of a solid sphere of `radius` (m, a number or an array) of the material `mat`."""
+    return ball_mass(radius, mat.density)
 
 
 def contact_modulus(mat: SphereMaterial, host_E: float = HOST_E, host_nu: float = HOST_NU) -> float:

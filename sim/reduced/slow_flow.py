@@ -107,6 +107,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from sim.common.errors import SimulationInputError
+from sim.model.materials import ball_mass
 from sim.stepped_sine.measures import APR, LINEAR, SMR
 from sim.model.system import Impactor, ModalModel, Nominal
 
@@ -458,11 +459,6 @@ def _tip_on_curve(curve: FoldCurve, eps: float | np.ndarray, r: float | np.ndarr
     return np.abs(a_w - b) * abs(h.phi_tip / h.phi_c)
 
 
-def sphere_mass(radius: float | np.ndarray, density: float) -> np.ndarray:
-    """m_a = 4/3 pi R^3 rho (kg) for radius R (m) and density rho (kg/m^3)."""
-    return 4.0 / 3.0 * np.pi * np.asarray(radius, dtype=float) ** 3 * float(density)
-
-
 @dataclass(frozen=True)
 class Screening:
     """Result of `screen`, arrays of shape (n_clearances, n_masses, n_levels): tip (resonant tip amplitude
@@ -494,7 +490,7 @@ def screen(host: HostMode, clearances: np.ndarray, masses: np.ndarray | None, a_
     if masses is None:
         if radii is None or density is None or not (isinstance(density, (int, float)) and density > 0):
             raise SimulationInputError("screening: give sphere masses (kg), or radii (m) with a positive density (kg/m^3)")
-        masses = sphere_mass(radii, density)
+        masses = ball_mass(radii, density)
     g = np.asarray(clearances, dtype=float)[:, None, None]
     m = np.asarray(masses, dtype=float)
     L = np.asarray(a_base, dtype=float)[None, None, :]
@@ -694,4 +690,4 @@ def orbit_map(model: SlowFlowModel, levels: np.ndarray, etas: np.ndarray) -> Orb
     return OrbitMap(levels, etas, n_orbits, best, normalised)
 
 
-__all__ = ["NO_ORBIT", "SADDLE", "STABLE", "SYMMETRY_BREAKING", "ExactOrbit", "FoldCurve", "HostMode", "OrbitMap", "Screening", "SlowFlowModel", "SwitchPrediction", "TwoImpactOrbit", "apr_branch", "base_ratio", "check_restitution", "effective_factor", "exact_orbit", "fast_multipliers", "fast_stability_limit", "fast_stable", "fold_curve", "host_mode", "impact_stiffness", "orbit_map", "periodic_orbits", "restitution_factor", "screen", "sim_min_amplitude", "sim_phase", "slow_flow_model", "sphere_mass", "switch_level"]
+__all__ = ["NO_ORBIT", "SADDLE", "STABLE", "SYMMETRY_BREAKING", "ExactOrbit", "FoldCurve", "HostMode", "OrbitMap", "Screening", "SlowFlowModel", "SwitchPrediction", "TwoImpactOrbit", "apr_branch", "base_ratio", "check_restitution", "effective_factor", "exact_orbit", "fast_multipliers", "fast_stability_limit", "fast_stable", "fold_curve", "host_mode", "impact_stiffness", "orbit_map", "periodic_orbits", "restitution_factor", "screen", "sim_min_amplitude", "sim_phase", "slow_flow_model", "switch_level"]

@@ -17,19 +17,19 @@ import time
 import numpy as np
 import pytest
 
-from sim.reduced.slow_flow import host_mode, screen, sphere_mass
+from sim.model.materials import material, sphere_mass
+from sim.reduced.slow_flow import host_mode, screen
 from sim.hosts.rig import seed_rig_model
 
 pytestmark = pytest.mark.benchmark
 TARGET_S = 2.0
 REPEATS = 5
-BRASS = 8490.0  # kg/m^3, Table 1
 
 
 def test_screening_50_clearances_10_radii_20_levels():
     host = host_mode(seed_rig_model())
     clearances = np.linspace(0.2e-3, 1.2e-3, 50)
-    masses = sphere_mass(np.linspace(4e-3, 9e-3, 10), BRASS)
+    masses = sphere_mass(np.linspace(4e-3, 9e-3, 10), material("brass"))
     a_base = np.linspace(2e-6, 8e-6, 20)
     result = screen(host, clearances, masses, a_base, 0.86)  # untimed first call
     times = []
