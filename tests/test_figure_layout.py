@@ -463,7 +463,24 @@ def draw_scan_calibrate(tmp: Path) -> None:
     sim.common.files.save_figure(fig, tmp / "scan-calibrate.png")
 
 
-FIGURES = {"response (fig5, fig6, figD2, figD3)": draw_response, "sweep": draw_sweep, "overview": draw_overview_command,
+def draw_design(tmp: Path) -> None:
+    """ies design's map and curves from a real screening of a small grid and fabricated verifications."""
+    from uq import design as d
+    from uq.design_figures import plot_design_curves, plot_design_map
+
+    problem = d.DesignProblem(excitation=tuple(np.linspace(1e-6, 6e-6, 6)), clearances=(0.3e-3, 0.45e-3, 0.6e-3),
+                              radii=(6e-3, 7.92e-3), materials=("brass", "tungsten"),
+                              baseline=d.Sphere(0.58e-3, 7.92e-3, "brass"))
+    screened = d.screen_designs(problem, d.host_mode(d.host_model(problem)))
+    level = np.linspace(0.1, 1.0, 6) * 1e-3
+    verified = [d.Verified(s, k * level, 1.3 * k * level, 1.1 * k * level, np.linspace(0, 1, 6), np.zeros(6, bool), 6)
+                for k, s in zip((1.0, 1.5, 2.0), d.candidates(problem, screened)[:3])]
+    result = d.DesignResult(problem, screened, verified, tmp, np.arange(1.0, 7.0), 3.0 * level, [])
+    plot_design_map(result, tmp / "design-map.png")
+    plot_design_curves(result, tmp / "design-curves.png")
+
+
+FIGURES = {"response (fig5, fig6, figD2, figD3)": draw_response, "design (map, curves)": draw_design, "sweep": draw_sweep, "overview": draw_overview_command,
            "interval (fig7, fig8, nominal-levels)": draw_interval, "interval of r (figD3)": draw_interval_restitution,
            "sobol": draw_sobol, "series (fig11, figC1, compare)": draw_series, "trace": draw_trace,
            "motion": draw_motion, "modal-fit (fig9b)": draw_modal_fit, "calibrate": draw_calibrate,

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from sim.common.figure_style import LEGEND_PT, legend_beside
 from sim.common.files import plot_to
 
 
@@ -16,7 +17,8 @@ def plot_design_map(result: Any, path: Path) -> Path:
     where the cavity does not fit), the contour where the predicted switch reaches the top of the operating range
     (to its left the response turns almost periodic within the range), verified designs as circles, the
     recommendation as a star and the baseline as a diamond."""
-    from matplotlib.colors import LogNorm
+    from matplotlib.colors import Normalize
+    from matplotlib.lines import Line2D
 
     p, s = result.problem, result.screened
     g = np.asarray(p.clearances) * 1e3
@@ -26,7 +28,7 @@ def plot_design_map(result: Any, path: Path) -> Path:
     worst = s.worst[:on_grid].reshape(n, R.size, g.size) * 1e3
     switch = s.switch[:on_grid].reshape(n, R.size, g.size)
     finite = worst[np.isfinite(worst)]
-    norm = LogNorm(vmin=finite.min(), vmax=finite.max()) if finite.size and finite.min() > 0 else None
+    norm = Normalize(vmin=finite.min(), vmax=finite.max()) if finite.size else None
     with plot_to(path, figsize=(4.2 * n + 1.4, 3.8)) as (fig, ax):
         fig.delaxes(ax)
         axes = fig.subplots(1, n, sharey=True, squeeze=False)[0]
@@ -54,19 +56,16 @@ def plot_design_map(result: Any, path: Path) -> Path:
                        label="baseline")
             a.set_title(name)
             a.set_xlabel("clearance $g$ (mm)")
+            a.margins(0.08)
         axes[0].set_ylabel("sphere radius $R$ (mm)")
-        fig.subplots_adjust(bottom=0.27, top=0.9, left=0.09, right=0.84, wspace=0.08)
-        if image is not None:
-            bar = fig.colorbar(image, cax=fig.add_axes((0.87, 0.27, 0.02, 0.63)))
+        if image is not None:  # beside the panels (constrained layout), never on them
+            bar = fig.colorbar(image, ax=list(axes), pad=0.02)
             bar.set_label("screened worst case (mm)")
         handles = [h for a in axes for h in a.get_legend_handles_labels()[0]]
         labels = [lab for a in axes for lab in a.get_legend_handles_labels()[1]]
-        from matplotlib.lines import Line2D
-
         handles += [Line2D([], [], marker="o", ls="", mfc="none", mec="k"), Line2D([], [], ls="--", color="k")]
         labels += ["verified", f"switch at {max(p.excitation) * 1e6:.3g} µm"]
-        fig.legend(handles, labels, loc="lower center", ncol=len(labels), frameon=False, fontsize=8,
-                   bbox_to_anchor=(0.45, -0.02))
+        fig.legend(handles, labels, loc="outside lower center", ncols=len(labels), frameon=False, fontsize=LEGEND_PT)
     return path
 
 
@@ -84,6 +83,5 @@ def plot_design_curves(result: Any, path: Path) -> Path:
         ax.set_xlabel("base amplitude $a_{base}$ (µm)")
         ax.set_ylabel("resonant tip amplitude (mm)")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
-        fig.subplots_adjust(right=0.62)
+        legend_beside(ax, title="bands: the uncertainty box's corners\nlines: its centre")
     return path
