@@ -70,10 +70,14 @@ SOBOL_CSV = OutputFile("sobol.csv", "ies sobol", "", (
     Column("output", "", "mean or max"),
     Column("level", "a_base/a_base*", "the excitation level"),
     Column("parameter", "", "the parameter's name"),
-    Column("S1", "-", "first-order Sobol' index (SALib)"),
+    Column("S1", "-", "first-order Sobol' index of the repetition mean, the noise counted in (`uq.sobol`)"),
     Column("S1_conf", "-", "half-width of its confidence interval"),
-    Column("ST", "-", "total Sobol' index"),
+    Column("ST", "-", "total Sobol' index, the noise counted into it as an input of its own"),
     Column("ST_conf", "-", "half-width of its confidence interval"),
+    Column("S1_noise_free", "-", "first-order index of the expected response: S1 / (1 - noise_share)"),
+    Column("S1_noise_free_conf", "-", "half-width of its confidence interval"),
+    Column("ST_noise_free", "-", "total index of the expected response: (ST - noise_share) / (1 - noise_share)"),
+    Column("ST_noise_free_conf", "-", "half-width of its confidence interval"),
 ))
 VARIANCE_CSV = OutputFile("variance.csv", "ies sobol", "", (
     Column("output", "", "mean or max"),
@@ -180,14 +184,18 @@ def _checked_model(study: Study) -> Any:
 
 
 def study_key(study: Study, model: Any) -> str:
-    """SHA-256 of what defines a study's results: the resolved study (without its output folder and file path)
-    and the model's settings. `--resume` continues a folder only with the same key."""
+    """SHA-256 of what defines a study's runs: the resolved study (without its output folder and file path) and the
+    model's settings. `--resume` continues a folder only with the same key. The Sobol' sample size and the
+    analysis settings are left out: Saltelli's sample and the surrogate's Sobol' design with a fixed seed are
+    nested (the first points of a larger sample are the smaller one's), so a study grown with --resume reuses every
+    run it has (a convergence check)."""
     import hashlib
     import json
 
     from uq.runner import describe_model
 
     data = {k: v for k, v in study.to_dict().items() if k not in ("output", "source")}
+    data["sobol"] = {"method": study.sobol_method}
     text = json.dumps({"study": data, "model": describe_model(model)}, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()
 
@@ -379,7 +387,7 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                     client: Any = None) -> StudyResult:
     """Sobol' study: S1, ST (bootstrap CI) of the repetition-mean resonant levels per excitation level,
     with the share of their variance that is repetition noise; from Saltelli's sample of n (k + 2) points
-    (`uq.sobol`), or with [sobol] method = "pce" from a polynomial-chaos surrogate of a Latin hypercube's points
+    (`uq.sobol`), or with [sobol] method = "pce" from a polynomial-chaos surrogate of a scrambled Sobol' design
     (`uq.surrogate`; its fit and smoothness verdict in surrogate.csv)."""
     from uq.results import sample_size_advice
     from uq.sobol import sobol_indices, sobol_sample
@@ -417,8 +425,10 @@ def run_sobol_study(study: Study, *, out: Path | None = None, n: int | None = No
                 _warn(result, f"{o} at level {level:g}: {note}")
             if res.message:
                 _warn(result, f"{o} at level {level:g}: not analysed: {res.message}")
+            free = res.noise_free()
             for k, pname in enumerate(res.names):
-                rows.append([o, level, pname, res.S1[k], res.S1_conf[k], res.ST[k], res.ST_conf[k]])
+                rows.append([o, level, pname, res.S1[k], res.S1_conf[k], res.ST[k], res.ST_conf[k],
+                             *(column[k] for column in free)])
             advice = None if pce else sample_size_advice([*res.S1, *res.ST], [*res.S1_conf, *res.ST_conf], n)
             if advice and not res.message:
                 _warn(result, f"{o} at level {level:g}: {advice}")
@@ -461,7 +471,7 @@ def _sobol_netcdf(study: Study, model: Any, folder: Path, points: list[dict], re
     from uq.netcdf import base_dataset, finish, table_variables
 
     parts = [base_dataset(study, model, points, results, stats, regimes),
-             xr.Dataset(table_variables(["output", "level", "parameter", "S1", "S1_conf", "ST", "ST_conf"], rows,
+             xr.Dataset(table_variables(list(SOBOL_CSV.names), rows,
                                         {"parameter": "parameter", "level": "level"}, split="output")),
              xr.Dataset(table_variables(["output", "level", "variance", "noise_variance", "noise_share", "failed_runs",
                                          "message"], summary_rows, {"level": "level"}, split="output"))]
@@ -475,7 +485,7 @@ SURROGATE_CSV = OutputFile("surrogate.csv", "ies sobol, method pce", "The polyno
                            "output and level (`uq.surrogate`).", (
     Column("output", "", "mean or max"),
     Column("level", "a_base/a_base*", "the excitation level"),
-    Column("points", "-", "the design's points (Latin hypercube)"),
+    Column("points", "-", "the design's points (scrambled Sobol')"),
     Column("degree", "-", "the basis' total degree"),
     Column("terms", "-", "the polynomial terms LARS kept"),
     Column("cv_error", "-", "10-fold cross-validated error, a share of the output variance"),

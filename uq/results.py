@@ -208,7 +208,8 @@ def sobol_table(folder: str | Path) -> str:
     fits = {(f["output"], float(f["level"])): f for f in _rows(folder / "surrogate.csv")} \
         if (folder / "surrogate.csv").is_file() else None
     how = "" if fits is None else ", from a polynomial-chaos surrogate"
-    lines = [f"Sobol' indices ({confidence:.0%} confidence intervals; S1 first order, ST total{how}):"]
+    lines = [f"Sobol' indices ({confidence:.0%} confidence intervals; S1 first order, ST total{how}; the "
+             "repetition noise counts into ST as an input of its own):"]
     for v in variance:
         o, level = v["output"], float(v["level"])
         share = float(v["noise_share"])
@@ -224,6 +225,10 @@ def sobol_table(folder: str | Path) -> str:
         for r in (r for r in rows if r["output"] == o and float(r["level"]) == level):
             lines.append(f"  {r['parameter']:>6}  S1 {float(r['S1']):6.3f} +- {float(r['S1_conf']):5.3f}   "
                          f"ST {float(r['ST']):6.3f} +- {float(r['ST_conf']):5.3f}" + ("   unreliable" if rough else ""))
+        free = [r for r in rows if r["output"] == o and float(r["level"]) == level and r.get("S1_noise_free")]
+        if free and np.isfinite(share) and 0 < share < 1:
+            lines.append("  without the noise (expected response): " + ", ".join(
+                f"{r['parameter']} S1 {float(r['S1_noise_free']):.3f} ST {float(r['ST_noise_free']):.3f}" for r in free))
         if rough:
             lines.append(f"  -> NOT SMOOTH: {fit['rough']}; a polynomial smears the jump over every term, so these "
                          "indices are unreliable: run this study with method = \"saltelli\".")

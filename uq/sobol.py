@@ -11,6 +11,15 @@ variance: the variance of a mean of r runs is s^2 / r, so the share of the varia
 output that is noise rather than parameters is  mean_i(s_i^2 / r_i) / Var_i(ybar_i).
 Failed runs (NaN/inf) are caught and reported before SALib sees them: a point with at least one
 finite repetition uses the finite ones; an output with a point that has none is not analysed.
+
+Two definitions of the indices, both written (`noise_free`, `with_noise`):
+* S1, ST: indices of the analysed output, the repetition mean, whose variance V + sigma^2 includes the noise
+  sigma^2 = s (V + sigma^2) of the mean of r runs. They are what Saltelli's estimators return on a noisy model:
+  every model evaluation draws its own noise, so the first-order estimator (Saltelli 2010) sees V_i / (V + sigma^2)
+  and Jansen's total-order estimator sees (V_Ti + sigma^2) / (V + sigma^2): the noise acts as an input of its own
+  that counts into every ST. They depend on the repetitions r through s.
+* S1_noise_free, ST_noise_free: V_i / V and V_Ti / V, the indices of the expected response (r -> infinity), what a
+  regression surrogate fits (`uq.surrogate`): S1 / (1 - s) and (ST - s) / (1 - s).
 """
 from __future__ import annotations
 
@@ -59,6 +68,33 @@ class SobolResult:
     @property
     def analysed(self) -> bool:
         return not self.message
+
+    def noise_free(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(S1, S1_conf, ST, ST_conf) of the expected response, the repetition noise taken out (module docstring)."""
+        return noise_free(self.S1, self.S1_conf, self.ST, self.ST_conf, self.noise_share)
+
+
+def _share(noise_share: float) -> float:
+    """The noise share used to convert: 0 when unknown (one repetition, a deterministic function), NaN from 1 on."""
+    if not np.isfinite(noise_share):
+        return 0.0
+    return float(noise_share) if noise_share < 1 else np.nan
+
+
+def noise_free(S1: np.ndarray, S1_conf: np.ndarray, ST: np.ndarray, ST_conf: np.ndarray,
+               noise_share: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Indices of the repetition mean (noise share s of its variance) -> of the expected response:
+    S1 / (1 - s), (ST - s) / (1 - s), half-widths / (1 - s). NaN where s >= 1 (no parameter effect resolved)."""
+    s = _share(noise_share)
+    return S1 / (1 - s), S1_conf / (1 - s), (ST - s) / (1 - s), ST_conf / (1 - s)
+
+
+def with_noise(S1: np.ndarray, S1_conf: np.ndarray, ST: np.ndarray, ST_conf: np.ndarray,
+               noise_share: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The inverse of `noise_free`: S1 (1 - s), ST (1 - s) + s, half-widths (1 - s); s >= 1 (all noise) gives
+    S1 = 0 and ST = 1."""
+    s = min(float(noise_share), 1.0) if np.isfinite(noise_share) else 0.0
+    return S1 * (1 - s), S1_conf * (1 - s), ST * (1 - s) + s, ST_conf * (1 - s)
 
 
 def check_runs(Y: np.ndarray, X: np.ndarray | None = None, names: list[str] | None = None) -> tuple[np.ndarray, list[str], str]:

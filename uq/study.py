@@ -57,7 +57,7 @@ Layout (every table and key is optional except where noted; SI units)::
     n = 64                       # saltelli: base sample size (power of two); n (k + 2) points
     bootstrap = 200
     confidence = 0.95
-    points = 30                  # pce: design points (a Latin hypercube; default 3 per polynomial term)
+    points = 32                  # pce: design points (scrambled Sobol'; default 3 per term, to a power of 2)
     degree = 2                   # pce: total degree of the polynomials (points >= C(k + degree, degree))
     max_misfit = 0.1             # pce: cross-validated error beyond the noise (share of the variance) above
                                  # which the response is flagged not smooth

@@ -6,8 +6,12 @@ coefficients (Sudret 2008, Reliab. Eng. Syst. Saf. 93: S_i = sum of the squared 
 x_i alone over the sum of all but the constant's; S_Ti of all terms containing x_i), provided the response is
 smooth over the parameter box.
 
-Design: a Latin hypercube of `points` points over the same box as Saltelli's sample (scipy.stats.qmc, seeded):
-each parameter's range cut into `points` equal strata, one point in each. Fit: Legendre polynomials of the
+Design: a scrambled Sobol' sequence of `points` points over the same box as Saltelli's sample (scipy.stats.qmc,
+seeded, Owen scrambling), balanced when `points` is a power of two. On the shipped Sobol' study (32 points x 3
+repetitions, eight seeds) it gave the small index of g with a third of a plain Latin hypercube's scatter (standard
+deviation 0.035 against 0.065; the hypercube's random column correlations move variance between parameters) and
+without the bias of a discrepancy-optimised one (+0.04).
+Fit: Legendre polynomials of the
 uniform inputs up to a total degree, the terms chosen by least-angle regression (LARS) with a corrected
 leave-one-out selection (Blatman & Sudret 2011, J. Comput. Phys. 230), OpenTURNS' `FunctionalChaosAlgorithm`.
 
@@ -19,6 +23,9 @@ What is reported beside the indices:
   (1 + terms / training points), the part no regression can explain;
 * bootstrap confidence half-widths of S1 and ST: the design points resampled with replacement, the fit
   repeated, z * standard deviation of the indices (SALib's convention, so the tables compare);
+* the indices in both definitions of `uq.sobol`: the fit's own are those of the expected response (regression
+  averages the repetition noise out); S1 and ST count the noise in as Saltelli's estimators do, so that the two
+  methods' tables mean the same;
 * smoothness: a regime switch inside the box (almost periodic / strongly modulated, Sect. 5.3 of the seed paper)
   makes the response jump, and a polynomial then spreads the jump over every term. The response is flagged
   not smooth when the cross-validated error exceeds the noise's expected part by more than `max_misfit`, or when
@@ -33,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from uq.errors import StudyError
-from uq.sobol import SobolResult
+from uq.sobol import SobolResult, with_noise
 from uq.space import ParameterSpace
 
 #: the methods of `[sobol] method`; Saltelli's sampling (`uq.sobol`) is the default and the reference
@@ -60,8 +67,9 @@ def check_design(k: int, points: int, degree: int) -> None:
 
 
 def default_points(k: int, degree: int) -> int:
-    """Three design points per term of the full basis (the usual rule for regression-based PCE)."""
-    return 3 * basis_size(k, degree)
+    """Three design points per term of the full basis (the usual rule for regression-based PCE), rounded up to a
+    power of two (the balance of the Sobol' design)."""
+    return 1 << (3 * basis_size(k, degree) - 1).bit_length()
 
 
 def openturns():
@@ -75,11 +83,15 @@ def openturns():
 
 
 def pce_sample(space: ParameterSpace, points: int, *, seed: int = 0) -> np.ndarray:
-    """Latin hypercube of the varied parameters (values in SI), shape (points, k), over the box [min, max]."""
+    """Scrambled Sobol' design of the varied parameters (values in SI), shape (points, k), over the box [min, max]."""
+    import warnings
+
     from scipy.stats import qmc
 
     lo, hi = np.array(space.salib_problem()["bounds"], dtype=float).T
-    unit = qmc.LatinHypercube(d=lo.size, seed=seed).random(points)
+    with warnings.catch_warnings():  # a count that is not a power of two is allowed: less balanced, still low-discrepancy
+        warnings.filterwarnings("ignore", message="The balance properties of Sobol' points")
+        unit = qmc.Sobol(d=lo.size, scramble=True, seed=seed).random(points)
     return lo + unit * (hi - lo)
 
 
@@ -195,6 +207,8 @@ def pce_indices(space: ParameterSpace, X: np.ndarray, y: np.ndarray, *, degree: 
         boot[b, 0], boot[b, 1], _ = pce_sobol(U[pick], y[pick], degree)
     z = norm.ppf(0.5 + confidence / 2)
     S1_conf, ST_conf = z * boot.std(axis=0, ddof=1)
+    # the fit filters the noise out: its indices are the noise-free ones; S1 and ST are defined as Saltelli's
+    S1, S1_conf, ST, ST_conf = with_noise(S1, S1_conf, ST, ST_conf, share)
     distinct = tuple(sorted({r for r in regimes if r}))
     rough = []
     if cv_error > floor + max_misfit:
