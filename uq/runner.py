@@ -302,14 +302,19 @@ def _dispatch(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs:
         # the model is sent once, as the result of a task rather than scattered data: when the workers holding it
         # die (a batch job cancelled or out of walltime) the scheduler recomputes it, while scattered data is lost
         remote_model = client.submit(_same, model, pure=False)
-        futures = [client.submit(_run_one, remote_model, key, task, seed, pure=False) for key, task in pending]
+        waiting = {client.submit(_run_one, remote_model, key, task, seed, pure=False) for key, task in pending}
         try:
-            for future in as_completed(futures):
+            for future in as_completed(list(waiting)):
                 key, result = future.result()
+                # forget a finished task at once: a result the client still holds lives on a worker, and when that
+                # worker's job ends the scheduler recomputes it (every finished task, again and again at each
+                # walltime); the result is on disk from here on
+                waiting.discard(future)
+                future.release()
                 yield key, by_key[key], result
         finally:
-            if client.status == "running":
-                client.cancel(futures)
+            if client.status == "running" and waiting:
+                client.cancel(list(waiting))
         return
     if jobs == 1:
         for key, task in pending:

@@ -119,3 +119,51 @@ def test_no_worker_in_time_stops_naming_resume_and_keeps_finished_tasks(on_slurm
     assert data_of(out) == data_of(serial)
     summary = json.loads((out / "study.json").read_text())["summary"]
     assert summary["reused"] == len(kept) and summary["ran"] == TOTAL - len(kept)
+
+
+WALLTIME_STUDY = STUDY.replace("hold = 0.3", "hold = 3.0").replace("n = 4", "n = 32")
+WALLTIME_TOTAL = 32 * (3 + 2) * 2 * 2
+
+
+@pytest.mark.long
+def test_a_worker_job_killed_at_its_walltime_loses_nothing(on_slurm, tmp_path):
+    """One worker job at a time with a 1-minute walltime (SLURM's smallest) and about 2 min of work: SLURM kills the
+    first job at its time limit (JobState TIMEOUT), the cluster submits another, and the study finishes with every
+    task once and the tasks finished before the kill untouched. (Above 3 min of walltime the workers retire before
+    it instead, `uq.cluster`.) About 3 min: run with `pytest -m long tests/cluster`."""
+    study = tmp_path / "walltime.toml"
+    study.write_text(WALLTIME_STUDY)
+    out = tmp_path / "out"
+    env = {**os.environ, **on_slurm.env()}
+    seen: dict = {"states": {}}
+
+    def watch():
+        """Record each worker job's state until the study ends, and the tasks on disk when the first job ends."""
+        while not seen.get("done"):
+            for job in on_slurm.jobs():
+                seen["states"].setdefault(job, "RUNNING")
+            for job in seen["states"]:
+                text = subprocess.run(["scontrol", "show", "job", job], env=env, capture_output=True, text=True).stdout
+                state = text.split("JobState=")[1].split()[0] if "JobState=" in text else seen["states"][job]
+                if state == "TIMEOUT" and "finished" not in seen:
+                    seen["finished"] = task_times(out)
+                seen["states"][job] = state
+            time.sleep(0.5)
+
+    watcher = threading.Thread(target=watch, daemon=True)
+    watcher.start()
+    t0 = time.monotonic()
+    options = [o if o != "00:10:00" else "00:01:00" for o in CLUSTER]
+    options[options.index("--cluster-max-jobs") + 1] = "1"
+    assert main(["sobol", str(study), "--out", str(out), *options]) == 0
+    seen["done"] = True
+    watcher.join(5)
+    print(f"\n{WALLTIME_TOTAL} tasks in {time.monotonic() - t0:.0f} s; worker jobs and their states: {seen['states']}; "
+          f"{len(seen.get('finished', {}))} tasks finished when the first job timed out")
+    assert "TIMEOUT" in seen["states"].values() and len(seen["states"]) >= 2
+    after = task_times(out)
+    assert 0 < len(seen["finished"]) < WALLTIME_TOTAL == len(after)
+    assert all(after[name] == mtime for name, mtime in seen["finished"].items())
+    summary = json.loads((out / "study.json").read_text())["summary"]
+    assert summary["tasks"] == summary["ran"] == WALLTIME_TOTAL and summary["failed_runs"] == 0
+    assert on_slurm.drained()

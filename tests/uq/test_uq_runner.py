@@ -1,5 +1,6 @@
-"""Runner: resumable after SIGKILL, identical numbers serially, with --jobs 2 and on a Dask LocalCluster,
-unreachable scheduler in one line. Runs the real simulator on a tiny protocol (short wait and hold)."""
+"""Runner: resumable after SIGKILL, identical numbers serially, with --jobs 2 and on a Dask LocalCluster, a dead
+worker costs only its unfinished tasks, an unreachable scheduler in one line. Runs the real simulator on a tiny
+protocol (short wait and hold)."""
 import json
 import os
 import signal
@@ -115,3 +116,40 @@ def test_resume_with_everything_done_runs_nothing(serial, tmp_path, capsys):
     assert main(["interval", str(tiny_study(tmp_path)), "--out", str(serial), "--resume", "--quiet", "--jobs", "1",
                  "--no-figures"]) == 0
     assert "(0 run now" in capsys.readouterr().out
+
+
+class CountingModel:
+    """A toy model that appends its parameter to a log file at every evaluation (to count recomputations)."""
+
+    outputs = ("y",)
+
+    def __init__(self, log: str) -> None:
+        self.log = log
+
+    def __call__(self, params, level, rep, seed):
+        time.sleep(0.05)
+        with open(self.log, "a") as fh:
+            fh.write(f"{params['x']:g}\n")
+        return {"y": params["x"]}
+
+
+def test_a_dead_worker_does_not_recompute_finished_tasks(tmp_path):
+    """A worker that dies (a batch job at its walltime) must cost only its unfinished tasks: the runner forgets each
+    result once it has it, otherwise the scheduler recomputes every finished task the client still holds, and with
+    jobs dying at each walltime a study never ends."""
+    distributed = pytest.importorskip("distributed")
+    from uq.runner import Task, _dispatch
+
+    log = tmp_path / "calls.log"
+    pending = [(f"k{i}", Task.make({"x": i}, 1.0, 0)) for i in range(40)]
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        finished = []
+        for key, task, result in _dispatch(CountingModel(str(log)), pending, 0, 1, client):
+            finished.append(key)
+            if len(finished) == 10:  # kill the only worker; its nanny starts a new one
+                pid = next(iter(client.run(os.getpid).values()))
+                os.kill(pid, signal.SIGKILL)
+    calls = log.read_text().split()
+    assert sorted(finished) == sorted(k for k, _ in pending)
+    assert all(calls.count(key[1:]) == 1 for key in finished[:10]), calls  # finished before the kill: run once
