@@ -302,7 +302,9 @@ def _dispatch(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs:
         # the model is sent once, as the result of a task rather than scattered data: when the workers holding it
         # die (a batch job cancelled or out of walltime) the scheduler recomputes it, while scattered data is lost
         remote_model = client.submit(_same, model, pure=False)
-        waiting = {client.submit(_run_one, remote_model, key, task, seed, pure=False) for key, task in pending}
+        keys, tasks = zip(*pending)
+        # one graph update for all tasks (client.map) rather than one message per task
+        waiting = set(client.map(_run_one, [remote_model] * len(keys), keys, tasks, [seed] * len(keys), pure=False))
         try:
             for future in as_completed(list(waiting)):
                 key, result = future.result()

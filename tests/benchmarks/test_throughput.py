@@ -12,13 +12,13 @@ run is below 0.5 (else printed with the load). Each engine is warmed up first (w
 loaded) on other tasks, so the figures are of a running study. Run:
 `pytest -m benchmark tests/benchmarks/test_throughput.py -s`.
 
-Latest figures (24 runs of 0.155 CPU s, 2 cores shared, load average 2.2-3.3): CPU overhead per task joblib 1
-worker +1.1 %, joblib 2 workers +4.8 %, local Dask +15.6 % raw / +4.7 % net of its idle background, SLURM +13.5 %
-raw / +8.0 % net; wall speed-up with 2 workers 0.86 (joblib), 0.92 (Dask), 1.22 (SLURM): the load left no second
-core free, so the 1.8 target was not measurable on that run.
+Each engine runs the same three sets of tasks; the table gives the medians over the three (the shared machine moves
+a single set by several per cent). Latest figures: in `tests/benchmarks/README.md`.
 """
 import os
+import statistics
 import time
+from types import SimpleNamespace
 from pathlib import Path
 
 import psutil
@@ -30,6 +30,7 @@ from uq.study import parse_study
 ROOT = Path(__file__).resolve().parents[2]
 N_TASKS = 24
 N_WARM = 8
+REPEATS = 3
 #: a small real study: the simulator on a short protocol (about 0.3 CPU s a run; the shipped Sobol' study's runs
 #: take about 1 s), long enough that a few ms of bookkeeping per task is a per-cent
 
@@ -48,7 +49,8 @@ def _tasks(study, offset: int, n: int = N_TASKS) -> list[Task]:
     """n distinct tasks (D varied); `offset` keeps warm-up tasks apart from measured ones."""
     space = study.space
     lo, hi = space["D"].min, space["D"].max
-    points = [{**space.nominal(), "D": lo + (hi - lo) * (i + offset * N_TASKS) / (3 * N_TASKS)} for i in range(n)]
+    points = [{**space.nominal(), "D": lo + (hi - lo) * (i + offset * N_TASKS) / ((REPEATS + 2) * N_TASKS)}
+              for i in range(n)]
     return [Task.make(p, study.levels[i % len(study.levels)], 0) for i, p in enumerate(points)]
 
 
@@ -108,9 +110,13 @@ def test_throughput_of_each_engine(model_and_study, tmp_path, monkeypatch, capsy
 
     def measure(name, run, pids=_children, cores=1):
         run(_tasks(study, 1, N_WARM), tmp_path / f"{name}-warm")  # warm-up: workers started, kernels loaded
-        with Meter(pids) as m:
-            run(_tasks(study, 2), tmp_path / name)
-        rows[name] = (m, cores)
+        meters = []
+        for repeat in range(REPEATS):
+            with Meter(pids) as m:
+                run(_tasks(study, 2 + repeat), tmp_path / f"{name}-{repeat}")
+            meters.append(m)
+        rows[name] = (SimpleNamespace(**{field: statistics.median(getattr(m, field) for m in meters)
+                                         for field in ("cpu", "idle", "wall", "load")}), cores)
 
     def bare(tasks, folder):
         for task in tasks:
@@ -134,7 +140,7 @@ def test_throughput_of_each_engine(model_and_study, tmp_path, monkeypatch, capsy
 
     bare_cpu = rows["bare"][0].cpu / N_TASKS
     bare_wall = rows["bare"][0].wall
-    lines = [f"{N_TASKS} runs of {bare_cpu:.3f} CPU s each (bare); 2 cores",
+    lines = [f"{N_TASKS} runs of {bare_cpu:.3f} CPU s each (bare); 2 cores; medians of {REPEATS} sets",
              (f"{'engine':26s} {'runs/core-s':>11s} {'CPU s/task':>10s} {'overhead':>8s} {'idle CPU':>8s} "
               f"{'net':>7s} {'wall s':>7s} {'speed-up':>8s} {'load':>5s}")]
     for name, (m, cores) in rows.items():
