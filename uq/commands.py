@@ -97,7 +97,8 @@ def add_sobol_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--method", choices=("saltelli", "pce"),
                         help="Saltelli's sampling (the reference) or a polynomial-chaos surrogate (default: [sobol] method)")
     parser.add_argument("--points", type=positive_int, metavar="N",
-                        help="pce: design points of the surrogate (default: [sobol] points, else 3 per polynomial term)")
+                        help="pce: design points of the surrogate (default: [sobol] points, else 3 per polynomial "
+                             "term, rounded up to a power of 2)")
     parser.add_argument("--degree", type=positive_int, metavar="P",
                         help="pce: total polynomial degree (default: [sobol] degree, else 2)")
     add_run_arguments(parser)
