@@ -222,13 +222,13 @@ def sobol_table(folder: str | Path) -> str:
             lines.append(f"  surrogate: degree {fit['degree']}, {fit['terms']} terms from {fit['points']} points; "
                          f"cross-validated error {float(fit['cv_error']):.0%} of the variance (the noise explains "
                          f"{float(fit['noise_floor']):.0%})")
-        for r in (r for r in rows if r["output"] == o and float(r["level"]) == level):
+        here = [r for r in rows if r["output"] == o and float(r["level"]) == level]
+        for r in here:
             lines.append(f"  {r['parameter']:>6}  S1 {float(r['S1']):6.3f} +- {float(r['S1_conf']):5.3f}   "
                          f"ST {float(r['ST']):6.3f} +- {float(r['ST_conf']):5.3f}" + ("   unreliable" if rough else ""))
-        free = [r for r in rows if r["output"] == o and float(r["level"]) == level and r.get("S1_noise_free")]
-        if free and np.isfinite(share) and 0 < share < 1:
+        if here and here[0].get("S1_noise_free") and np.isfinite(share) and 0 < share < 1:
             lines.append("  without the noise (expected response): " + ", ".join(
-                f"{r['parameter']} S1 {float(r['S1_noise_free']):.3f} ST {float(r['ST_noise_free']):.3f}" for r in free))
+                f"{r['parameter']} S1 {float(r['S1_noise_free']):.3f} ST {float(r['ST_noise_free']):.3f}" for r in here))
         if rough:
             lines.append(f"  -> NOT SMOOTH: {fit['rough']}; a polynomial smears the jump over every term, so these "
                          "indices are unreliable: run this study with method = \"saltelli\".")

@@ -74,18 +74,12 @@ class SobolResult:
         return noise_free(self.S1, self.S1_conf, self.ST, self.ST_conf, self.noise_share)
 
 
-def _share(noise_share: float) -> float:
-    """The noise share used to convert: 0 when unknown (one repetition, a deterministic function), NaN from 1 on."""
-    if not np.isfinite(noise_share):
-        return 0.0
-    return float(noise_share) if noise_share < 1 else np.nan
-
-
 def noise_free(S1: np.ndarray, S1_conf: np.ndarray, ST: np.ndarray, ST_conf: np.ndarray,
                noise_share: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Indices of the repetition mean (noise share s of its variance) -> of the expected response:
-    S1 / (1 - s), (ST - s) / (1 - s), half-widths / (1 - s). NaN where s >= 1 (no parameter effect resolved)."""
-    s = _share(noise_share)
+    S1 / (1 - s), (ST - s) / (1 - s), half-widths / (1 - s); an unknown s (one repetition) counts as 0, and s >= 1
+    (no parameter effect resolved) gives NaN."""
+    s = 0.0 if not np.isfinite(noise_share) else (float(noise_share) if noise_share < 1 else np.nan)
     return S1 / (1 - s), S1_conf / (1 - s), (ST - s) / (1 - s), ST_conf / (1 - s)
 
 

@@ -10,10 +10,9 @@ Design: a scrambled Sobol' sequence of `points` points over the same box as Salt
 seeded, Owen scrambling), balanced when `points` is a power of two. On the shipped Sobol' study (32 points x 3
 repetitions, eight seeds) it gave the small index of g with a third of a plain Latin hypercube's scatter (standard
 deviation 0.035 against 0.065; the hypercube's random column correlations move variance between parameters) and
-without the bias of a discrepancy-optimised one (+0.04).
-Fit: Legendre polynomials of the
-uniform inputs up to a total degree, the terms chosen by least-angle regression (LARS) with a corrected
-leave-one-out selection (Blatman & Sudret 2011, J. Comput. Phys. 230), OpenTURNS' `FunctionalChaosAlgorithm`.
+without the bias of a discrepancy-optimised one (+0.04). Fit: Legendre polynomials of the uniform inputs up to a
+total degree, the terms chosen by least-angle regression (LARS) with a corrected leave-one-out selection (Blatman &
+Sudret 2011, J. Comput. Phys. 230), OpenTURNS' `FunctionalChaosAlgorithm`.
 
 What is reported beside the indices:
 * the cross-validated error: K-fold (10 folds, or one per point below 10), the whole fit (LARS included)
