@@ -62,7 +62,8 @@ def check_design(k: int, points: int, degree: int) -> None:
     terms = basis_size(k, degree)
     if points < terms:
         raise StudyError(f"[sobol] points = {points} is too few for degree {degree} in {k} parameters ({terms} "
-                         f"polynomial terms): give points >= {terms} (about {3 * terms} recommended) or lower the degree")
+                         f"polynomial terms): give points >= {terms} (the default, {default_points(k, degree)}, "
+                         "recommended) or lower the degree")
 
 
 def default_points(k: int, degree: int) -> int:
