@@ -5,7 +5,7 @@ result tables and figures (seed paper Sects. 5.2-5.4, Figs. 5-8).
 Pipeline: k_H (bem_contact) and modal model (sim) -> **uq** -> bands, indices, figures. uq imports sim; of
 the other stages only the `ies` front door (`uq.cli`) imports them. Its commands `ies interval`, `ies sobol`,
 `ies response`, `ies reproduce`, `ies plot` live in `uq.commands`; analytic test functions for studies in
-`uq.test_functions`.
+`uq.problem.test_functions`.
 
 Public names, each imported from its module on first use, so that `import uq.errors` stays light
 (importing all of them takes 0.2-0.3 s more), as in the other stages:
@@ -22,11 +22,11 @@ from typing import Any
 from uq.errors import StudyError
 
 _MODULE_OF = {
-    "Study": "study", "load_study": "study",
-    "Parameter": "space", "ParameterSpace": "space", "table2_space": "space",
-    "run_interval_study": "execute", "run_sobol_study": "execute", "run_response_study": "execute",
-    "StudyResult": "execute",
-    "interval_figures": "paper_figures", "sobol_figure": "figures", "response_figures": "paper_figures",
+    "Study": "problem.study", "load_study": "problem.study",
+    "Parameter": "problem.space", "ParameterSpace": "problem.space", "table2_space": "problem.space",
+    "run_interval_study": "engine.execute", "run_sobol_study": "engine.execute", "run_response_study": "engine.execute",
+    "StudyResult": "engine.execute", "open_study": "outputs.results",
+    "interval_figures": "outputs.paper_figures", "sobol_figure": "outputs.figures", "response_figures": "outputs.paper_figures",
 }
 __all__ = ["StudyError", *_MODULE_OF]
 

@@ -73,10 +73,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 def version_line() -> str:
     """``ies-workbench VERSION (simulator code HASH)``: the installed distribution's version and the hash of the
-    simulator's source (the code version in every study's task keys, `uq.models`)."""
+    simulator's source (the code version in every study's task keys, `uq.problem.models`)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    from uq.models import IESModel
+    from uq.problem.models import IESModel
 
     try:
         installed = version("ies-workbench")

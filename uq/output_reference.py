@@ -10,9 +10,9 @@ from sim.analysis.cli import IMPACTS_JSON, MODAL_FIT_JSON
 from sim.analysis.trace import TRACE_CSV, TRACE_JSON
 from sim.common.outputs import OutputFile, describe
 from sim.stepped_sine.tables import OVERVIEW_CSV, OVERVIEW_JSON, SWEEP_CSV, SWEEP_JSON
-from uq.compare import COMPARE_CSV
-from uq.design import DESIGN_CSV, DESIGN_JSON, DESIGN_LEVELS_CSV
-from uq.execute import (
+from uq.outputs.compare import COMPARE_CSV
+from uq.design.tables import DESIGN_CSV, DESIGN_JSON, DESIGN_LEVELS_CSV
+from uq.engine.execute import (
     BANDS_CSV,
     POINTS_CSV,
     RESULTS_NC,
@@ -24,7 +24,7 @@ from uq.execute import (
     TASK_JSON,
     VARIANCE_CSV,
 )
-from uq.reproduce_report import FILES
+from uq.outputs.reproduce_report import FILES
 
 PAGE = Path(__file__).with_name("OUTPUTS.md")
 #: the sections of the page: (heading, the files it lists)
@@ -69,7 +69,7 @@ def render() -> str:
     parts.append("## What `ies reproduce` adds\n")
     parts.append("Beside each figure's study folder: `summary.txt` (the command, every table printed and the "
                  "paper's statement beside each), `FIG/table.txt` (one figure's printed table) and `index.md` "
-                 "(every figure and table with one line), from `uq.reproduce_report`:\n")
+                 "(every figure and table with one line), from `uq.outputs.reproduce_report`:\n")
     parts.append("\n".join(f"- `{name}`: {line}" for name, line in FILES.items()) + "\n")
     return "\n".join(parts)
 

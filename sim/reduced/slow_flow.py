@@ -68,7 +68,7 @@ A^ = A/g, tau = omega t, eta = Omega/omega, b = a_base/g.
     3.7; the rig (9 modes) is almost periodic only at 0.972-0.980, maximum at 0.980 with 4.0. The maximum thus
     sits beyond the symmetric two-impact orbit's stable range, on a multi-impact branch (issue 28).
 
-Accuracy (tests/sim/test_slow_flow.py): against the exact orbit of the one-mode Newton model at the rig's eps
+Accuracy (tests/sim/reduced/test_slow_flow.py): against the exact orbit of the one-mode Newton model at the rig's eps
 the slow flow is within 0.15 % in tip amplitude and 0.003 rad in impact phase (the recoil terms of (2)-(4b)
 matter at that eps); a direct solve_ivp simulation settles on the exact orbit to 1e-4. Assumed: one mode, rigid walls with a
 fixed r (k_H does not enter; the similarity law then makes the response depend on g only through a_base/g),
