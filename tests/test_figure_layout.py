@@ -465,17 +465,17 @@ def draw_scan_calibrate(tmp: Path) -> None:
 
 def draw_design(tmp: Path) -> None:
     """ies design's map and curves from a real screening of a small grid and fabricated verifications."""
-    from uq import design as d
+    from uq.design import problem as dp, results as dr, search as ds
     from uq.design.figures import plot_design_curves, plot_design_map
 
-    problem = d.DesignProblem(excitation=tuple(np.linspace(1e-6, 6e-6, 6)), clearances=(0.3e-3, 0.45e-3, 0.6e-3),
+    problem = dp.DesignProblem(excitation=tuple(np.linspace(1e-6, 6e-6, 6)), clearances=(0.3e-3, 0.45e-3, 0.6e-3),
                               radii=(6e-3, 7.92e-3), materials=("brass", "tungsten"),
-                              baseline=d.Sphere(0.58e-3, 7.92e-3, "brass"))
-    screened = d.screen_designs(problem, d.host_mode(d.host_model(problem)))
+                              baseline=dp.Sphere(0.58e-3, 7.92e-3, "brass"))
+    screened = ds.screen_designs(problem, dp.host_mode(dp.host_model(problem)))
     level = np.linspace(0.1, 1.0, 6) * 1e-3
-    verified = [d.Verified(s, k * level, 1.3 * k * level, 1.1 * k * level, np.linspace(0, 1, 6), np.zeros(6, bool), 6)
-                for k, s in zip((1.0, 1.5, 2.0), d.candidates(problem, screened)[:3])]
-    result = d.DesignResult(problem, screened, verified, tmp, np.arange(1.0, 7.0), 3.0 * level, [])
+    verified = [dr.Verified(s, k * level, 1.3 * k * level, 1.1 * k * level, np.linspace(0, 1, 6), np.zeros(6, bool), 6)
+                for k, s in zip((1.0, 1.5, 2.0), ds.candidates(problem, screened)[:3])]
+    result = dr.DesignResult(problem, screened, verified, tmp, np.arange(1.0, 7.0), 3.0 * level, [])
     plot_design_map(result, tmp / "design-map.png")
     plot_design_curves(result, tmp / "design-curves.png")
 

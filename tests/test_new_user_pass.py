@@ -219,7 +219,7 @@ def test_compare_refuses_a_non_empty_out_and_a_folder_given_twice(tmp_path, caps
 
 
 def test_compare_checks_out_before_writing(tmp_path, capsys, monkeypatch):
-    from uq import compare
+    from uq.outputs import compare
 
     fake = compare.ResponseFolder("a", tmp_path / "a", {}, {"levels": []})
     monkeypatch.setattr(compare, "read_response_folder", lambda folder: fake)

@@ -11,7 +11,7 @@ from sim.analysis.trace import TRACE_CSV, TRACE_JSON
 from sim.common.outputs import OutputFile, describe
 from sim.stepped_sine.tables import OVERVIEW_CSV, OVERVIEW_JSON, SWEEP_CSV, SWEEP_JSON
 from uq.outputs.compare import COMPARE_CSV
-from uq.design.tables import DESIGN_CSV, DESIGN_JSON, DESIGN_LEVELS_CSV
+from uq.design.results import DESIGN_CSV, DESIGN_JSON, DESIGN_LEVELS_CSV
 from uq.engine.execute import (
     BANDS_CSV,
     POINTS_CSV,

@@ -48,7 +48,7 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
 def design_problem(args: argparse.Namespace) -> tuple[Any, Path, Any]:
     """The design problem, output folder and [cluster] table of `ies design`'s study file and options (options win;
     `uq.design.problem.read_design_file`, `uq.design.problem.problem_of`)."""
-    from uq import design as d
+    from uq.design import problem as d
 
     file = d.read_design_file(args.study) if args.study is not None else d.DesignFile()
     given = {name: getattr(args, name) for name in d.DESIGN_SETTINGS if getattr(args, name, None) is not None}
@@ -59,7 +59,7 @@ def design_problem(args: argparse.Namespace) -> tuple[Any, Path, Any]:
 def design_command(args: argparse.Namespace) -> int:
     """`ies design`: screen, verify and recommend (uq.design)."""
     from uq.design.search import run_design
-    from uq.design.tables import design_table
+    from uq.design.results import design_table
 
     problem, out, cluster = design_problem(args)
     with engine(args, cluster) as client:

@@ -5,7 +5,6 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -20,23 +19,8 @@ from uq.design.problem import (
     micrometres,
     no_absorber,
 )
-from uq.design.tables import write_design
+from uq.design.results import DesignResult, Screened, Verified, write_design
 from uq.errors import StudyError
-
-
-@dataclass(frozen=True)
-class Screened:
-    """The screening of the grid: per design (`designs`, grid order) the worst case over the uncertainty ends of the
-    predicted resonant tip amplitude (m) at each operating level (`tip`, shape designs x levels), its regime there
-    (`regime`), the base amplitude of the predicted switch to the almost periodic response (`switch`, m) and the
-    design's worst case over the levels (`worst`, m; inf for designs that do not fit)."""
-
-    designs: list[Sphere]
-    tip: np.ndarray
-    regime: np.ndarray
-    switch: np.ndarray
-    worst: np.ndarray
-    seconds: float
 
 
 def screen_designs(problem: DesignProblem, mode: Any) -> Screened:
@@ -114,25 +98,6 @@ def corners(problem: DesignProblem, sphere: Sphere) -> list[dict[str, float]]:
     return [*unique.values(), nominal]
 
 
-@dataclass(frozen=True)
-class Verified:
-    """One verified design: per operating level the band (m) of the resonant tip amplitude over the corners (low,
-    high; averaged over the repetitions), the nominal point's value, the fraction of runs in the almost periodic
-    regime, whether the nominal point left the corners' band beyond the repetition noise (monotonicity check), and
-    the worst case over the levels (m)."""
-
-    sphere: Sphere
-    low: np.ndarray
-    high: np.ndarray
-    nominal: np.ndarray
-    apr: np.ndarray
-    outside: np.ndarray
-    runs: int
-
-    @property
-    def worst(self) -> float:
-        """The worst case (m): the corners' and the nominal point's highest value over the levels."""
-        return float(np.max(np.maximum(self.high, self.nominal)))
 
 
 def verification_model(problem: DesignProblem) -> Any:
@@ -180,36 +145,6 @@ def verify(problem: DesignProblem, spheres: Sequence[Sphere], model: Any, folder
     return out
 
 
-@dataclass(frozen=True)
-class DesignResult:
-    """A finished design: the problem, the screening, the verified designs (best first), the recommendation (the best
-    verified design), the baseline's verification (if asked), and the folder of its files."""
-
-    problem: DesignProblem
-    screened: Screened
-    verified: list[Verified]
-    folder: Any
-    levels: np.ndarray
-    no_absorber: np.ndarray
-    files: list[Any]
-
-    @property
-    def recommendation(self) -> Verified:
-        return self.verified[0]
-
-    @property
-    def baseline(self) -> Verified | None:
-        return next((v for v in self.verified if v.sphere == self.problem.baseline), None)
-
-    def sentence(self) -> str:
-        """The recommendation in words and units."""
-        best, p = self.recommendation, self.problem
-        s = best.sphere
-        lo, hi = min(p.excitation), max(p.excitation)
-        ratio = float(np.max(self.no_absorber)) / best.worst
-        return (f"clearance {s.clearance * 1e3:.2f} mm, {s.material} sphere of radius {s.radius * 1e3:.2f} mm "
-                f"({s.mass * 1e3:.1f} g): worst case {best.worst * 1e3:.3g} mm over {micrometres(lo)}-{micrometres(hi)} um, "
-                f"{ratio:.1f}x below the structure without IES ({float(np.max(self.no_absorber)) * 1e3:.3g} mm)")
 
 
 def run_design(problem: DesignProblem, out: Any, *, jobs: int | None = 1, scheduler: str | None = None,

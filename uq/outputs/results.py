@@ -254,7 +254,7 @@ def open_study(folder: str | Path) -> xarray.Dataset:
     Dimensions as the study has them: ``point`` (with each parameter as a coordinate along it), ``level``
     (a_base / a_base*), ``repetition``; ``design``/``design_point`` (interval), ``parameter`` (Sobol'), ``eta``
     (response; a series adds a dimension named after its parameter); ``design`` x ``level`` and ``screened`` for
-    `ies design` (`uq.design.tables.write_design_netcdf`). Every variable has CF ``units`` and
+    `ies design` (`uq.design.results.write_design_netcdf`). Every variable has CF ``units`` and
     ``long_name``; ``ds.attrs["study"]`` is the resolved study (JSON) and ``ds.attrs["code_version"]`` the
     simulator's code version. Example, in Python or a notebook::
 

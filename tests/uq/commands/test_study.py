@@ -106,7 +106,7 @@ def test_calibrated_k_H_becomes_the_upper_bound():
 
 def tiny_reproduction(tmp_path, monkeypatch, extra=""):
     """`ies reproduce` on a tiny simulator study (k_H varied, one level, two frequencies) instead of the shipped ones."""
-    import uq.commands as reproduce
+    import uq.commands.reproduce as reproduce
 
     tiny = tmp_path / "tiny.toml"
     tiny.write_text("[study]\nkind = 'interval'\nrepetitions = 1\n[parameters.k_H]\n[excitation]\nlevels = [7.4]\n"

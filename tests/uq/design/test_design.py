@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from uq import design as d
+from uq.design import problem as dp, results as dr, search as ds
 from uq.cli import main
 
 TINY = """[study]
@@ -51,7 +51,7 @@ def test_a_tiny_design_end_to_end_resumes_and_is_the_same_in_parallel(tmp_path, 
                                                "design-map.pdf", "design-curves.png", "design-curves.pdf", "tasks",
                                                "results.nc"}
     data = json.loads((out / "design.json").read_text())
-    assert set(data) == set(d.DESIGN_KEYS)
+    assert set(data) == set(dr.DESIGN_KEYS)
     best = data["recommendation"]
     assert printed.strip().splitlines()[-2].startswith("recommendation: clearance ")
     assert best["sentence"] in printed
@@ -61,7 +61,7 @@ def test_a_tiny_design_end_to_end_resumes_and_is_the_same_in_parallel(tmp_path, 
     assert data["baseline"]["clearance_m"] == pytest.approx(0.58e-3)
     with open(out / "design.csv") as f:
         rows = list(csv.DictReader(f))
-    assert list(rows[0]) == list(d.DESIGN_CSV.names)
+    assert list(rows[0]) == list(dr.DESIGN_CSV.names)
     assert sum(r["status"] != "screened" for r in rows) == len(data["verified"])
     assert all(float(r["cavity_m"]) == pytest.approx(2 * (float(r["radius_m"]) + float(r["clearance_m"])))
                for r in rows)
@@ -87,12 +87,12 @@ def test_a_tiny_design_end_to_end_resumes_and_is_the_same_in_parallel(tmp_path, 
 
 
 def test_ranges_read_units_counts_and_accelerations():
-    assert d.parse_range("0.2mm:1.2mm:6", "clearance", count=10) == pytest.approx((2e-4, 4e-4, 6e-4, 8e-4, 1e-3,
+    assert dp.parse_range("0.2mm:1.2mm:6", "clearance", count=10) == pytest.approx((2e-4, 4e-4, 6e-4, 8e-4, 1e-3,
                                                                                     1.2e-3))
-    assert d.parse_range("7.92mm", "radius", count=4) == (pytest.approx(7.92e-3),)
-    assert len(d.parse_range("2um:8um", "excitation", count=10)) == 10
+    assert dp.parse_range("7.92mm", "radius", count=4) == (pytest.approx(7.92e-3),)
+    assert len(dp.parse_range("2um:8um", "excitation", count=10)) == 10
     omega = 2 * np.pi * 10.0
-    assert d.parse_range("1m/s2:4m/s2:2", "excitation", count=10, omega=omega) == pytest.approx(
+    assert dp.parse_range("1m/s2:4m/s2:2", "excitation", count=10, omega=omega) == pytest.approx(
         (1 / omega**2, 4 / omega**2))
 
 
@@ -130,14 +130,14 @@ def test_a_study_file_with_an_unknown_key_or_kind_is_refused(tmp_path, capsys):
 
 
 def test_the_screening_is_worst_over_the_damping_interval_and_ranks_designs():
-    problem = d.DesignProblem(excitation=(2e-6, 6e-6), clearances=(0.3e-3, 0.58e-3), radii=(6e-3, 7.92e-3))
-    mode = d.host_mode(d.host_model(problem))
-    screened = d.screen_designs(problem, mode)
-    low_damping = d.screen_designs(d.DesignProblem(excitation=problem.excitation, clearances=problem.clearances,
+    problem = dp.DesignProblem(excitation=(2e-6, 6e-6), clearances=(0.3e-3, 0.58e-3), radii=(6e-3, 7.92e-3))
+    mode = dp.host_mode(dp.host_model(problem))
+    screened = ds.screen_designs(problem, mode)
+    low_damping = ds.screen_designs(dp.DesignProblem(excitation=problem.excitation, clearances=problem.clearances,
                                                    radii=problem.radii, D=(0.0009, 0.0009),
                                                    clearance_tolerance=(0.0, 0.0)), mode)
     assert np.all(screened.tip >= low_damping.tip - 1e-15)
-    chosen = d.candidates(problem, screened)
+    chosen = ds.candidates(problem, screened)
     assert chosen[0] == screened.designs[int(np.argmin(screened.worst))]
 
 

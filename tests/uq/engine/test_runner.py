@@ -61,7 +61,7 @@ def test_jobs_2_gives_identical_numbers(serial, tmp_path):
 
 def test_dask_local_cluster_gives_identical_numbers(serial, tmp_path, monkeypatch):
     distributed = pytest.importorskip("distributed")
-    from uq import runner
+    from uq.engine import runner
 
     addresses = []
     connect = runner._connect

@@ -61,7 +61,7 @@ def test_a_response_study_in_parallel_and_resumed_is_byte_identical(tmp_path, ca
 
 
 def test_reproduce_all_runs_figures_5_to_8(tmp_path, monkeypatch, capsys):
-    import uq.commands as commands
+    import uq.commands.reproduce as commands
 
     response = tiny(tmp_path, "[response]\nfigures = ['fig5', 'fig6']\n")
     interval = tmp_path / "interval.toml"
