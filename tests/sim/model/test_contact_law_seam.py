@@ -5,7 +5,12 @@ each at 0.99 omega_1, the sphere launched at 0.3 m/s: the rattling is chaotic, a
 integrator's 1e-11 per step already grow to 5e-7) by both integrators and checked against scipy's DOP853 with events
 (`sim.integration.references.reference_run`, which evaluates the law's force in Python), against its own
 single-impact reference (a half sine: restitution 1, duration pi sqrt(m / k)), and by the energy ledger's balance
-with the law's potential k delta^2 / 2."""
+with the law's potential k delta^2 / 2.
+
+Compiling a new law into the integrators takes minutes (numba cannot cache kernels specialised on a law defined at
+run time), so those three tests are in the `long` set (`pytest -m long tests/sim/model/test_contact_law_seam.py`); the
+default run keeps a stand-in that compiles nothing: the same registered toy law, through `system_arrays`, in the
+DOP853 reference against its single-impact reference."""
 from __future__ import annotations
 
 import math
@@ -101,6 +106,33 @@ def test_an_unknown_law_is_one_line():
         ContactLaw("linear-spring")
 
 
+def immovable_wall(law_name: str = "linear-spring"):
+    """A sphere against a wall that does not move (a 1e6 kg 'beam'), the impactor with the law `law_name`."""
+    m_wall = 1e6
+    phi = 1.0 / math.sqrt(m_wall)
+    model = ModalModel(frequencies_hz=np.array([1e-3]), damping_ratios=np.array([1e-6]), phi_wall_left=np.array([phi]),
+                       phi_wall_right=np.array([phi]), phi_tip=np.array([phi]), participation=np.array([0.0]),
+                       source="immovable wall")
+    impactor = Impactor(k_H=K_SPRING, contact_law=ContactLaw(law_name))
+    return model, impactor, system_arrays(model, impactor)
+
+
+def test_the_toy_law_reaches_the_reference_and_meets_its_single_impact(spring):
+    """The default run's stand-in for the compiled tests below: the registered toy law, carried by `system_arrays`
+    like any law, drives the DOP853 reference (its force evaluated in Python): one impact on the immovable wall lasts
+    half a period of the spring and rebounds with restitution 1, as the law's own reference says."""
+    model, impactor, sys = immovable_wall()
+    assert sys.law.force is spring_force
+    v0 = 0.2
+    y0 = np.array([0.0, 0.0, -sys.g + 1e-4 * v0, -v0])
+    _, onsets, releases, rebounds = reference_run(y0, 1e-3, 2 * math.pi * 1000.0, 0.0, sys, rtol=1e-12)
+    expected = SPRING.reference(impactor.mass, v0, K_SPRING, 0.0)
+    assert onsets.size == 1 and releases.size == 1
+    assert releases[0] - onsets[0] == pytest.approx(expected.duration, rel=1e-6)
+    assert abs(rebounds[0]) / v0 == pytest.approx(expected.restitution, rel=1e-6)
+
+
+@pytest.mark.long  # compiles the toy law into the integrator: minutes (see the module docstring)
 @pytest.mark.parametrize("integrator", ["exact", "ode3"])
 def test_the_toy_law_runs_a_stepped_sine_point_like_scipy(spring, integrator):
     model, sys = three_mode_system()
@@ -132,16 +164,11 @@ def test_the_toy_law_runs_a_stepped_sine_point_like_scipy(spring, integrator):
     assert abs(ledger.balance_error) < (1e-7 if integrator == "exact" else 1e-3)
 
 
+@pytest.mark.long  # compiles the toy law into the exact integrator: minutes (see the module docstring)
 def test_the_toy_law_meets_its_single_impact_reference(spring):
     """One impact on a wall that does not move (a 1e6 kg 'beam'): the exact integrator's impact log against the
     law's reference (half a period of the spring, restitution 1)."""
-    m_wall = 1e6
-    phi = 1.0 / math.sqrt(m_wall)
-    model = ModalModel(frequencies_hz=np.array([1e-3]), damping_ratios=np.array([1e-6]), phi_wall_left=np.array([phi]),
-                       phi_wall_right=np.array([phi]), phi_tip=np.array([phi]), participation=np.array([0.0]),
-                       source="immovable wall")
-    impactor = Impactor(k_H=K_SPRING, contact_law=ContactLaw("linear-spring"))
-    sys = system_arrays(model, impactor)
+    model, impactor, sys = immovable_wall()
     v0 = 0.2
     y = np.zeros(4)
     y[2] = -sys.g + 1e-4 * v0
