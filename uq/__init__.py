@@ -10,7 +10,8 @@ the other stages only the `ies` front door (`uq.cli`) imports them. Its parts, e
   engine:   running: the task store and runner (joblib, Dask), batch clusters, the execution of a study
   outputs:  tables, results.nc, reading results back, figures, the paper's figure table, compare, reproduce report
   design:   `ies design` (problem, search, results, figures)
-  commands: the stage's words of the `ies` command line (`uq.commands.commands()`)
+  commands: the stage's words of the `ies` command line (`uq.commands.commands()`): interval, sobol, response,
+            reproduce, plot, compare, design
 
 Public names, each imported from its module on first use, so that `import uq.errors` stays light:
   load_study (a study file against the registered methods), Study, Parameter, ParameterSpace, table2_space,

@@ -1,6 +1,6 @@
 """The uncertainty stage's words of the `ies` command line, one module each: the study commands (`study`: one per study
-kind of the method registry `uq.methods`, today `interval`, `sobol`, `response`), `reproduce` (the paper's
-figures), `plot`, `compare` and `design`.
+kind of the method registry `uq.methods`: `interval`, `sobol`, `response`), `reproduce` (the paper's figures),
+`plot`, `compare` and `design`.
 
 `commands()` lists these words (name, help, options, run); `add_commands(subparsers, calibrate=...)` registers them
 with the front door (`uq.cli`), which hands over the calibration as a callable: this stage never imports the contact
