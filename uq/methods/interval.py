@@ -32,7 +32,7 @@ from uq.errors import StudyError
 from uq.outputs.tables import PARAMETERS_COLUMN, parameter_columns
 from uq.problem.method import Analysis, Method, Plan, Runs, Table
 from uq.problem.space import ParameterSpace
-from uq.problem.study import Context, Setting, Study, check_number, read_fixed_values
+from uq.problem.study import Context, Setting, Study, numeric, read_fixed_values
 
 
 @dataclass(frozen=True)
@@ -236,14 +236,6 @@ def _designs(value: Any, context: Context) -> tuple[str, ...]:
     return tuple(value)
 
 
-def _interior(value: Any, context: Context) -> int:
-    return int(check_number("[interval] interior", value, integer=True, positive=False, minimum=0))
-
-
-def _z(value: Any, context: Context) -> float:
-    return float(check_number("[interval] z", value, positive=False, minimum=0.0))
-
-
 def _fix(value: Any, context: Context) -> dict[str, float]:
     return read_fixed_values(value, context.space, context.base_dir, context.source)
 
@@ -308,10 +300,10 @@ class IntervalMethod(Method):
     settings = (
         Setting("designs", ("individual",), _designs, "the designs: individual (one parameter at a time, Fig. 7), "
                 "joint (the whole box, Fig. 8), residual (the box with `fix` held, Fig. 8)"),
-        Setting("interior", 1, _interior, "interior points per axis (individual) or in the box (joint, residual), "
-                "where the monotonicity is checked"),
-        Setting("z", 2.0, _z, "noise multiple (combined standard errors) below which a monotonicity violation is not "
-                "flagged"),
+        numeric("interior", 1, "interior points per axis (individual) or in the box (joint, residual), where the "
+                "monotonicity is checked", integer=True, positive=False, minimum=0),
+        numeric("z", 2.0, "noise multiple (combined standard errors) below which a monotonicity violation is not "
+                "flagged", positive=False, minimum=0.0),
         Setting("fix", None, _fix, "parameters held fixed in the residual band, e.g. { k_H = \"best_estimate\" } (the "
                 "default when k_H is a parameter)"),
     )

@@ -39,7 +39,7 @@ from sim.common.outputs import Column, OutputFile
 from uq.errors import StudyError
 from uq.problem.method import Analysis, Method, Plan, Runs, Table
 from uq.problem.space import ParameterSpace
-from uq.problem.study import Context, Setting, Study, check_number
+from uq.problem.study import Context, Setting, Study, check_number, numeric
 
 
 def sobol_sample(space: ParameterSpace, n: int, *, seed: int = 0) -> np.ndarray:
@@ -210,10 +210,6 @@ VARIANCE_CSV = OutputFile("variance.csv", "ies sobol", "", (
 ))
 
 
-def _bootstrap(value: Any, context: Context) -> int:
-    return int(check_number("[sobol] bootstrap", value, integer=True))
-
-
 def _confidence(value: Any, context: Context) -> float:
     value = float(check_number("[sobol] confidence", value))
     if not 0 < value < 1:
@@ -223,7 +219,7 @@ def _confidence(value: Any, context: Context) -> float:
 
 #: the settings every Sobol' method has (analysis settings: not part of the study's identity)
 SHARED_SETTINGS = (
-    Setting("bootstrap", 200, _bootstrap, "bootstrap resamples of the confidence intervals", identity=False),
+    numeric("bootstrap", 200, "bootstrap resamples of the confidence intervals", integer=True, identity=False),
     Setting("confidence", 0.95, _confidence, "confidence level of the intervals", identity=False),
 )
 

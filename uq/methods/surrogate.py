@@ -48,7 +48,7 @@ from uq.errors import StudyError
 from uq.methods.sobol import SHARED_SETTINGS, SobolMethod, SobolResult, with_noise
 from uq.problem.method import Table
 from uq.problem.space import ParameterSpace
-from uq.problem.study import Context, Setting, Study, check_number
+from uq.problem.study import Context, Study, numeric
 #: cross-validation folds (fewer when the design has fewer points)
 FOLDS = 10
 #: the default of `[sobol] max_misfit`: cross-validated error beyond the noise's part, share of the variance
@@ -248,18 +248,6 @@ SURROGATE_CSV = OutputFile("surrogate.csv", "ies sobol, method pce", "The polyno
 ))
 
 
-def _points(value: Any, context: Context) -> int:
-    return int(check_number("[sobol] points", value, integer=True))
-
-
-def _degree(value: Any, context: Context) -> int:
-    return int(check_number("[sobol] degree", value, integer=True))
-
-
-def _misfit(value: Any, context: Context) -> float:
-    return float(check_number("[sobol] max_misfit", value))
-
-
 class PCE(SobolMethod):
     """Sobol' indices from a polynomial-chaos surrogate of a scrambled Sobol' design (module docstring)."""
 
@@ -267,12 +255,12 @@ class PCE(SobolMethod):
     help = ("a polynomial-chaos surrogate (OpenTURNS) of a scrambled Sobol' design: a tenth of the runs where the response "
             "is smooth")
     settings = (*SHARED_SETTINGS,
-                Setting("points", 0, _points, "design points of the surrogate (default: 3 per polynomial term, rounded "
-                        "up to a power of 2)", option="--points", metavar="N", parse=positive_int, identity=False),
-                Setting("degree", 2, _degree, "total polynomial degree (points >= C(k + degree, degree))",
+                numeric("points", 0, "design points of the surrogate (default: 3 per polynomial term, rounded up to a "
+                        "power of 2)", integer=True, option="--points", metavar="N", parse=positive_int, identity=False),
+                numeric("degree", 2, "total polynomial degree (points >= C(k + degree, degree))", integer=True,
                         option="--degree", metavar="P", parse=positive_int, identity=False),
-                Setting("max_misfit", MAX_MISFIT, _misfit, "cross-validated error beyond the noise (share of the "
-                        "variance) above which the response is flagged not smooth", identity=False))
+                numeric("max_misfit", MAX_MISFIT, "cross-validated error beyond the noise (share of the variance) above "
+                        "which the response is flagged not smooth", identity=False))
     tables = (*SobolMethod.tables, Table(SURROGATE_CSV, dims={"level": "level"}, split="output"))
 
     def finish(self, values: dict[str, Any], context: Context) -> dict[str, Any]:

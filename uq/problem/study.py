@@ -242,13 +242,25 @@ def check_number(where: str, value: Any, *, integer: bool = False, positive: boo
     return value
 
 
+def numeric(key: str, default: float, help: str, *, integer: bool = False, positive: bool = True,
+            minimum: float | None = None, maximum: float | None = None, **option: Any) -> Setting:
+    """A setting whose value is a number checked by `check_number` (the error names ``[KIND] KEY``); `option`: the
+    Setting's option, metavar, parse and identity."""
+    def read(value: Any, context: Context) -> float:
+        checked = check_number(f"[{context.kind}] {key}", value, integer=integer, positive=positive, minimum=minimum,
+                               maximum=maximum)
+        return int(checked) if integer else float(checked)
+
+    return Setting(key, default, read, help, **option)
+
+
 def _number(table: str, key: str, value: Any, *, integer: bool = False, positive: bool = True) -> float:
     return check_number(f"[{table}] {key}", value, integer=integer, positive=positive)
 
 
 def _kinds(methods: Mapping[str, Any]) -> dict[str, list[Any]]:
     """kind -> its methods, in registry order (the first is the kind's default)."""
-    kinds: dict[str, list[Method]] = {}
+    kinds: dict[str, list[Any]] = {}
     for method in methods.values():
         kinds.setdefault(method.kind, []).append(method)
     return kinds

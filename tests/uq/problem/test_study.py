@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 from uq.cli import main
-from uq.errors import StudyError
 from uq.problem.space import K_H_STAR, calibrated_k_H, resolve_k_H, table2_space
 from uq.methods import load_study
 
