@@ -208,7 +208,7 @@ UQ_LAYERS: dict[str, set[str]] = {
     "design": {"problem", "outputs", "engine"},
     "commands": {"problem", "methods", "engine", "outputs", "design"},
 }
-#: the written-down exceptions: (importing module, the part it may also import) with the reason (none today)
+#: the written-down exceptions: (importing module, the part it may also import) with the reason (none yet)
 UQ_EXCEPTIONS: set[tuple[str, str]] = set()
 UQ_SHARED = ("uq", "uq.errors")
 
