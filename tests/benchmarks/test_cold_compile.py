@@ -27,7 +27,7 @@ WARM_ALL = """
 import time
 from sim.integration.integrators import compile_probe_s, warm_up_all
 from uq.outputs.paper_figures import PAPER_FIGURES, figures_of_all
-from uq.problem.study import load_study
+from uq.methods import load_study
 models = [load_study(PAPER_FIGURES[figure].study_file(True)).make_model() for figure in figures_of_all()]
 warm_up_all(pair for model in models for pair in model.kernel_variants())
 print(f"probe {compile_probe_s():.3f}")
