@@ -555,13 +555,13 @@ FIGURES = {"response (fig5, fig6, figD2, figD3)": draw_response, "design (map, c
            "calibrate a scan": draw_scan_calibrate}
 
 
-@pytest.mark.parametrize("look", [None, "classic"])  # the default style, and one a user may pick (ies plot --style)
-@pytest.mark.parametrize("name", FIGURES)
 #: problems known and owned elsewhere, (file, start of the problem): the design curves' legend width is fixed with the
 #: design figures (uq.design.figures); drop the entry then
 KNOWN_ELSEWHERE = {("design-curves.png", "legend 'no IES")}
 
 
+@pytest.mark.parametrize("look", [None, "classic"])  # the default style, and one a user may pick (ies plot --style)
+@pytest.mark.parametrize("name", FIGURES)
 def test_no_legend_on_data_and_no_title_on_a_title(checked, name, look):
     with style(look):
         drawn = checked(FIGURES[name])
