@@ -31,7 +31,6 @@ import hashlib
 import inspect
 import os
 import re
-import shutil
 import sys
 import tempfile
 import time
