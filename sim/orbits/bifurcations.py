@@ -19,8 +19,8 @@ Detection between two accepted points a, b of a branch:
 * a multiplier crossing: the number of multipliers outside the unit circle (pairs counted twice) changes; the
   crossing is located by the secant method on log |m| of the multiplier nearest to the circle, from a by
   pseudo-arclength steps along a's tangent, to |log |m|| < LOCATION_TOLERANCE or LOCATION_STEPS steps; its label
-  comes from that multiplier's angle at the located point (within ANGLE of 0: a real +1 (fold of the count, or a
-  branch point), of pi: -1, else Neimark-Sacker);
+  comes from that multiplier at the located point: real and positive (+1 without a fold: a branch point), real
+  and negative (-1), or one of a complex pair (Neimark-Sacker, at any angle);
 * grazing (an impact appears or vanishes): the number of contact onsets over the k periods changes; located
   by bisection to LOCATION_STEPS halvings.
 A located point is inserted between a and b with its label. Crossings of already unstable orbits are labelled
@@ -59,8 +59,8 @@ OUTSIDE = 1.0 + 1e-6
 #: Location of a crossing: |log |m|| below this, or this many secant / bisection steps.
 LOCATION_TOLERANCE = 1e-3
 LOCATION_STEPS = 5
-#: A crossing multiplier within this angle (rad) of 0 or pi counts as real.
-ANGLE = 0.15
+#: A multiplier counts as real when its imaginary part is below this share of its modulus.
+REAL = 1e-9
 #: First step off a symmetry-breaking or period-doubling point (scaled units): the new branch's amplitude grows
 #: like the square root of the parameter's distance, with a cubic coefficient as large as the maps' derivatives
 #: (on the rig a step of 1e-3 along the eigenvector already leaves Newton's basin, 1e-4 converges).
@@ -88,13 +88,14 @@ def nearest_to_circle(orbit: PeriodicOrbit) -> complex:
 
 
 def crossing_label(orbit: PeriodicOrbit, multiplier: complex) -> str:
-    """The label of a multiplier crossing the unit circle at `orbit` (module docstring)."""
-    angle = abs(math.atan2(multiplier.imag, multiplier.real))
-    if angle < ANGLE:
+    """The label of a multiplier crossing the unit circle at `orbit` (module docstring): a real one (a real matrix'
+    eigenvalue without an imaginary part) at +1 or -1, else a complex pair: Neimark-Sacker, whatever its angle (the
+    slow pair of the rig's orbits crosses at angles of 0.1 rad)."""
+    if abs(multiplier.imag) > REAL * abs(multiplier):
+        return NEIMARK_SACKER
+    if multiplier.real > 0:
         return BRANCH_POINT
-    if angle > math.pi - ANGLE:
-        return SYMMETRY_BREAKING if orbit.symmetric else PERIOD_DOUBLING
-    return NEIMARK_SACKER
+    return SYMMETRY_BREAKING if orbit.symmetric else PERIOD_DOUBLING
 
 
 def _insert(continuer: Continuer, previous: BranchPoint, A: np.ndarray, total: float,

@@ -54,8 +54,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="continue in the level at this eta instead of in eta (the level curve)")
     parser.add_argument("--start", default="slow-flow", choices=STARTS,
                         help="starting orbit: slow-flow (default: the slow flow's two-impact orbit carried to the full "
-                             "model by continuation in the higher modes' damping), simulation (the state after 400 "
-                             "periods of the stepped sine's start, then k = 1..--max-period), linear (the linear orbit)")
+                             "model by continuation in the higher modes' damping), simulation (the state an up-sweep "
+                             "from the range's low end reaches at --at, then k = 1..--max-period), linear (the linear orbit)")
     parser.add_argument("--at", type=float, default=None, metavar="X",
                         help="the eta (or level) to start at (default: the start's own choice in the range)")
     parser.add_argument("--restitution", type=float, default=DEFAULT_RESTITUTION, metavar="R",

@@ -15,7 +15,8 @@ What is computed (`orbit_response`):
 4. The linear orbits (no impact, the sphere at rest where the walls do not reach it) on LINEAR_POINTS values of
    the range where they exist: they are unstable in the frictionless model (a sphere given any speed drifts into
    a wall: the multiplier 1 of its free flight is a Jordan block), but they are the response a sphere at rest
-   would keep. A level whose linear response never reaches the clearance has only these (`impacts` False).
+   would keep. Impacting orbits may coexist with them (the sphere's own motion drives the walls). Where no start
+   converges and the linear response never reaches the clearance, the level has only these (`impacts` False).
 """
 from __future__ import annotations
 
@@ -31,7 +32,7 @@ from sim.orbits.continuation import Branch, BranchPoint, continue_branch
 from sim.orbits.setting import OrbitSetting, parameter
 from sim.orbits.shooting import MAX_PERIOD_MULTIPLE, OrbitNotConverged, PeriodicOrbit, solve_orbit
 from sim.orbits.starts import (DEFAULT_RESTITUTION, linear_orbit, linear_wall_amplitude, simulated_state,
-                               slow_flow_candidates, slow_flow_orbit)
+                               slow_flow_candidates, slow_flow_orbit, stepped_sine_state)
 
 #: The starts of `orbit_response` (module docstring).
 STARTS = ("slow-flow", "simulation", "linear")
@@ -105,7 +106,10 @@ def _start(base: OrbitSetting, name: str, lo: float, hi: float, how: str, at: fl
     if how == "simulation":
         value = at if at is not None else 0.5 * (lo + hi)
         setting = par.set(base, value)
-        y = simulated_state(setting, SIMULATION_PERIODS)
+        if name == "eta":  # an up-sweep from the range's low end, as the stepped sine reaches the point
+            y = stepped_sine_state(setting, lo)
+        else:
+            y = simulated_state(setting, SIMULATION_PERIODS)
         failures = []
         for k in range(1, max_period + 1):
             try:
@@ -153,14 +157,14 @@ def orbit_response(base: OrbitSetting, name: str, bounds: tuple[float, float], *
     par = parameter(name)
     result = OrbitResponse(base, name, (lo, hi))
     result.linear = _linear_branch(base, name, lo, hi)
-    reach = [linear_wall_amplitude(par.set(base, float(v))) for v in np.linspace(lo, hi, START_GRID)]
-    if max(reach) < base.impactor.clearance and (result.linear is not None and len(result.linear.points) == LINEAR_POINTS):
-        result.impacts = False
-        result.notes.append(f"the walls never reach the sphere for {name} in {lo:g}:{hi:g} (largest linear wall motion "
-                            f"{max(reach) / base.impactor.clearance:.3g} g): the response is the linear one")
-        return result
     orbit = _start(base, name, lo, hi, start, at, max_period, restitution, result.notes, progress)
     if orbit is None:
+        reach = max(linear_wall_amplitude(par.set(base, float(v))) for v in np.linspace(lo, hi, START_GRID))
+        if reach < base.impactor.clearance:
+            result.impacts = False
+            result.notes.append(f"no impacting orbit found, and the linear response never reaches the sphere for {name} "
+                                f"in {lo:g}:{hi:g} (largest wall motion {reach / base.impactor.clearance:.3g} g): the "
+                                "response is the linear one")
         return result
     if orbit.linear and start != "linear":
         result.notes.append("the start converged to the linear orbit (no impacts)")

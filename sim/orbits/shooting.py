@@ -26,9 +26,12 @@ continuous across every switching surface, so the saltation matrix is the identi
 monodromy matrix), although the damped law's force is not Lipschitz at onset (delta^-0.75 in its derivative,
 integrable). The monodromy matrix is therefore taken by central differences of the map on every scaled state
 component (`OrbitSetting.scales`: g at the walls, times omega_j for velocities), step FD_STEP; both the end state
-and the half state come from the same runs, so one Jacobian gives DP_k and DG. Accuracy, measured: the columns
-agree to 1e-4 (relative to the matrix' largest entry) for steps 1e-4 .. 1e-8 at the rig's symmetric orbit, and
-against a DOP853 integration of the variational equations (tests/sim/orbits/test_shooting.py) to the figure stated there.
+and the half state come from the same runs, so one Jacobian gives DP_k and DG. Accuracy against DOP853 on the
+variational equations (tests/sim/orbits/test_orbit_jacobian.py), largest error over the largest entry, at 7.4 / eta
+0.95: the rig with its higher modes damped 100-fold (a stable two-impact orbit) 2e-9 (half map) and 2e-8 (whole
+period), multipliers 1e-8, at steps 1e-6 and 1e-7; the nominal rig (its unstable orbit, |mu| = 11.8), whose map
+over a whole period has huge third derivatives: half map 7e-8 at both steps, whole period 4e-4 at 1e-6 and 4e-6 at
+1e-7 (multipliers 4e-5 and 6e-7), hence FD_STEP = 1e-7; below it the map's noise (~1e-12 g) takes over.
 
 Newton's method (`solve_orbit`): the residual in scaled units, the step by least squares (the linear orbit's
 sphere is neutral: its position is free, `sim.orbits.starts`), damped by backtracking on the residual's largest
@@ -69,7 +72,7 @@ NOISE_FLOOR = 1e-7
 #: differences of Newton's iterations: the maps' second derivatives reach ~4e3 (scaled) on the rig, so a forward
 #: step of 1e-6 errs by ~2e-3 per entry, which next to a branch point (smallest singular value ~1e-3) misleads
 #: Newton's method; 1e-8 errs by ~2e-5 (plus the map's noise, ~1e-12 / 1e-8).
-FD_STEP = 1e-6
+FD_STEP = 1e-7
 FORWARD_STEP = 1e-8
 #: Most Newton iterations of `solve_orbit`.
 MAX_ITERATIONS = 40

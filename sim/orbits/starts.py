@@ -16,8 +16,8 @@ two-impact orbit carried to the full model by continuation, and a simulated stat
   ring out between impacts and the map is close to the one-mode map the slow flow averages); from there the orbit is
   continued in that factor (`higher_damping`, log) down to the setting's value. If that continuation turns back (a
   fold) before reaching it, there is no such orbit connected to the slow flow's, and the function says where.
-* `simulated_state`: the state after a number of periods of the integrator from a given state (a stepped-sine
-  state, a perturbed orbit): a start near a stable orbit.
+* `stepped_sine_state`: the state a stepped sine reaches at a point, stepping from another eta as the protocol does
+  (`simulated_state`: the state after a number of periods from a given state): a start near a stable orbit.
 """
 from __future__ import annotations
 
@@ -33,6 +33,9 @@ from sim.orbits.shooting import OrbitNotConverged, PeriodicOrbit, ShootingMap, s
 
 #: The higher modes' damping factor from which `slow_flow_orbit` starts (modes 2..N ring out within a period).
 HOMOTOPY_DAMPING = 100.0
+#: The stepped-sine start's grid step in eta and wait per point (s): the fidelity studies' protocol (0.002, 3 s).
+STEP = 0.002
+WAIT = 3.0
 #: The slow flow's modal restitution r (Eq. D.1) of the start: the simulator's value on the rig near resonance
 #: (`sim.reduced.slow_flow`'s validity table: 0.857); only the start depends on it, not the orbit found.
 DEFAULT_RESTITUTION = 0.86
@@ -140,6 +143,20 @@ def slow_flow_orbit(setting: OrbitSetting, *, restitution: float = DEFAULT_RESTI
                                 f"{setting.level:g} could not be carried to the nominal higher-mode damping (stopped "
                                 f"at {last.setting.higher_damping:.3g} x: {branch.stop}); try another eta")
     return last
+
+
+def stepped_sine_state(setting: OrbitSetting, eta_from: float, *, step: float = STEP, wait: float = WAIT) -> np.ndarray:
+    """The state a stepped sine reaches at the setting's eta (Sect. 5.1, `sim.stepped_sine.protocol`): from the
+    base-velocity start at eta_from, `wait` seconds at every eta of the grid eta_from, eta_from +- step, ... up to
+    (or down to) the setting's eta, SI."""
+    if not (math.isfinite(eta_from) and eta_from > 0 and step > 0 and wait > 0):
+        raise SimulationInputError("orbits: a stepped-sine start needs a positive eta_from, step and wait")
+    n = max(1, int(round(abs(setting.eta - eta_from) / step)))
+    y = None
+    for eta in np.linspace(eta_from, setting.eta, n + 1):
+        at = replace(setting, eta=float(eta))
+        y = simulated_state(at, max(1, int(round(wait / at.period))), y)
+    return y
 
 
 def simulated_state(setting: OrbitSetting, periods: int, y0: np.ndarray | None = None) -> np.ndarray:
