@@ -163,11 +163,11 @@ def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], t
                 response = orbit_response(base, name, bounds, start=args.start, at=args.at,
                                           max_period=args.max_period, switches=args.switches,
                                           restitution=args.restitution, progress=bar.update)
-                if response.impacts and not response.branches:
-                    where = f"level {base.level:g}" if name == "eta" else f"eta {base.eta:g}"
-                    raise OrbitNotConverged(f"no impacting orbit found at {where} ({'; '.join(response.notes)}); "
-                                            "nothing was written")
                 responses.append(response)
+        if all(r.impacts and not r.branches for r in responses):  # nothing found anywhere: say why, write nothing
+            where = (f"level {responses[-1].base.level:g}" if not curve else f"eta {args.level_curve:g}")
+            raise OrbitNotConverged(f"no impacting orbit found at {where} ({responses[-1].notes[-1]}); try another "
+                                    "--start or --at; nothing was written")
         settings = {"command": "ies orbits", "parameter": "level" if curve else "eta",
                     "levels": levels if not curve else None, "level_range": level_range,
                     "eta_range": eta_range, "level_curve_eta": args.level_curve, "start": args.start,
@@ -191,7 +191,7 @@ def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], t
             target = figure if figure is not None and where == folder else where / (figure.name if figure else
                                                                                      "orbits.png")
             plot_orbits(panels, target, parameter="level" if curve else "eta", max_period=args.max_period,
-                        title=f"periodic orbits ({model.source})")
+                        title=f"periodic orbits: {model.source.split(' (')[0]}")
             return [*written, target]
 
         written = write_or_fallback(write, folder, "orbits")

@@ -21,7 +21,7 @@ What is computed (`orbit_response`):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
@@ -37,7 +37,7 @@ from sim.orbits.starts import (DEFAULT_RESTITUTION, linear_orbit, linear_wall_am
 #: The starts of `orbit_response` (module docstring).
 STARTS = ("slow-flow", "simulation", "linear")
 #: Parameter values tried for the slow-flow start, and the grid they are picked from.
-START_TRIES = 3
+START_TRIES = 4
 START_GRID = 21
 #: Periods the "simulation" start runs before solving (the stepped sine's 3 s wait at the rig's 117 Hz: 352).
 SIMULATION_PERIODS = 400
@@ -119,18 +119,17 @@ def _start(base: OrbitSetting, name: str, lo: float, hi: float, how: str, at: fl
         raise OrbitNotConverged(f"orbits: no periodic orbit of period <= {max_period} T near the simulated state at "
                                 f"{name} {value:g} ({failures[-1].split(': ', 2)[-1]})")
     grid = [at] if at is not None else list(np.linspace(lo, hi, START_GRID))
+    grid = [v for v in grid if slow_flow_candidates(par.set(base, float(v)), restitution)]
+    if len(grid) > START_TRIES:  # spread over where the slow flow has an orbit, from the low end
+        grid = [grid[i] for i in np.linspace(0, len(grid) - 1, START_TRIES).round().astype(int)]
     tried = 0
     for value in grid:
         setting = par.set(base, float(value))
-        if not slow_flow_candidates(setting, restitution):
-            continue
         tried += 1
         try:
             return slow_flow_orbit(setting, restitution=restitution, progress=progress)
         except (OrbitNotConverged, SimulationDiverged) as exc:
-            notes.append(f"slow-flow start at {name} {value:.5g}: {exc}")
-        if tried >= START_TRIES:
-            break
+            notes.append(f"slow-flow start at {name} {value:.5g}: {str(exc).split(';')[0]}")
     if tried == 0:
         notes.append(f"the slow flow (r = {restitution:g}) has no two-impact orbit for {name} in {lo:g}:{hi:g}")
     return None
@@ -184,3 +183,29 @@ def orbit_response(base: OrbitSetting, name: str, bounds: tuple[float, float], *
         except (OrbitNotConverged, SimulationDiverged, SimulationInputError) as exc:
             result.notes.append(f"switching at the {point.label} at {name} {par.get(point.orbit.setting):.5g}: {exc}")
     return result
+
+
+def parameter_branch(setting: OrbitSetting, name: str, bounds: tuple[float, float], *,
+                     restitution: float = DEFAULT_RESTITUTION, direction: float = -1.0,
+                     progress: Callable[[], None] | None = None) -> Branch:
+    """The symmetric two-impact orbit of `setting` continued in any parameter of `sim.orbits.setting.PARAMETERS`
+    (the higher modes' damping, r_cont, k_H, eta, the level) over `bounds`, with its bifurcations located and
+    labelled: where it loses stability, how, and where it turns back. For "higher_damping" the branch starts from
+    the slow flow at the upper bound (Newton's method reaches it there, `sim.orbits.starts`) and runs down (the
+    homotopy of `slow_flow_orbit`, kept whole); otherwise from the setting's orbit (`slow_flow_orbit`) along
+    `direction` (+1: increasing)."""
+    from sim.orbits.starts import slow_flow_state
+
+    lo, hi = sorted(float(b) for b in bounds)
+    if name == "higher_damping":
+        top = replace(setting, higher_damping=hi)
+        candidates = slow_flow_candidates(top, restitution)
+        if not candidates:
+            raise OrbitNotConverged(f"orbits: the slow flow has no two-impact orbit at eta {setting.eta:g}, level "
+                                    f"{setting.level:g} (r = {restitution:g})")
+        start = solve_orbit(top, slow_flow_state(top, candidates[0]), symmetric=setting.symmetric_walls)
+        return continue_branch(start, name, (lo, hi), direction=-1.0, origin="slow flow at the higher damping",
+                               detect=detect, progress=progress)
+    start = slow_flow_orbit(setting, restitution=restitution, progress=progress)
+    return continue_branch(start, name, (lo, hi), direction=direction, origin="slow-flow start", detect=detect,
+                           progress=progress)

@@ -11,10 +11,10 @@ two-impact orbit carried to the full model by continuation, and a simulated stat
   between the impacts at the orbit's impact phase with its speed V: after the left impact at Omega t_L it leaves
   the left wall (absolute position w(t_L) - g) at +V, after the right one at t_L + T/2 the right wall (w + g) at -V.
 * `slow_flow_orbit`: the full model's symmetric two-impact orbit. Newton's method does not reach it from the slow
-  flow on the nominal host (the ringing higher modes make the half map's multipliers ~ -50 and its basin
-  ~1e-3 g, `sim.orbits.shooting`), but it does with the higher modes' damping raised HOMOTOPY_DAMPING-fold (they
-  ring out between impacts and the map is close to the one-mode map the slow flow averages); from there the orbit is
-  continued in that factor (`higher_damping`, log) down to the setting's value. If that continuation turns back (a
+  flow on the nominal host (the ringing higher modes make the half map's multipliers ~ 10-50 and its basin
+  ~1e-3 g, `sim.orbits.shooting`), but it does with the higher modes' damping raised a hundredfold or more
+  (HOMOTOPY_DAMPING: they ring out between impacts and the map is close to the one-mode map the slow flow
+  averages); from there the orbit is continued in that factor (`higher_damping`, log) down to the setting's value. If that continuation turns back (a
   fold) before reaching it, there is no such orbit connected to the slow flow's, and the function says where.
 * `stepped_sine_state`: the state a stepped sine reaches at a point, stepping from another eta as the protocol does
   (`simulated_state`: the state after a number of periods from a given state): a start near a stable orbit.
@@ -31,8 +31,10 @@ from sim.integration.integrators import get_integrator
 from sim.orbits.setting import OrbitSetting
 from sim.orbits.shooting import OrbitNotConverged, PeriodicOrbit, ShootingMap, solve_orbit
 
-#: The higher modes' damping factor from which `slow_flow_orbit` starts (modes 2..N ring out within a period).
-HOMOTOPY_DAMPING = 100.0
+#: The higher modes' damping factors from which `slow_flow_orbit` starts, tried in turn (modes 2..N ring out within
+#: a period; the damping ratios are capped at 0.5): on the rig Newton's method reaches the two-impact orbit from the
+#: slow flow at 100x at 7.4, but only at 300x at level 5.
+HOMOTOPY_DAMPING = (100.0, 300.0)
 #: The stepped-sine start's grid step in eta and wait per point (s): the fidelity studies' protocol (0.002, 3 s).
 STEP = 0.002
 WAIT = 3.0
@@ -118,10 +120,11 @@ def slow_flow_candidates(setting: OrbitSetting, restitution: float = DEFAULT_RES
 
 
 def slow_flow_orbit(setting: OrbitSetting, *, restitution: float = DEFAULT_RESTITUTION, which: int = 0,
-                    damping: float = HOMOTOPY_DAMPING, progress: object = None) -> PeriodicOrbit:
+                    damping: tuple[float, ...] = HOMOTOPY_DAMPING, progress: object = None) -> PeriodicOrbit:
     """The full model's symmetric two-impact orbit at the setting from the slow flow's (the `which`-th by
-    decreasing amplitude), by Newton's method at the higher modes' damping times `damping` and continuation in that
-    factor down to the setting's (module docstring). OrbitNotConverged with what to try when it fails."""
+    decreasing amplitude), by Newton's method at the higher modes' damping times the first factor of `damping` that
+    converges and continuation in that factor down to the setting's (module docstring). OrbitNotConverged with what
+    to try when it fails."""
     from sim.orbits.continuation import continue_branch
 
     candidates = slow_flow_candidates(setting, restitution)
@@ -129,19 +132,28 @@ def slow_flow_orbit(setting: OrbitSetting, *, restitution: float = DEFAULT_RESTI
         raise OrbitNotConverged(f"orbits: the slow flow has no two-impact orbit at eta {setting.eta:g}, level "
                                 f"{setting.level:g} (r = {restitution:g}); try another eta (below the resonance) "
                                 "or a higher level")
-    damped = replace(setting, higher_damping=setting.higher_damping * damping)
     symmetric = setting.symmetric_walls
-    start = solve_orbit(damped, slow_flow_state(damped, candidates[which]), symmetric=symmetric)
-    if damping == 1.0:
+    failure: Exception | None = None
+    for factor in damping:
+        damped = replace(setting, higher_damping=setting.higher_damping * factor)
+        try:
+            start = solve_orbit(damped, slow_flow_state(damped, candidates[which]), symmetric=symmetric)
+            break
+        except OrbitNotConverged as exc:
+            failure = exc
+    else:
+        raise failure
+    if factor == 1.0:
         return start
     target = setting.higher_damping
     branch = continue_branch(start, "higher_damping", (target, damped.higher_damping), direction=-1.0,
                              origin="slow flow", progress=progress)
     last = branch.points[-1].orbit
     if not math.isclose(last.setting.higher_damping, target, rel_tol=1e-9):
+        lowest = min(p.orbit.setting.higher_damping for p in branch.points)
         raise OrbitNotConverged(f"orbits: the slow flow's two-impact orbit at eta {setting.eta:g}, level "
-                                f"{setting.level:g} could not be carried to the nominal higher-mode damping (stopped "
-                                f"at {last.setting.higher_damping:.3g} x: {branch.stop}); try another eta")
+                                f"{setting.level:g} does not reach the setting's higher-mode damping: followed from "
+                                f"{factor:g} x it turns back at {lowest:.3g} x ({branch.stop}); try another eta")
     return last
 
 
