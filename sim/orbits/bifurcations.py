@@ -98,35 +98,40 @@ def crossing_label(orbit: PeriodicOrbit, multiplier: complex) -> str:
     return SYMMETRY_BREAKING if orbit.symmetric else PERIOD_DOUBLING
 
 
-def _insert(continuer: Continuer, previous: BranchPoint, A: np.ndarray, total: float,
+def _insert(continuer: Continuer, previous: BranchPoint, new: BranchPoint, A: np.ndarray, total: float,
             test: Callable[[BranchPoint], float], secant: bool) -> BranchPoint | None:
-    """The point between `previous` (s = 0) and the accepted next point (s = total, arclength) where test changes
-    sign (test(previous) and test at total have opposite signs), by the secant (regula falsi, Illinois) or
-    bisection on s; pseudo-arclength steps from `previous` along its tangent. None if no step converges."""
+    """The point between `previous` (s = 0) and `new` (s = total, arclength) where test changes sign, by the
+    secant method (Illinois' variant of regula falsi) or bisection on s, each trial a pseudo-arclength step from
+    `previous` along its tangent; the trial with the smallest |test| (None if no step converges)."""
     lo, hi = 0.0, total
-    f_lo = test(previous)
-    f_hi = None
-    best = None
+    f_lo, f_hi = test(previous), test(new)
+    best, best_f = None, math.inf
+    side = 0
     for _ in range(LOCATION_STEPS):
-        if secant and f_hi is not None and f_hi != f_lo:
+        if secant and f_hi != f_lo:
             s = hi - f_hi * (hi - lo) / (f_hi - f_lo)
-            s = min(max(s, lo + 0.05 * (hi - lo)), hi - 0.05 * (hi - lo))
+            s = min(max(s, lo + 0.01 * (hi - lo)), hi - 0.01 * (hi - lo))
         else:
             s = 0.5 * (lo + hi)
-        outcome = continuer.advance(previous, A, s)
+        outcome = continuer.advance(previous, A, s, strict=False)
         if outcome is None:
             return best
         point = outcome[0]
         f = test(point)
-        best = point
+        if abs(f) < best_f:
+            best, best_f = point, abs(f)
         if secant and abs(f) < LOCATION_TOLERANCE:
             return point
         if (f > 0) == (f_lo > 0):
             lo, f_lo = s, f
+            if side == -1:
+                f_hi *= 0.5  # Illinois: the end that stays gets half its weight
+            side = -1
         else:
             hi, f_hi = s, f
-        if f_hi is None:
-            f_hi = -f_lo  # the far end's sign is the opposite one
+            if side == 1:
+                f_lo *= 0.5
+            side = 1
     return best
 
 
@@ -141,12 +146,12 @@ def detect(continuer: Continuer, branch: Branch, previous: BranchPoint, new: Bra
         return found
     if np.sign(previous.tangent[-1]) != np.sign(new.tangent[-1]) and previous.tangent[-1] != 0.0:
         # the turning point: the parameter component of the tangent through zero
-        point = _insert(continuer, previous, A, total, lambda p: float(p.tangent[-1]), secant=True)
+        point = _insert(continuer, previous, new, A, total, lambda p: float(p.tangent[-1]), secant=True)
         if point is not None:
             point.label = FOLD
             found.append(point)
     if outside_count(previous.orbit) != outside_count(new.orbit):
-        point = _insert(continuer, previous, A, total,
+        point = _insert(continuer, previous, new, A, total,
                         lambda p: math.log(abs(nearest_to_circle(p.orbit))), secant=True)
         if point is not None:
             point.label = crossing_label(point.orbit, nearest_to_circle(point.orbit))
@@ -156,8 +161,8 @@ def detect(continuer: Continuer, branch: Branch, previous: BranchPoint, new: Bra
             found.append(point)
     if int(np.sum(previous.orbit.impacts)) != int(np.sum(new.orbit.impacts)):
         before = int(np.sum(previous.orbit.impacts))
-        point = _insert(continuer, previous, A, total, lambda p: 1.0 if int(np.sum(p.orbit.impacts)) == before else -1.0,
-                        secant=False)
+        point = _insert(continuer, previous, new, A, total,
+                        lambda p: 1.0 if int(np.sum(p.orbit.impacts)) == before else -1.0, secant=False)
         if point is not None:
             point.label = GRAZING
             point.note = f"{before} -> {int(np.sum(new.orbit.impacts))} impacts per {new.orbit.k} T"

@@ -96,7 +96,7 @@ def _linear_branch(base: OrbitSetting, name: str, lo: float, hi: float) -> Branc
     return branch if branch.points else None
 
 
-def _start(base: OrbitSetting, name: str, lo: float, hi: float, how: str, at: float | None, max_period: int,
+def _start(base: OrbitSetting, name: str, lo: float, hi: float, how: str, *, at: float | None, max_period: int,
            restitution: float, notes: list[str], progress: Callable[[], None] | None) -> PeriodicOrbit | None:
     """The starting orbit (module docstring, step 1), or None with the reasons in `notes`."""
     par = parameter(name)
@@ -156,7 +156,8 @@ def orbit_response(base: OrbitSetting, name: str, bounds: tuple[float, float], *
     par = parameter(name)
     result = OrbitResponse(base, name, (lo, hi))
     result.linear = _linear_branch(base, name, lo, hi)
-    orbit = _start(base, name, lo, hi, start, at, max_period, restitution, result.notes, progress)
+    orbit = _start(base, name, lo, hi, start, at=at, max_period=max_period, restitution=restitution,
+                   notes=result.notes, progress=progress)
     if orbit is None:
         reach = max(linear_wall_amplitude(par.set(base, float(v))) for v in np.linspace(lo, hi, START_GRID))
         if reach < base.impactor.clearance:
