@@ -129,8 +129,13 @@ class Continuer:
         return float(u[-1]) * self.parameter.scale
 
     def shooting(self, coordinate: float) -> ShootingMap:
-        """The shooting map at the continuation coordinate (cached for the last few)."""
+        """The shooting map at the continuation coordinate (cached for the last few); SimulationDiverged where the
+        coordinate gives no valid setting (a Newton step far off: the corrector then backtracks or refuses)."""
         key = float(coordinate)
+        try:
+            self.parameter.set(self.base, self.parameter.from_coordinate(key))
+        except (SimulationInputError, OverflowError) as exc:
+            raise SimulationDiverged(f"orbits: {self.parameter.name} out of range in a Newton step ({exc})") from None
         if self.parameter.name in EXCITATION:  # one map, moved to each excitation (the system stays)
             if self._map is None:
                 self._map = ShootingMap(self.parameter.set(self.base, self.parameter.from_coordinate(key)), self.k,
