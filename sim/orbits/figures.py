@@ -111,13 +111,13 @@ def draw_orbits(ax: Any, columns: Mapping[str, np.ndarray], *, parameter: str = 
 def plot_orbits(panels: Sequence[tuple[Mapping[str, np.ndarray], str, tuple[float, float],
                                        Mapping[str, np.ndarray] | None]],
                 path: str | os.PathLike, *, parameter: str = "eta", max_period: int = 1, title: str = "") -> None:
-    """The figure: one panel per (columns, panel title, range, sweep or None), stacked, each with its legend beside
-    it, written atomically to `path` (format from the suffix)."""
+    """The figure: one panel per (columns, panel title, range, sweep or None), stacked on one y scale, each with its
+    legend beside it, written atomically to `path` (format from the suffix)."""
     from sim.common.files import pyplot, save_figure
 
     plt = pyplot()
-    fig, axes = plt.subplots(len(panels), 1, figsize=(8.0, 3.2 * len(panels) + 0.4), squeeze=False,
-                             layout="constrained")
+    fig, axes = plt.subplots(len(panels), 1, figsize=(8.0, 3.2 * len(panels) + 0.4), squeeze=False, sharey=True,
+                             layout="constrained")  # one y scale: the panels compare the levels
     try:
         for ax, (columns, panel_title, bounds, sweep) in zip(axes[:, 0], panels):
             draw_orbits(ax, columns, parameter=parameter, bounds=bounds, sweep=sweep, max_period=max_period,
