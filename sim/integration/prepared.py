@@ -5,7 +5,7 @@ free-flight grid, the scratch and the output buffers are built once and every ru
 through `run_step`, of which the period loop is 0.06 ms and the preparation (`exact._prepare`, the `Run` tuple) the
 rest. Shooting (`sim.orbits`) runs the same excitation from dozens of perturbed states per Newton step, so it
 prepares once (`PreparedExact`) and pays 0.06 ms per run. The trajectory is the one of `run_step` bit for bit (same
-kernel, same constants; tests/sim/orbits/test_shooting.py compares them); no ledger, no impact log, no counters.
+kernel, same constants; tests/sim/orbits/test_orbit_checks.py compares them); no ledger, no impact log, no counters.
 """
 from __future__ import annotations
 
