@@ -13,7 +13,7 @@ def pytest_sessionstart(session) -> None:
     """Compile (or load) the integrators' kernels once, quietly, before the tests: a cold numba cache would otherwise
     put the first run's "compiling ..." notice on the stderr of whichever command test comes first, and the tests
     that check a command's one-line messages would depend on their order. The notice itself is tested in
-    tests/sim/test_warm_up.py."""
+    tests/sim/integration/test_warm_up.py."""
     import io
 
     from sim.integration.integrators import available, warm_up_all

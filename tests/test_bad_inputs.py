@@ -106,8 +106,8 @@ def test_unknown_units_are_refused(tmp_path, model_file, capsys, option, value):
 
 
 def test_study_files_take_units_and_warn_on_slips(tmp_path, capsys):
-    from uq.space import K_H_STAR
-    from uq.study import load_study
+    from uq.problem.space import K_H_STAR
+    from uq.methods import load_study
 
     path = tmp_path / "s.toml"
     path.write_text("[study]\nkind = 'interval'\n[parameters.g]\nmax = '0.612 mm'\n[parameters.k_H]\n"
@@ -165,7 +165,7 @@ AB = "[parameters.a]\nnominal = 0.5\nmin = 0.0\nmax = 1.0\n[parameters.b]\nnomin
 
 def test_resume_refuses_a_folder_of_another_study(tmp_path, capsys):
     first, second = tmp_path / "first.toml", tmp_path / "second.toml"
-    head = "[study]\nkind = 'interval'\nmodel = 'uq.test_functions:noisy_linear'\nrepetitions = 2\n"
+    head = "[study]\nkind = 'interval'\nmodel = 'uq.problem.test_functions:noisy_linear'\nrepetitions = 2\n"
     first.write_text(head + "seed = 1\n" + AB)
     second.write_text(head + "seed = 2\n" + AB)  # another seed: other results
     out = tmp_path / "o"

@@ -34,8 +34,8 @@ from matplotlib.text import Text
 import sim.plots.figures
 import sim.common.files
 import sim.analysis.modal_fit
-import uq.figures
-import uq.paper_figures
+import uq.outputs.figures
+import uq.outputs.paper_figures
 from sim.plots.redraw import PlotOptions, style
 
 LEVELS = [2.0, 4.0, 5.3, 6.7, 7.0, 7.4, 7.8, 9.0]
@@ -196,7 +196,7 @@ def checked(monkeypatch, tmp_path):
                                   "ylim": [ax.get_ylim() for ax in fig.axes]}
         return Path(path)
 
-    for module in (sim.common.files, sim.plots.figures, uq.figures, sim.analysis.modal_fit):
+    for module in (sim.common.files, sim.plots.figures, uq.outputs.figures, sim.analysis.modal_fit):
         monkeypatch.setattr(module, "save_figure", check_then_save)
 
     def run(draw: Callable[[Path], Any]) -> dict[str, dict[str, Any]]:
@@ -260,7 +260,7 @@ def overview(levels: list[float] = LEVELS, regimes: list[str] = REGIMES) -> dict
 
 def response_folder(folder: Path, figures: tuple[str, ...] = ("fig5", "fig6", "figD2", "figD3"),
                     levels: list[float] = LEVELS, regimes: list[str] = REGIMES) -> Path:
-    """A response study's files (study.json, overview.csv, sweeps.csv, runs.csv) as `uq.execute` writes them."""
+    """A response study's files (study.json, overview.csv, sweeps.csv, runs.csv) as `uq.engine.execute` writes them."""
     folder.mkdir(parents=True, exist_ok=True)
     study = {"kind": "response", "model": "ies", "repetitions": 3, "levels": levels, "response": {"figures": list(figures)},
              "contact_law": "hertz", "protocol_resolved": {"wait": 2.0, "hold": 1.0, "integrator": "exact",
@@ -284,7 +284,7 @@ def response_folder(folder: Path, figures: tuple[str, ...] = ("fig5", "fig6", "f
     return folder
 
 
-#: Table 2 (`uq.space.TABLE2`): g and k_H vary upwards from the nominal value, so a corner lies on the nominal curve
+#: Table 2 (`uq.problem.space.TABLE2`): g and k_H vary upwards from the nominal value, so a corner lies on the nominal curve
 PARAMETERS = {"D": {"nominal": 0.00085, "min": 0.00075, "max": 0.0009, "unit": "-", "label": "modal damping ratio D_1"},
               "g": {"nominal": 0.00058, "min": 0.00058, "max": 0.000612, "unit": "m", "label": "clearance g"},
               "k_H": {"nominal": 282e3 * 1e3**1.5, "min": 282e3 * 1e3**1.5, "max": 428e3 * 1e3**1.5,
@@ -365,7 +365,7 @@ def trace_data(periods: int = 80) -> tuple[dict, np.ndarray, np.ndarray, np.ndar
 # --- the figures -------------------------------------------------------------------------------------------------
 
 def draw_response(tmp: Path) -> None:
-    uq.paper_figures.response_figures(response_folder(tmp / "response"), PlotOptions(formats=(".png",)))
+    uq.outputs.paper_figures.response_figures(response_folder(tmp / "response"), PlotOptions(formats=(".png",)))
 
 
 def draw_sweep(tmp: Path) -> None:
@@ -379,17 +379,17 @@ def draw_overview_command(tmp: Path) -> None:
 
 
 def draw_interval(tmp: Path) -> None:
-    uq.paper_figures.interval_figures(interval_folder(tmp / "fig7"), PlotOptions(formats=(".png",)))
+    uq.outputs.paper_figures.interval_figures(interval_folder(tmp / "fig7"), PlotOptions(formats=(".png",)))
 
 
 def draw_interval_restitution(tmp: Path) -> None:
     apr = [i for i, r in enumerate(REGIMES) if r == "APR"][:3]
-    uq.paper_figures.interval_figures(interval_folder(tmp / "figD3", "restitution", [LEVELS[i] for i in apr],
+    uq.outputs.paper_figures.interval_figures(interval_folder(tmp / "figD3", "restitution", [LEVELS[i] for i in apr],
                                                 [REGIMES[i] for i in apr]), PlotOptions(formats=(".png",)))
 
 
 def draw_sobol(tmp: Path) -> None:
-    uq.figures.sobol_figure(sobol_folder(tmp / "sobol"), PlotOptions(formats=(".png",)))
+    uq.outputs.figures.sobol_figure(sobol_folder(tmp / "sobol"), PlotOptions(formats=(".png",)))
 
 
 def draw_series(tmp: Path) -> None:
@@ -465,17 +465,17 @@ def draw_scan_calibrate(tmp: Path) -> None:
 
 def draw_design(tmp: Path) -> None:
     """ies design's map and curves from a real screening of a small grid and fabricated verifications."""
-    from uq import design as d
-    from uq.design_figures import plot_design_curves, plot_design_map
+    from uq.design import problem as dp, results as dr, search as ds
+    from uq.design.figures import plot_design_curves, plot_design_map
 
-    problem = d.DesignProblem(excitation=tuple(np.linspace(1e-6, 6e-6, 6)), clearances=(0.3e-3, 0.45e-3, 0.6e-3),
+    problem = dp.DesignProblem(excitation=tuple(np.linspace(1e-6, 6e-6, 6)), clearances=(0.3e-3, 0.45e-3, 0.6e-3),
                               radii=(6e-3, 7.92e-3), materials=("brass", "tungsten"),
-                              baseline=d.Sphere(0.58e-3, 7.92e-3, "brass"))
-    screened = d.screen_designs(problem, d.host_mode(d.host_model(problem)))
+                              baseline=dp.Sphere(0.58e-3, 7.92e-3, "brass"))
+    screened = ds.screen_designs(problem, dp.host_mode(dp.host_model(problem)))
     level = np.linspace(0.1, 1.0, 6) * 1e-3
-    verified = [d.Verified(s, k * level, 1.3 * k * level, 1.1 * k * level, np.linspace(0, 1, 6), np.zeros(6, bool), 6)
-                for k, s in zip((1.0, 1.5, 2.0), d.candidates(problem, screened)[:3])]
-    result = d.DesignResult(problem, screened, verified, tmp, np.arange(1.0, 7.0), 3.0 * level, [])
+    verified = [dr.Verified(s, k * level, 1.3 * k * level, 1.1 * k * level, np.linspace(0, 1, 6), np.zeros(6, bool), 6)
+                for k, s in zip((1.0, 1.5, 2.0), ds.candidates(problem, screened)[:3])]
+    result = dr.DesignResult(problem, screened, verified, tmp, np.arange(1.0, 7.0), 3.0 * level, [])
     plot_design_map(result, tmp / "design-map.png")
     plot_design_curves(result, tmp / "design-curves.png")
 

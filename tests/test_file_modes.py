@@ -9,7 +9,7 @@ import pytest
 from scans import write_scan
 from sim.common.files import write_text
 from uq.cli import main
-from uq.commands import run_calibration
+from uq.commands.reproduce import run_calibration
 
 FAST_SWEEP = ["--eta", "0.98:1.0:3", "--wait", "0.02", "--hold", "0.03", "--reps", "2"]
 FAST_CALIBRATION = ["--grid", "32", "--points", "4"]

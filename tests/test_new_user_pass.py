@@ -219,7 +219,7 @@ def test_compare_refuses_a_non_empty_out_and_a_folder_given_twice(tmp_path, caps
 
 
 def test_compare_checks_out_before_writing(tmp_path, capsys, monkeypatch):
-    from uq import compare
+    from uq.outputs import compare
 
     fake = compare.ResponseFolder("a", tmp_path / "a", {}, {"levels": []})
     monkeypatch.setattr(compare, "read_response_folder", lambda folder: fake)
@@ -240,7 +240,7 @@ def test_ctrl_c_mentions_resume_only_where_it_exists(tmp_path, model_file, capsy
     err = capsys.readouterr().err
     assert "--resume" not in err and "no results were written" in err and len(err.splitlines()) == 1
     assert not (tmp_path / "res").exists()
-    monkeypatch.setattr("uq.execute.run_interval_study", interrupt)
+    monkeypatch.setattr("uq.engine.execution.run_study", interrupt)
     assert main(["interval", str(STUDIES / "fig7-quick.toml"), "--out", str(tmp_path / "study")]) == 130
     assert "rerun with --resume" in capsys.readouterr().err
 
@@ -307,7 +307,7 @@ def test_sobol_indices_outside_0_1_beyond_their_ci_come_with_advice_on_n(tmp_pat
 
 
 def test_sample_size_advice_counts_indices_beyond_their_ci_or_undetermined():
-    from uq.results import outside_unit_interval, sample_size_advice
+    from uq.outputs.results import outside_unit_interval, sample_size_advice
 
     assert outside_unit_interval([-0.05, 1.04, 0.5, -0.5, 2.2], [0.1, 0.1, 0.1, 0.2, 0.5]) == 2
     assert sample_size_advice([0.3, -0.01, 0.99], [0.05, 0.02, 0.03], 1024) is None  # noise about a true 0 or 1
@@ -396,7 +396,7 @@ def test_a_trace_at_an_extreme_rate_says_what_it_will_cost(tmp_path, model_file,
 def test_jobs_above_the_cores_warns_and_small_work_runs_serially(monkeypatch):
     import io
 
-    from uq.runner import PARALLEL_OVERHEAD_S, choose_jobs
+    from uq.engine.runner import PARALLEL_OVERHEAD_S, choose_jobs
 
     stream = io.StringIO()
     assert choose_jobs(64, 1.0, cores=2, stream=stream) == 64

@@ -1,8 +1,8 @@
 """The `ies` front door: one entry point that dispatches to the stages' own command modules.
 
 Each stage owns its words of the command line (`add_commands(subparsers)`, SALib's habit):
-`bem_contact.cli` (calibrate), `sim.cli` (modes, sweep, overview) and `uq.commands` (interval, sobol,
-reproduce). Each subcommand parser sets ``_run(args) -> exit code``. This module only builds the parser from
+`bem_contact.cli` (calibrate), `sim.cli` (modes, sweep, overview, trace, impacts, modal-fit) and `uq.commands`
+(interval, sobol, response: one per study kind of `uq.methods`; reproduce, plot, compare, design). Each subcommand parser sets ``_run(args) -> exit code``. This module only builds the parser from
 the dispatch table `STAGES`, hands `ies reproduce` the calibration as a callable (so that the uq stage never
 imports the contact stage), and turns the stages' errors into exit codes. It is the one module of uq that
 imports scans and bem_contact (their error classes and the calibration).
@@ -73,10 +73,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 def version_line() -> str:
     """``ies-workbench VERSION (simulator code HASH)``: the installed distribution's version and the hash of the
-    simulator's source (the code version in every study's task keys, `uq.models`)."""
+    simulator's source (the code version in every study's task keys, `uq.problem.models`)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    from uq.models import IESModel
+    from uq.problem.models import IESModel
 
     try:
         installed = version("ies-workbench")

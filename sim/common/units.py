@@ -5,7 +5,7 @@ clearance g* = 0.58 mm and the Hertzian spring constant k_H* = 282e3 N/mm^1.5 (E
 the code works in SI units (m, N/m^1.5). `parse_quantity` reads ``0.58e-3``, ``"0.58mm"``, ``"580 um"`` or
 ``"282e3 N/mm^1.5"`` and returns SI; `implausible` names a magnitude outside the physically plausible range
 and the value that was probably meant (e.g. ``--g 0.58`` is 0.58 m, probably 0.58 mm). The command line
-(`sim.common.options`) and the study files (`uq.study`) both read g and k_H through this module.
+(`sim.common.options`) and the study files (`uq.problem.study`) both read g and k_H through this module.
 """
 from __future__ import annotations
 

@@ -273,7 +273,7 @@ def timoshenko_element(length: np.ndarray, EI: np.ndarray, kGA: np.ndarray, rhoA
     Energies U = 1/2 int EI theta'^2 + kGA (w' - theta)^2 and T = 1/2 int rhoA w_t^2 + rhoI theta_t^2 (rotary
     inertia included). Bending and mass are integrated exactly (p+1 Gauss points); the shear term with p points
     (selective reduced integration), which removes shear locking for slender elements. Eigenvalues converge
-    as h^(2p) (tests/sim/test_rig.py); rhoI must be positive for a positive definite mass matrix. Inputs per element: length (m), EI (N m^2), kGA (N), rhoA (kg/m), rhoI (kg m).
+    as h^(2p) (tests/sim/hosts/test_rig.py); rhoI must be positive for a positive definite mass matrix. Inputs per element: length (m), EI (N m^2), kGA (N), rhoA (kg/m), rhoI (kg m).
     """
     L = np.atleast_1d(np.asarray(length, float))
     EI, kGA, rhoA, rhoI = (np.broadcast_to(np.asarray(a, float), L.shape) for a in (EI, kGA, rhoA, rhoI))
@@ -423,11 +423,11 @@ def mass_normalised_modes(mesh: BeamMesh, n_modes: int | None = None) -> tuple[n
 # The seed rig
 
 # Element size of the rig mesh (m): cubic elements of at most 5 mm (about 500 DOFs); the nine frequencies
-# are within 1e-8 of the exact stepped-beam solution (tests/sim/test_rig.py).
+# are within 1e-8 of the exact stepped-beam solution (tests/sim/hosts/test_rig.py).
 ELEMENT_SIZE = 0.005
 
 # Results of `update_rig()` for the two updating variants (see update_rig and RIG_VARIANTS), stored so that
-# `seed_rig_model()` is fast; tests/sim/test_rig.py re-runs the default updating and checks the other's optimum.
+# `seed_rig_model()` is fast; tests/sim/hosts/test_rig.py re-runs the default updating and checks the other's optimum.
 # Default, "joint-spring": steel E within 200-215 GPa (it ends on the upper bound), a neck cut only in y (the
 # paper's reason for the neck: y-bending below x-bending), and the translational compliance of the beam-block
 # joint; weighted least squares on f1..f4 (Table A.1) and the paper's f9 = 19.8 kHz.
@@ -661,7 +661,7 @@ def update_rig(start: RigParameters | None = None, geometry: RigGeometry = RigGe
     variant's start). joint_stiffness (N/m, inf = rigid): fix the joint's translational stiffness there and update
     the variant's other free parameters (only where the variant frees it, "joint-spring"). Takes 10-60 s.
 
-    Findings (report of the updating; tests/sim/test_rig.py):
+    Findings (report of the updating; tests/sim/hosts/test_rig.py):
     * "effective-modulus" (E, neck length and widths; rigid joint; f1..f4): f1..f4 to < 1e-8, unique from several
       starts, but only with E = 240.8 GPa (not steel); f9 = 21.26 kHz (+7.4 % on the paper's 19.8 kHz), m_a phi_c^2
       = 3.35 %, phi_tip/phi_c = 0.962, beam mass 1.757 kg.

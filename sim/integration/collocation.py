@@ -28,7 +28,7 @@ come here; the exact integrator takes the contacts of the others by Dormand-Prin
 
 Accuracy: the force is interpolated by a polynomial of degree s - 1 in u, so a step has the order of
 its interpolation (about s + 1 for the modal response, 2 s for the force impulse, Gauss quadrature);
-with s = 10 a whole impact has a rebound error near 1e-10 (tests/sim/test_collocation.py).
+with s = 10 a whole impact has a rebound error near 1e-10 (tests/sim/integration/test_collocation.py).
 """
 from __future__ import annotations
 

@@ -16,7 +16,7 @@ speed, the masses or k_H. Its exact value `restitution(xi)` follows from the ene
 restitution is conservative): r^2 = (4/5) x_max^2.5, x_max the largest indentation of that equation. The
 paper's xi(r) is this relation to first order in xi (1 - r = (pi / sqrt 5) xi + O(xi^2), the energy lost on the
 elastic approach path); beyond it the true r lies below r_cont,diss, by 1.1 % at r_cont,diss = 0.5 (checks in
-tests/sim/test_contact_law.py).
+tests/sim/model/test_contact_law.py).
 
 Both walls use the same law; the sign conventions of sim/model/system.py apply (delta_l, delta_r of Eqs. 5, 6 with
 delta_r < 0 in contact: the right wall's indentation is -delta_r).
@@ -183,7 +183,7 @@ def _calling(kernel: Callable | None, arguments: str, passed: str, default: str 
 
 
 # numba's inliner checks its own IR pedantically and warns that the variables of a law's conditional expression are
-# "not in scope" after the law is inlined into a loop; the compiled code is right (tests/sim/test_contact_law_seam.py
+# "not in scope" after the law is inlined into a loop; the compiled code is right (tests/sim/model/test_contact_law_seam.py
 # against scipy), the warning is noise for the user of a first compilation
 warnings.filterwarnings("ignore", message=r"variable '.*' is not in scope", category=NumbaIRAssumptionWarning)
 

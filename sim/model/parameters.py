@@ -7,7 +7,7 @@ A row of `PARAMETERS` (an `UncertainParameter`) says everything the workbench ne
 name and unit, its nominal value and interval (Table 2 for D, g, k_H), what it feeds in the simulated system (a
 field of `SystemSettings`, set or scaled: `Feed`), its option of `ies sweep` / `ies overview` / `ies trace` and its
 key in a study file (``[parameters.KEY]``). Adding a parameter is adding a row: the study files
-(`uq.study`, `uq.space`), the simulator's response model (`uq.models.IESModel`), the commands' options
+(`uq.problem.study`, `uq.problem.space`), the simulator's response model (`uq.problem.models.IESModel`), the commands' options
 (`sim.cli`) and the impactor builder (`sim.model.system.build_system`) all read this table.
 """
 from __future__ import annotations

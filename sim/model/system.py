@@ -252,7 +252,7 @@ def build_impactor(settings: SystemSettings) -> Impactor:
 def build_system(model: ModalModel, settings: SystemSettings, *,
                  integrator: str | None = None) -> tuple[ModalModel, Impactor]:
     """The one impactor builder of the workbench, used by `ies sweep/overview/trace` (`sim.cli`) and by studies
-    (`uq.models.IESModel`): (the model with D_1 = settings.D1 when given, the impactor of `build_impactor`).
+    (`uq.problem.models.IESModel`): (the model with D_1 = settings.D1 when given, the impactor of `build_impactor`).
 
     The checks that need the model and the integrator live here, once, so that a bad combination fails before any
     work with one line: the damped law (Eq. 10) needs the model's beam mass, dry friction (Appendix C) the model's

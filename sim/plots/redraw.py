@@ -7,7 +7,7 @@ Every kind of result folder registers how to recognise it and how to draw its fi
 
 `redraw(folder, options)` finds the registered kind and draws (in the formats, the matplotlib style and the
 subset of excitation levels of `options`, into `options.out`). The simulation stage registers its folders in
-`sim.plots.figures` (`ies sweep --out`, `ies overview --out`), the uncertainty stage its studies in `uq.figures`; a
+`sim.plots.figures` (`ies sweep --out`, `ies overview --out`), the uncertainty stage its studies in `uq.outputs.figures`; a
 new kind of result registers its own redraw function in its own module, and `ies plot` imports that module.
 """
 from __future__ import annotations

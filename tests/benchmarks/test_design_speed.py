@@ -2,7 +2,7 @@
 
 * The slow-flow kernel (`sim.reduced.slow_flow.screen`): 50 clearances x 10 sphere radii x 20 excitation levels.
   Target <= 2 s (median of 5 repeats after one untimed call; numpy only, no JIT). Latest: 0.03-0.04 s.
-* The design's screening step (`uq.design.screen_designs`: the same grid for each end of the D interval and of the
+* The design's screening step (`uq.design.search.screen_designs`: the same grid for each end of the D interval and of the
   clearance tolerance, i.e. four slow-flow calls). Target <= 2 s. Latest: see `-s`.
 * A full design (screening + verification of the five best candidates, their neighbours and the paper's design as
   baseline, 3 repetitions, 8 corners and the centre of the uncertainty box, 10 levels). Target <= 15 min on 2 cores.
@@ -44,7 +44,8 @@ def test_screening_50_clearances_10_radii_20_levels():
 
 
 def test_the_design_screening_step_50_clearances_10_radii_20_levels():
-    from uq.design import DesignProblem, host_mode as design_host, host_model, screen_designs
+    from uq.design.problem import DesignProblem, host_mode as design_host, host_model
+    from uq.design.search import screen_designs
 
     problem = DesignProblem(excitation=tuple(np.linspace(2e-6, 8e-6, 20)),
                             clearances=tuple(np.linspace(0.2e-3, 1.2e-3, 50)),

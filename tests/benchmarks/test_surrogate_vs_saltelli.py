@@ -1,4 +1,4 @@
-"""The surrogate's Sobol' indices against Saltelli's on the shipped Sobol' study (issue 26, `uq.surrogate`).
+"""The surrogate's Sobol' indices against Saltelli's on the shipped Sobol' study (issue 26, `uq.methods.surrogate`).
 
 Saltelli's sampling at n = 64 (the reference: 5 x 64 points x 2 levels x 3 repetitions = 1,920 runs) and the
 polynomial-chaos surrogate at its default design (32 points, degree 2: 192 runs, a tenth) on `uq/studies/sobol.toml`.

@@ -1,6 +1,6 @@
 """Throughput of a study's runs through each engine of the runner (issue 26, item 4): bare runs in this process
-(`uq.runner.evaluate` in a loop), joblib with 1 and 2 workers, local Dask processes (2 workers) and the SLURM path
-(`uq.cluster.open_cluster` on the test SLURM of tests/cluster, 2 one-core jobs).
+(`uq.engine.runner.evaluate` in a loop), joblib with 1 and 2 workers, local Dask processes (2 workers) and the SLURM path
+(`uq.engine.cluster.open_cluster` on the test SLURM of tests/cluster, 2 one-core jobs).
 
 Per engine: runs per core-second, the CPU time per task (this process and every worker process, from psutil)
 and its overhead against the bare runs, the engine's idle background CPU over the same wall time (Dask's
@@ -24,8 +24,8 @@ from pathlib import Path
 import psutil
 import pytest
 
-from uq.runner import ResultStore, Task, evaluate, prepare_output, run_tasks
-from uq.study import parse_study
+from uq.engine.runner import ResultStore, Task, evaluate, prepare_output, run_tasks
+from uq.methods import study_from as parse_study
 
 ROOT = Path(__file__).resolve().parents[2]
 N_TASKS = 24
@@ -162,7 +162,8 @@ def _slurm_row(measure, engine, tmp_path, monkeypatch) -> str:
         import dask
 
         from tests.cluster._slurm import LocalSlurm, SlurmUnavailable
-        from uq.cluster import ClusterSettings, open_cluster
+        from uq.engine.cluster import open_cluster
+        from uq.problem.cluster_settings import ClusterSettings
     except ImportError as exc:
         return f"SLURM path not measured: {exc}"
     try:

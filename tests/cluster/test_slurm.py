@@ -130,7 +130,7 @@ def test_a_worker_job_killed_at_its_walltime_loses_nothing(on_slurm, tmp_path):
     """One worker job at a time with a 1-minute walltime (SLURM's smallest) and about 2 min of work: SLURM kills the
     first job at its time limit (JobState TIMEOUT), the cluster submits another, and the study finishes with every
     task once and the tasks finished before the kill untouched. (Above 3 min of walltime the workers retire before
-    it instead, `uq.cluster`.) About 3 min: run with `pytest -m long tests/cluster`."""
+    it instead, `uq.engine.cluster`.) About 3 min: run with `pytest -m long tests/cluster`."""
     study = tmp_path / "walltime.toml"
     study.write_text(WALLTIME_STUDY)
     out = tmp_path / "out"

@@ -1,4 +1,4 @@
-"""Simulated traces of the built-in rig for the signal-analysis tests (tests/sim/test_impacts.py,
+"""Simulated traces of the built-in rig for the signal-analysis tests (tests/sim/analysis/test_impacts.py,
 test_modal_fit.py, test_sim_signals.py): the states of the exact integrator recorded at ~51.2 kHz.
 
 The almost periodic response at a_base/a_base* = 7.4, eta = 0.976 (Sect. 5.5, Figs. 4a-b and 9) is not

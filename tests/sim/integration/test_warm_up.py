@@ -1,0 +1,106 @@
+"""sim.integration.integrators.warm_up: the kernels are compiled before a progress bar starts, and a slow (first) compilation
+says so while it happens."""
+import io
+import time
+
+import numpy as np
+import pytest
+
+from sim.integration import integrators
+
+
+@pytest.fixture(autouse=True)
+def fresh(monkeypatch):
+    monkeypatch.setattr(integrators, "_WARM", set())
+
+
+def test_a_slow_warm_up_says_that_it_compiles_while_it_happens(monkeypatch):
+    said_during = []
+    stream = io.StringIO()
+
+    def slow_compile(run_step):
+        time.sleep(0.5)
+        said_during.append(stream.getvalue())
+
+    monkeypatch.setattr(integrators, "NOTICE_AFTER_S", 0.1)
+    monkeypatch.setattr(integrators, "_run_tiny_system", lambda run_step, law: slow_compile(run_step))
+    assert integrators.warm_up("exact", stream=stream) >= 0.5
+    assert said_during == ["compiling the exact integrator's kernels (first run only, about "
+                           f"{integrators.COMPILE_MINUTES['exact']} min) ...\n"]
+    assert stream.getvalue().splitlines()[-1].startswith("kernels compiled in ")
+    assert integrators.warm_up("exact", stream=stream) == 0.0  # once per process
+
+
+def test_a_quick_warm_up_is_silent(monkeypatch):
+    stream = io.StringIO()
+    calls = []
+    monkeypatch.setattr(integrators, "_run_tiny_system", lambda run_step, law: calls.append(run_step))
+    integrators.warm_up("ode3", stream=stream)
+    assert stream.getvalue() == "" and len(calls) == 1
+
+
+@pytest.mark.parametrize("name", integrators.available())
+def test_the_tiny_system_impacts(name):
+    """The warm-up run reaches a contact, so the contact kernels are compiled too."""
+    record = {}
+    run_step = integrators.get_integrator(name)
+
+    def counting(y, n, Omega, a_base, sys, rec, **options):
+        record["out"] = run_step(y, n, Omega, a_base, sys, rec, **options)
+        return record["out"]
+
+    integrators._run_tiny_system(counting)
+    amplitudes, impacts = record["out"]
+    assert np.sum(impacts) > 0 and np.all(np.isfinite(amplitudes))
+
+
+def test_an_unknown_integrator_is_refused_before_anything_runs():
+    from sim.common.errors import SimulationInputError
+
+    with pytest.raises(SimulationInputError, match="unknown integrator 'rk4'"):
+        integrators.warm_up("rk4")
+
+
+NEW_SIGNATURES = """
+import importlib, sys
+from sim.integration import integrators, jit
+from sim.hosts.rig import seed_rig_model
+from sim.model.contact_law import ContactLaw
+from sim.model.system import Impactor
+from sim.stepped_sine.protocol import SteppedSine, run_sweep
+
+name, law_name = sys.argv[1], sys.argv[2]
+
+def signatures():
+    found = {}
+    for stem in jit.KERNEL_MODULES + ("energy",):
+        for attr, obj in vars(importlib.import_module(f"sim.integration.{stem}")).items():
+            if hasattr(obj, "signatures") and hasattr(obj, "py_func"):
+                found[f"{stem}.{attr}"] = set(obj.signatures)
+    return found
+
+integrators.warm_up(name, law=law_name)
+before = signatures()
+law = ContactLaw("hertz-damped", 0.95) if law_name == "hertz-damped" else ContactLaw()
+protocol = SteppedSine(eta_start=0.99, eta_stop=1.0, n_eta=2, wait=0.03, hold=0.03, integrator=name)
+run = run_sweep(seed_rig_model(), Impactor(contact_law=law), 7.4, protocol, seed=3, rep=0)
+assert run.impacts_per_period.sum() > 0  # the hold reached the contact kernels
+after = signatures()
+print(sorted(k for k in after if after[k] - before.get(k, set())))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, law", [("exact", "hertz"), ("ode3", "hertz"), ("exact", "hertz-damped")])
+def test_after_the_warm_up_a_stepped_sine_run_compiles_nothing_more(name, law):
+    """Issue 25: workers load every kernel from the cache and never compile. A real stepped-sine run (lead-in,
+    wait, hold with the energy ledger) in a fresh process after `warm_up` adds no specialisation to any kernel."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[3]
+    done = subprocess.run([sys.executable, "-c", NEW_SIGNATURES, name, law], cwd=root, capture_output=True,
+                          text=True, timeout=1200)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip().splitlines()[-1] == "[]"

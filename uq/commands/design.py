@@ -1,0 +1,70 @@
+"""`ies design`: choose the clearance and the sphere for a host structure (`uq.design`)."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from sim.common.options import positive_int
+from uq.commands.study import add_run_arguments, engine
+
+DESIGN_HELP = ("choose the clearance and the sphere (radius, material) for a host structure: the worst case of the "
+               "resonant tip amplitude over an excitation range and the uncertain D, clearance and k_H, screened by "
+               "the slow flow and verified by stepped-sine simulation (uq.design)")
+
+
+def add_design_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("study", nargs="?", type=Path, metavar="STUDY.toml",
+                        help="a design study file ([study] kind = \"design\", [design] with the options below as keys); "
+                             "options given here win")
+    parser.add_argument("--excitation", metavar="RANGE",
+                        help="operating base amplitudes START:STOP[:COUNT] with units (e.g. 0.66um:6.6um:10) or base "
+                             "accelerations (0.5m/s2:2m/s2); required")
+    parser.add_argument("--clearance", metavar="RANGE", help="clearances to consider (default 0.3mm:1.2mm:10)")
+    parser.add_argument("--radius", metavar="RANGE", help="sphere radii (default the paper's 7.92mm)")
+    parser.add_argument("--material", metavar="LIST", help="sphere materials, comma separated: brass, steel, tungsten "
+                                                           "(default brass)")
+    parser.add_argument("--model", metavar="FILE", help="the host as a modal-model file (default: the built-in rig)")
+    parser.add_argument("--objective", choices=("mean", "max"), help="the amplitude whose worst case is minimised: "
+                                                                     "the resonant mean (default) or max")
+    parser.add_argument("--damping", metavar="LOW:HIGH", help="interval of D_1 (default Table 2: 0.00075:0.0009)")
+    parser.add_argument("--clearance-tolerance", metavar="LOW:HIGH",
+                        help="tolerance added to each clearance (default Table 2: 0:0.032mm)")
+    parser.add_argument("--k-H-factor", metavar="LOW:HIGH", help="factor on Eq. 8's k_H (default Table 2: 1:1.518)")
+    parser.add_argument("--calibration", metavar="FILE",
+                        help="`ies calibrate --json` output: its k_H / k_H* becomes the upper end of the k_H factor "
+                             "(the crater's stiffening, as `ies reproduce` uses it)")
+    parser.add_argument("--candidates", type=positive_int, metavar="N", help="screened designs to verify (default 5)")
+    parser.add_argument("--reps", type=positive_int, metavar="N", help="repetitions per verification run (default 3)")
+    parser.add_argument("--restitution", type=float, metavar="R",
+                        help="modal restitution r (Eq. D.1) of the screening (default 0.86, the simulator's at the rig)")
+    parser.add_argument("--baseline", metavar="G[,R[,MAT]]",
+                        help="a design to verify beside the recommendation, e.g. the paper's 0.58mm,7.92mm,brass")
+    parser.add_argument("--block-width", metavar="LENGTH", help="the host's block across the cavity (default 28mm)")
+    parser.add_argument("--min-wall", metavar="LENGTH", help="thinnest wall left beside the cavity (default 5.5mm)")
+    add_run_arguments(parser)
+
+
+def design_problem(args: argparse.Namespace) -> tuple[Any, Path, Any]:
+    """The design problem, output folder and [cluster] table of `ies design`'s study file and options (options win;
+    `uq.design.problem.read_design_file`, `uq.design.problem.problem_of`)."""
+    from uq.design import problem as d
+
+    file = d.read_design_file(args.study) if args.study is not None else d.DesignFile()
+    given = {name: getattr(args, name) for name in d.DESIGN_SETTINGS if getattr(args, name, None) is not None}
+    settings = {**d.DESIGN_SETTINGS, **file.settings, **given}
+    return d.problem_of(settings, file.protocol), Path(args.out or settings["output"]), file.cluster
+
+
+def design_command(args: argparse.Namespace) -> int:
+    """`ies design`: screen, verify and recommend (uq.design)."""
+    from uq.design.search import run_design
+    from uq.design.results import design_table
+
+    problem, out, cluster = design_problem(args)
+    with engine(args, cluster) as client:
+        result = run_design(problem, out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
+                            progress=not args.quiet, figures=not args.no_figures, client=client)
+    print(design_table(result))
+    print(f"wrote {len(result.files)} files to {result.folder}")
+    return 0

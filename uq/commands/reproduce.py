@@ -1,0 +1,157 @@
+"""`ies reproduce NAME|all`: the paper's figures, each from its shipped study file, with the crater calibration
+as k_H's upper bound (Sect. 4.1)."""
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import replace
+from pathlib import Path
+from typing import Any, Callable
+
+from sim.common.options import positive_int
+from uq.commands.study import JOBS_HELP, engine
+
+#: the calibration `ies reproduce` runs: no arguments, returns the JSON object of `ies calibrate --json`
+Calibrate = Callable[[], dict]
+
+
+REPRODUCE_HELP = ("reproduce the paper's Figs. 5 and 6 (nominal response), 7 and 8 (uncertainty of D, g, k_H) and "
+                  "D.2 and D.3 (impacts per period, restitution)")
+
+
+def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies reproduce`."""
+    from uq.outputs.paper_figures import PAPER_FIGURES
+
+    rows = PAPER_FIGURES.values()
+    parser.add_argument("figure", choices=(*PAPER_FIGURES, "all"),
+                        help="which figure(s): " + ", ".join(f"{row.name} ({row.help}{'' if row.in_all else '; not in all'})"
+                                                             for row in rows) + ", all")
+    parser.add_argument("--quick", action="store_true",
+                        help="reduced protocol (fewer levels, frequencies, repetitions, shorter holds); same trends")
+    parser.add_argument("--out", type=Path, default=Path("ies-out/reproduce"), metavar="DIR",
+                        help="output folder (default ies-out/reproduce)")
+    parser.add_argument("--jobs", type=positive_int, default=None, metavar="N", help=JOBS_HELP)
+    parser.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://host:8786")
+    parser.add_argument("--resume", action="store_true", help="continue an interrupted reproduction in --out")
+    from uq.engine.cluster import add_cluster_arguments
+
+    add_cluster_arguments(parser)
+    calib = parser.add_mutually_exclusive_group()
+    calib.add_argument("--calibration", type=Path, metavar="FILE",
+                       help="use this `ies calibrate --json` output instead of running the calibration")
+    calib.add_argument("--no-calibration", action="store_true", help="keep Table 2's k_H bounds")
+    parser.add_argument("--model", type=Path, metavar="FILE",
+                        help="run the studies on this modal-model file (`ies modes --save`) instead of the built-in rig")
+    parser.add_argument("--integrator", metavar="NAME",
+                        help="override the study files' integrator (ode3 = the paper's scheme, exact = free flight)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def study_file(figure: str, quick: bool) -> Path:
+    """The study file of a figure (`uq.outputs.paper_figures.PaperFigure.study_file`)."""
+    from uq.outputs.paper_figures import PAPER_FIGURES
+
+    return PAPER_FIGURES[figure].study_file(quick)
+
+
+def run_calibration(calibrate: Calibrate, out: Path) -> dict | None:
+    """Run the calibration and keep its JSON object in out/calibration.json (Sect. 4.1).
+
+    Returns None after one warning line when it fails: the calibration is optional, and whatever stops it
+    (a bad scan, a solver that does not converge, ...) leaves the studies on Table 2's k_H bounds.
+    """
+    from sim.common.files import dumps, write_text
+
+    try:
+        data = calibrate()
+    except Exception as exc:  # noqa: BLE001 - any failure falls back to Table 2, named in the warning
+        sys.stderr.write(f"warning: the calibration failed ({type(exc).__name__}: {exc}); using Table 2's k_H bounds\n")
+        return None
+    write_text(out / "calibration.json", dumps(data))
+    return data
+
+
+def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
+    """`ies reproduce`: check every study first, connect to the cluster once, then calibrate (for Figs. 7-8, with
+    `calibrate` unless --calibration FILE or --no-calibration) and run."""
+    from uq.engine.runner import check_writable, dask_client
+    from uq.outputs.paper_figures import figures_of_all
+    from uq.methods import load_study
+    from uq.problem.space import calibrated_k_H
+
+    figures = figures_of_all() if args.figure == "all" else (args.figure,)
+    studies = [load_study(study_file(f, args.quick)) for f in figures]
+    if args.integrator:
+        studies = [replace(s, protocol={**s.protocol, "integrator": args.integrator}) for s in studies]
+    if args.model is not None:
+        studies = [replace(s, modal_model=args.model) for s in studies]
+    models = [s.make_model() for s in studies]
+    for model in models:
+        model.check()  # bad settings (e.g. an unknown integrator) fail here, before anything is written
+    calibration = None
+    if args.calibration is not None:  # a bad file fails here too
+        calibration = {"k_H": calibrated_k_H(args.calibration), "source": str(args.calibration)}
+    with engine(args, None) as batch, dask_client(args.scheduler, batch) as client:
+        # connected (or the batch cluster started) once, first: a bad address leaves nothing behind
+        check_writable(args.out)
+        from sim.integration.integrators import warm_up_all
+
+        # every kernel any study's workers will call, compiled here once, before the first bar
+        warm_up_all(pair for model in models if hasattr(model, "kernel_variants") for pair in model.kernel_variants())
+        return _reproduce(args, figures, studies, client, calibrate, calibration)
+
+
+def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list, client: Any,
+               calibrate: Calibrate, calibration: dict | None) -> int:
+    """Calibration (the given one, or run unless disabled) when an interval study needs it, then each figure's
+    study, its figures and its table; then OUT/summary.txt, each figure's table.txt and OUT/index.md
+    (`uq.outputs.reproduce_report`)."""
+    from sim.common.files import report_written
+    from uq.outputs.reproduce_report import captured_stdout, write_index, write_summary
+
+    calibrated = False
+    sections: list[tuple[str, str]] = []
+    for figure, study in zip(figures, studies):
+        with captured_stdout() as printed:
+            calibration, calibrated = _reproduce_figure(args, figure, study, client, calibrate, calibration,
+                                                        calibrated)
+        sections.append((figure, printed.copy.getvalue()))
+    command = " ".join(["ies reproduce", args.figure, *(["--quick"] if args.quick else []), "--out", str(args.out)])
+    report_written([*write_summary(args.out, command, sections), write_index(args.out)])
+    return 0
+
+
+def _reproduce_figure(args: argparse.Namespace, figure: str, study: Any, client: Any, calibrate: Calibrate,
+                      calibration: dict | None, calibrated: bool) -> tuple[dict | None, bool]:
+    """One figure of `ies reproduce`: the calibration first if its study varies k_H and none was made yet, then
+    the study, its figures and its table. Returns (the calibration, whether it was made)."""
+    from uq.engine.execution import run_study
+    from uq.outputs.paper_figures import PAPER_FIGURES
+    from uq.problem.space import K_H_STAR, calibrated_k_H
+    from uq.problem.study import with_calibration
+
+    out = args.out
+    row = PAPER_FIGURES[figure]
+    if study.kind == "interval" and "k_H" in [p.name for p in study.space.varied]:  # calibrated once, first
+        if not calibrated and calibration is None and not args.no_calibration:
+            calibration = run_calibration(calibrate, out)
+        if calibration is not None:
+            k_cal = calibrated_k_H(calibration)
+            study = with_calibration(study, k_cal)  # one line if k_cal < k_H*
+            if not calibrated:
+                print(f"calibrated k_H = {k_cal:.4g} N/m^1.5 = {k_cal / K_H_STAR:.3f} k_H* (upper bound of k_H)")
+        calibrated = True
+    folder = out / figure
+    print(f"{figure}: {study.source} -> {folder}/")
+    result = run_study(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet)
+    paths = study.method.figures(result.folder)
+    if row.traced:
+        from uq.methods.response import series_traces
+
+        paths += series_traces(study, folder, row.traced)
+    s = result.summary
+    print(f"{figure}: {s['tasks']} runs ({s['ran']} run now), {s['failed_runs']} failed, "
+          f"{s['wall_time_s']:.1f} s; figures: {', '.join(p.name for p in paths)}")
+    study.method.report(folder, s, figure)
+    return calibration, calibrated

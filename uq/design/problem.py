@@ -1,0 +1,410 @@
+"""What `ies design` is asked (the design problem): the operating range, the grid of clearances and spheres, the
+uncertainty box (Table 2's intervals by default), the host, and the reading of its options and study file with
+units; one line (StudyError) for anything wrong."""
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from uq.errors import StudyError
+
+#: Table 2's intervals as the default uncertainty box: D_1, the clearance's tolerance above its nominal value
+#: (0.58 -> 0.612 mm) and the factor on Eq. 8's k_H (282e3 -> 428e3 N/mm^1.5)
+D_INTERVAL = (0.00075, 0.00090)
+
+
+CLEARANCE_TOLERANCE = (0.0, 0.032e-3)
+
+
+K_H_FACTOR = (1.0, 428.0 / 282.0)
+
+
+#: the built-in rig's block across the cavity and its walls (Sect. 2: 28 mm, 17 mm cavity in the paper's design)
+BLOCK_WIDTH = 28e-3
+
+
+MIN_WALL = 5.5e-3
+
+
+#: the modal restitution r (Eq. D.1) the screening uses unless told: the simulator's value at the seed rig's APR
+RESTITUTION = 0.86
+
+
+#: the stepped sine of a verification run: Fig. 6's quick study (26 frequencies, 2 s wait, 3 s hold, up, eta 0.96-1.01)
+PROTOCOL = {"eta_start": 0.96, "eta_stop": 1.01, "n_eta": 26, "wait": 2.0, "hold": 3.0, "sequence": "up",
+            "start": "base-velocity", "repetition": "run", "integrator": "exact"}
+
+
+OBJECTIVES = ("mean", "max")
+
+
+@dataclass(frozen=True)
+class Sphere:
+    """One design: clearance g (m), sphere radius (m) and material name (`sim.model.materials`)."""
+
+    clearance: float
+    radius: float
+    material: str
+
+    @property
+    def mass(self) -> float:
+        """m_a (kg) from the radius and the material's density."""
+        from sim.model.materials import material, sphere_mass
+
+        return sphere_mass(self.radius, material(self.material))
+
+    @property
+    def k_H(self) -> float:
+        """k_H (N/m^1.5) of Eq. 8 against the host's steel wall."""
+        from sim.model.materials import hertz_constant, material
+
+        return hertz_constant(self.radius, material(self.material))
+
+    def cavity(self) -> float:
+        """The cavity's width 2R + 2g (m)."""
+        return 2.0 * (self.radius + self.clearance)
+
+    def label(self) -> str:
+        return f"g {self.clearance * 1e3:.3f} mm, {self.material} R {self.radius * 1e3:.2f} mm"
+
+    def describe(self) -> dict[str, Any]:
+        return {"clearance_m": self.clearance, "radius_m": self.radius, "material": self.material,
+                "mass_kg": self.mass, "k_H_N_per_m1p5": self.k_H, "cavity_m": self.cavity()}
+
+
+@dataclass(frozen=True)
+class DesignProblem:
+    """What `ies design` is asked: the operating base amplitudes a_base (m), the design grid, the uncertainty box, the
+    objective, how many screened candidates to verify, the repetitions and the stepped sine of a verification run."""
+
+    excitation: tuple[float, ...]
+    clearances: tuple[float, ...]
+    radii: tuple[float, ...]
+    materials: tuple[str, ...] = ("brass",)
+    D: tuple[float, float] = D_INTERVAL
+    clearance_tolerance: tuple[float, float] = CLEARANCE_TOLERANCE
+    k_H_factor: tuple[float, float] = K_H_FACTOR
+    objective: str = "mean"
+    candidates: int = 5
+    repetitions: int = 3
+    restitution: float = RESTITUTION
+    block_width: float = BLOCK_WIDTH
+    min_wall: float = MIN_WALL
+    modal_file: str | None = None
+    baseline: Sphere | None = None
+    seed: int = 2024
+    protocol: Mapping[str, Any] = field(default_factory=lambda: dict(PROTOCOL))
+
+    def check(self) -> None:
+        """Refuse a problem that cannot be designed, with one line (StudyError)."""
+        from sim.common.errors import SimulationInputError
+        from sim.model.materials import material
+
+        for name, values, unit in (("--excitation", self.excitation, "m"), ("--clearance", self.clearances, "m"),
+                                   ("--radius", self.radii, "m")):
+            if not values:
+                raise StudyError(f"{name}: the range is empty; give START:STOP[:COUNT] with units, e.g. "
+                                 f"{_EXAMPLES[name]}")
+            if any(not math.isfinite(v) or v <= 0 for v in values):
+                raise StudyError(f"{name}: every value must be a positive number of {unit}, got "
+                                 f"{', '.join(f'{v:g}' for v in values)}")
+        for name in self.materials:
+            try:
+                material(name)
+            except SimulationInputError as exc:  # one line naming the known materials
+                raise StudyError(f"--material: {exc}") from None
+        if self.objective not in OBJECTIVES:
+            raise StudyError(f"--objective must be one of {', '.join(OBJECTIVES)}, got {self.objective!r}")
+        for name, (lo, hi) in (("--damping", self.D), ("--clearance-tolerance", self.clearance_tolerance),
+                               ("--k-H-factor", self.k_H_factor)):
+            if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+                raise StudyError(f"{name}: give an interval LOW:HIGH with LOW <= HIGH, got {lo:g}:{hi:g}")
+        if not 0 < self.D[0] and self.D[1] < 1:
+            raise StudyError(f"--damping: D_1 must lie in (0, 1), got {self.D[0]:g}:{self.D[1]:g}")
+        if self.k_H_factor[0] <= 0:
+            raise StudyError(f"--k-H-factor: the factor on Eq. 8's k_H must be > 0, got {self.k_H_factor[0]:g}")
+        if min(self.clearances) + self.clearance_tolerance[0] <= 0:
+            raise StudyError("--clearance-tolerance: the lower end makes the smallest clearance <= 0")
+        if not 0 < self.restitution <= 1:
+            raise StudyError(f"--restitution must lie in (0, 1], got {self.restitution:g}")
+        if self.candidates < 1 or self.repetitions < 1:
+            raise StudyError("--candidates and --reps must be >= 1")
+        if self.baseline is not None and not self.fits(self.baseline):
+            raise StudyError(f"--baseline: {self.baseline.label()} needs a {self.baseline.cavity() * 1e3:.2f} mm cavity;"
+                             f" {self.room() * 1e3:.2f} mm fit between {self.min_wall * 1e3:g} mm walls")
+        if not any(self.fits(s) for s in self.grid()):
+            raise StudyError(f"no design fits: the cavity 2R + 2g must stay within {self.room() * 1e3:.2f} mm "
+                             f"({self.block_width * 1e3:g} mm block, walls of {self.min_wall * 1e3:g} mm); "
+                             f"the smallest design needs {min(s.cavity() for s in self.grid()) * 1e3:.2f} mm: "
+                             "give smaller radii or clearances")
+
+    def room(self) -> float:
+        """The widest cavity (m) that leaves walls of min_wall."""
+        return self.block_width - 2.0 * self.min_wall
+
+    def fits(self, sphere: Sphere) -> bool:
+        return sphere.cavity() <= self.room() * (1 + 1e-12)
+
+    def grid(self) -> list[Sphere]:
+        """Every design of the grid, material by material, radius by radius, clearance by clearance."""
+        return [Sphere(g, R, m) for m in self.materials for R in self.radii for g in self.clearances]
+
+
+_EXAMPLES = {"--excitation": "0.66um:6.6um:10", "--clearance": "0.3mm:1.2mm:10", "--radius": "5mm:8mm:4"}
+
+
+def host_model(problem: DesignProblem) -> Any:
+    """The host's modal model (`sim.model.system.ModalModel`): the built-in rig or the problem's modal file."""
+    from sim.common.errors import SimulationInputError
+    from sim.hosts.modal_file import load_modal_model
+    from sim.hosts.rig import seed_rig_model
+
+    try:
+        return seed_rig_model() if problem.modal_file is None else load_modal_model(problem.modal_file)
+    except SimulationInputError as exc:
+        raise StudyError(f"--model: {exc}") from None
+
+
+def host_mode(model: Any) -> Any:
+    """The slow flow's view of the host (`sim.reduced.slow_flow.HostMode`), refused with one line when the host lacks
+    what the design needs (a first mode that moves the walls and is excited by the base)."""
+    from sim.common.errors import SimulationInputError
+    from sim.reduced.slow_flow import host_mode as mode_of
+
+    try:
+        return mode_of(model)
+    except SimulationInputError as exc:
+        raise StudyError(f"the host model cannot be designed for: {exc}") from None
+
+
+def levels_of(model: Any, a_base: Sequence[float]) -> np.ndarray:
+    """Excitation levels a_base / a_base* (-) of base amplitudes (m), a_base* of the paper's nominal D*, g* (Sect. 5.3)."""
+    from sim.model.system import a_base_star
+
+    return np.asarray(a_base, dtype=float) / a_base_star(model)
+
+
+def no_absorber(model: Any, a_base: Sequence[float], D: float) -> np.ndarray:
+    """Resonant tip amplitude (m) of the host alone at damping D (Sect. 5's a_noabs* with D* = D)."""
+    from sim.model.system import Nominal, a_noabs_star
+
+    return a_noabs_star(model, np.asarray(a_base, dtype=float), Nominal(D1=D))
+
+
+def first_impacts(mode: Any, clearance: float) -> float:
+    """The base amplitude (m) at which the host's linear resonant wall amplitude reaches `clearance` (Eq. 7, mode 1
+    at resonance: |phi_c gamma| a_base / (2 D))."""
+    return 2.0 * mode.D * clearance / mode.coupling
+
+
+def micrometres(a: float) -> str:
+    return f"{a * 1e6:.3g}"
+
+
+def _quantities() -> dict[str, Any]:
+    from sim.common.units import Quantity
+
+    length = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6}
+    return {"excitation": Quantity("base amplitude a_base", "m", {**length, "nm": 1e-9}, (1e-10, 1e-2), "2um"),
+            "acceleration": Quantity("base acceleration", "m/s2", {"m/s2": 1.0, "m/s^2": 1.0}, (1e-4, 1e4), "1m/s2"),
+            "clearance": Quantity("clearance g", "m", length, (1e-6, 1e-2), "0.58mm"),
+            "radius": Quantity("sphere radius R", "m", length, (0.5e-3, 0.1), "7.92mm")}
+
+
+def parse_range(text: str, kind: str, *, count: int, omega: float | None = None) -> tuple[float, ...]:
+    """`START:STOP[:COUNT]` or one value, each a number with its unit (`0.2mm:1.2mm`, `2um:8um:7`, `7.92mm`) or, for
+    the excitation, base accelerations (`0.5m/s2:2m/s2`, turned into amplitudes a / omega^2 at the resonance omega);
+    returns the COUNT (default `count`) equispaced values in SI. One line (StudyError) for a malformed, empty,
+    reversed, unitless or implausible range."""
+    from sim.common.errors import SimulationInputError
+    from sim.common.units import implausible, parse_quantity
+
+    quantities = _quantities()
+    option = f"--{kind}"
+    parts = [t.strip() for t in str(text).split(":")]
+    if len(parts) > 3 or not all(parts[:2]):
+        raise StudyError(f"{option} {text!r}: give START:STOP[:COUNT] or one value, with units, e.g. "
+                         f"{_EXAMPLES.get(option, '1mm')}")
+    n = count if len(parts) < 3 else _count(parts[2], option)
+    accelerating = kind == "excitation" and any(u in parts[0] for u in ("m/s2", "m/s^2"))
+    quantity = quantities["acceleration" if accelerating else kind]
+    values = []
+    for part in parts[:2]:
+        if not any(ch.isalpha() for ch in part):
+            raise StudyError(f"{option} {text!r}: {part!r} has no unit; write it with one, e.g. "
+                             f"{quantity.example}")
+        try:
+            value = parse_quantity(part, quantity)
+        except SimulationInputError as exc:
+            raise StudyError(f"{option}: {exc}") from None
+        if value <= 0:
+            raise StudyError(f"{option} {text!r}: {quantity.name} must be > 0")
+        if (why := implausible(value, quantity)) is not None:
+            raise StudyError(f"{option}: {why}")
+        values.append(value)
+    if len(parts) == 1:
+        values = values[:1]
+        n = 1
+    elif values[1] < values[0]:
+        raise StudyError(f"{option} {text!r}: the range is reversed; give START:STOP with START <= STOP")
+    elif values[1] == values[0]:
+        n = 1
+    if accelerating:
+        if omega is None:
+            raise StudyError(f"{option}: base accelerations need the host's first frequency")
+        values = [v / omega**2 for v in values]
+    return tuple(float(v) for v in np.linspace(values[0], values[-1], n)) if n > 1 else (float(values[0]),)
+
+
+def _count(text: str, option: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise StudyError(f"{option}: COUNT {text!r} must be a whole number >= 1") from None
+    if n < 1:
+        raise StudyError(f"{option}: COUNT must be >= 1 (an empty range), got {n}")
+    return n
+
+
+def parse_interval(text: str, what: str, quantity: str | None = None) -> tuple[float, float]:
+    """`LOW:HIGH` (plain numbers, or lengths with units for the clearance tolerance) -> (low, high)."""
+    from sim.common.errors import SimulationInputError
+    from sim.common.units import parse_quantity
+
+    parts = str(text).split(":")
+    if len(parts) != 2:
+        raise StudyError(f"{what} {text!r}: give LOW:HIGH, e.g. {'0:0.032mm' if quantity else '0.00075:0.0009'}")
+    try:
+        if quantity:
+            lo, hi = (parse_quantity(p.strip(), _quantities()[quantity]) for p in parts)
+        else:
+            lo, hi = (float(p) for p in parts)
+    except (ValueError, SimulationInputError) as exc:
+        raise StudyError(f"{what} {text!r}: {exc}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
+        raise StudyError(f"{what} {text!r}: give LOW:HIGH with LOW <= HIGH")
+    return lo, hi
+
+
+def parse_baseline(text: str, radii: Sequence[float], materials: Sequence[str]) -> Sphere:
+    """`G[,R[,MATERIAL]]` -> a Sphere; R and the material default to the first of the grid's."""
+    from sim.common.errors import SimulationInputError
+    from sim.model.materials import material
+
+    parts = [t.strip() for t in str(text).split(",")]
+    if not 1 <= len(parts) <= 3 or not parts[0]:
+        raise StudyError(f"--baseline {text!r}: give G[,R[,MATERIAL]], e.g. 0.58mm,7.92mm,brass")
+    g = parse_range(parts[0], "clearance", count=1)[0]
+    R = parse_range(parts[1], "radius", count=1)[0] if len(parts) > 1 and parts[1] else radii[0]
+    name = parts[2] if len(parts) > 2 else materials[0]
+    try:
+        material(name)
+    except SimulationInputError as exc:
+        raise StudyError(f"--baseline: {exc}") from None
+    return Sphere(g, R, name.lower())
+
+
+def protocol_of(table: Mapping[str, Any], where: str) -> dict[str, Any]:
+    """The stepped-sine settings of a design study's [excitation] table (eta = {start, stop, n}, wait, hold, sequence,
+    start, repetition, integrator), checked by building the protocol."""
+    from sim.common.errors import SimulationInputError
+    from sim.stepped_sine.protocol import SteppedSine
+
+    settings = {k: v for k, v in table.items() if k != "eta"}
+    eta = table.get("eta", {})
+    if not isinstance(eta, Mapping) or set(eta) - {"start", "stop", "n"}:
+        raise StudyError(f"{where} eta must be a table {{ start = ..., stop = ..., n = ... }}")
+    settings.update({{"start": "eta_start", "stop": "eta_stop", "n": "n_eta"}[k]: v for k, v in eta.items()})
+    try:
+        SteppedSine(**{**PROTOCOL, **settings})
+    except (TypeError, SimulationInputError) as exc:
+        raise StudyError(f"{where}: {exc}") from None
+    return settings
+
+
+#: setting (the option `--NAME` with - for _, the key of a design study's [design] table) -> default
+DESIGN_SETTINGS: dict[str, Any] = {
+    "excitation": None, "clearance": "0.3mm:1.2mm:10", "radius": "7.92mm", "material": "brass", "model": None,
+    "objective": "mean", "damping": None, "clearance_tolerance": None, "k_H_factor": None, "calibration": None,
+    "candidates": 5, "reps": 3, "restitution": None, "baseline": None, "block_width": None, "min_wall": None,
+    "output": "ies-out/design"}
+
+
+@dataclass(frozen=True)
+class DesignFile:
+    """What a design study file (`[study] kind = "design"`) holds: its [design] settings (and [study] output), the
+    stepped sine of its [excitation] table over `PROTOCOL`, and its [cluster] table (`uq.engine.cluster`) or None."""
+
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    protocol: Mapping[str, Any] = field(default_factory=lambda: dict(PROTOCOL))
+    cluster: Any = None
+
+
+def read_design_file(path: Any) -> DesignFile:
+    """Read and check a design study file; one line (StudyError) for an unreadable file, another kind or an unknown
+    key."""
+    import tomllib
+
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise StudyError(f"cannot read design study {path}: {exc}") from None
+    if data.get("study", {}).get("kind") != "design":
+        raise StudyError(f"{path}: [study] kind must be \"design\" for ies design")
+    settings = dict(data.get("design", {}))
+    unknown = sorted(set(settings) - set(DESIGN_SETTINGS))
+    if unknown:
+        raise StudyError(f"{path}: unknown key(s) in [design]: {', '.join(unknown)}; known: {', '.join(DESIGN_SETTINGS)}")
+    if "output" in data.get("study", {}):
+        settings.setdefault("output", data["study"]["output"])
+    cluster = None
+    if "cluster" in data:
+        from uq.problem.cluster_settings import parse_cluster_table
+
+        cluster = parse_cluster_table(data["cluster"])
+    return DesignFile(settings, {**PROTOCOL, **protocol_of(data.get("excitation", {}), f"{path}: [excitation]")},
+                      cluster)
+
+
+def problem_of(settings: Mapping[str, Any], protocol: Mapping[str, Any] = PROTOCOL) -> DesignProblem:
+    """The checked `DesignProblem` of a design's settings (`DESIGN_SETTINGS` keys; ranges and lengths as text with
+    units) and stepped sine; one line (StudyError) for anything wrong."""
+    value = {**DESIGN_SETTINGS, **settings}
+    if value["excitation"] is None:
+        raise StudyError("--excitation is required: the operating base amplitudes, e.g. --excitation 0.66um:6.6um:10")
+    problem = DesignProblem(excitation=(), clearances=(), radii=(), modal_file=value["model"], protocol=dict(protocol))
+    mode = host_mode(host_model(problem))
+    materials = tuple(m.strip().lower() for m in str(value["material"]).split(",") if m.strip())
+    radii = parse_range(value["radius"], "radius", count=4)
+    fields: dict[str, Any] = dict(
+        excitation=parse_range(value["excitation"], "excitation", count=10, omega=mode.omega),
+        clearances=parse_range(value["clearance"], "clearance", count=10), radii=radii, materials=materials,
+        objective=value["objective"], candidates=int(value["candidates"]), repetitions=int(value["reps"]))
+    for name, key, quantity in (("damping", "D", None), ("clearance_tolerance", "clearance_tolerance", "clearance"),
+                                ("k_H_factor", "k_H_factor", None)):
+        if value[name] is not None:
+            fields[key] = parse_interval(value[name], "--" + name.replace("_", "-"), quantity)
+    for name in ("block_width", "min_wall"):
+        if value[name] is not None:
+            fields[name] = parse_range(value[name], "radius", count=1)[0]
+    if value["calibration"] is not None:
+        if value["k_H_factor"] is not None:
+            raise StudyError("give --calibration or --k-H-factor, not both: the calibration sets the factor's upper end")
+        from uq.problem.space import K_H_STAR, calibrated_k_H
+
+        ratio = calibrated_k_H(value["calibration"]) / K_H_STAR
+        if ratio < 1.0:
+            raise StudyError(f"--calibration: k_H / k_H* = {ratio:.3f} < 1; a crater should stiffen the contact")
+        fields["k_H_factor"] = (1.0, ratio)
+    if value["restitution"] is not None:
+        fields["restitution"] = float(value["restitution"])
+    if value["baseline"] is not None:
+        fields["baseline"] = parse_baseline(value["baseline"], radii, materials)
+    problem = dataclasses.replace(problem, **fields)
+    problem.check()
+    return problem

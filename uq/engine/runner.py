@@ -1,0 +1,317 @@
+"""Running study tasks with joblib (local processes) or a Dask cluster, with an on-disk result store.
+
+A task is one model evaluation: (parameter values, excitation level, repetition). Its key is the
+SHA-256 of the task, the model's settings, the study seed and the model's code version, so a stored
+result is reused only for exactly the same computation. Every result is written to its own JSON file
+(atomically) by the controlling process as soon as it arrives; an interrupted study therefore keeps
+every finished task, and `--resume` runs only the missing ones.
+
+Determinism: a task's random stream depends only on (seed, rep) (sim.stepped_sine.protocol contract), results are
+stored as JSON floats (exact round trip), and they are collected by key, never by arrival order: the
+same study gives identical numbers serially, with `--jobs N` and on Dask.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import math
+import os
+import sys
+import time
+from contextlib import contextmanager
+from dataclasses import asdict, is_dataclass
+from pathlib import Path
+from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
+
+from sim.common.files import write_text
+from uq.errors import StudyError
+from uq.problem.tasks import Task
+
+
+def describe_model(model: Any) -> Any:
+    """The model's settings as plain data (part of every task key)."""
+    if hasattr(model, "describe"):
+        return model.describe()
+    if is_dataclass(model):
+        return {"class": type(model).__name__, **{k: v for k, v in asdict(model).items()}}
+    return repr(model)
+
+
+def task_key(task: Task, model: Any, seed: int, version: str) -> str:
+    """Stable key of a task (hex SHA-256 of its parameters, the model settings, seed and code version)."""
+    return _keyer(model, seed, version)(task)
+
+
+def _keyer(model: Any, seed: int, version: str) -> Callable[[Task], str]:
+    """Key function with the study-wide part (model settings, seed, version) hashed once."""
+    common = hashlib.sha256(json.dumps({"seed": seed, "model": describe_model(model), "version": version},
+                                       sort_keys=True, default=str).encode())
+
+    def key(task: Task) -> str:
+        digest = common.copy()
+        digest.update(json.dumps([task.params, task.level, task.rep]).encode())
+        return digest.hexdigest()
+
+    return key
+
+
+class ResultStore:
+    """One JSON file per finished task under ``folder/tasks``; writes are atomic."""
+
+    def __init__(self, folder: str | Path) -> None:
+        self.folder = Path(folder) / "tasks"
+
+    def _path(self, key: str) -> Path:
+        return self.folder / f"{key}.json"
+
+    def has(self, key: str) -> bool:
+        return self._path(key).is_file()
+
+    def count(self) -> int:
+        return sum(1 for _ in self.folder.glob("*.json")) if self.folder.is_dir() else 0
+
+    def save(self, key: str, task: Task, result: Mapping[str, Any]) -> None:
+        record = {"key": key, "params": dict(task.params), "level": task.level, "rep": task.rep, **result}
+        write_text(self._path(key), json.dumps(record, sort_keys=True, allow_nan=True))
+
+    def load(self, key: str) -> dict:
+        return json.loads(self._path(key).read_text())
+
+
+def check_writable(folder: str | Path) -> Path:
+    """Create `folder` (and parents) and prove a file can be written in it, else a one-line StudyError."""
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / f".probe-{os.getpid()}"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise StudyError(f"cannot write to output folder {folder} ({reason}); choose another --out") from None
+    return folder
+
+
+#: the file in OUT/tasks naming the study whose tasks the folder holds: its name, then its key
+STUDY_MARK = "STUDY.txt"
+
+
+def prepare_output(folder: str | Path, *, resume: bool, study: tuple[str, str] | None = None) -> Path:
+    """Create the output folder and check it can be written; refuse to overwrite finished results, and refuse
+    `resume` into a folder that holds the tasks of another study. `study`: (name, key) of the study to run
+    (`uq.engine.execution.study_key`), kept in OUT/tasks/STUDY.txt."""
+    folder = Path(folder)
+    store = ResultStore(folder)
+    if not resume and store.count():
+        raise StudyError(f"output folder {folder} already holds task results; pass --resume to continue that study "
+                         "or choose another --out")
+    mark = store.folder / STUDY_MARK
+    if resume and study is not None and mark.is_file():
+        name, key = (mark.read_text().splitlines() + ["", ""])[:2]
+        if key != study[1] and store.count():
+            raise StudyError(f"output folder {folder} holds the tasks of another study ('{name}', key {key[:12]}), not "
+                             f"of '{study[0]}' (key {study[1][:12]}); --resume continues only the same study: choose "
+                             "another --out")
+    check_writable(store.folder)
+    if study is not None:
+        write_text(mark, f"{study[0]}\n{study[1]}\n")
+    for stale in store.folder.glob(".*.json"):  # a temporary file of a write cut off by SIGKILL
+        stale.unlink(missing_ok=True)
+    return folder
+
+
+def evaluate(model: Callable, task: Task, seed: int) -> dict:
+    """Run one task; a diverged simulation or non-finite output is recorded as a failed run."""
+    from sim.common.errors import SimulationDiverged
+
+    start = time.perf_counter()
+    try:
+        outputs = dict(model(dict(task.params), task.level, task.rep, seed))
+        trace = outputs.pop("trace", None)
+        error = ""
+        bad = [k for k, v in outputs.items() if not math.isfinite(v) and k in getattr(model, "banded_outputs", ())]
+        if bad:
+            error = f"non-finite output(s) {', '.join(bad)}"
+    except (SimulationDiverged, FloatingPointError, ZeroDivisionError) as exc:
+        outputs, trace = {name: float("nan") for name in getattr(model, "outputs", ())}, None
+        error = f"{type(exc).__name__}: {exc}"
+    record = {"outputs": outputs, "error": error, "seconds": time.perf_counter() - start}
+    if trace is not None:
+        record["trace"] = trace
+    return record
+
+
+def _same(value: Any) -> Any:
+    return value
+
+
+def _run_one(model: Callable, key: str, task: Task, seed: int) -> tuple[str, dict]:
+    return key, evaluate(model, task, seed)
+
+
+@contextmanager
+def dask_client(scheduler: str | None, client: Any = None) -> Iterator[Any]:
+    """The Dask client of a study, connected once for all its tasks: `client` as given, else a connection to
+    `scheduler` (an unreachable address is a one-line StudyError; closed on exit), else None (local).
+    While it is open, the distributed library's own log lines stay quiet: a lost scheduler is reported once,
+    by `run_tasks`."""
+    if client is not None or scheduler is None:
+        yield client
+        return
+    own = _connect(scheduler)
+    logging.disable(logging.ERROR)  # distributed logs (with tracebacks) every failed reconnection attempt
+    try:
+        yield own
+    finally:
+        try:
+            own.close(timeout=5)
+        except (OSError, TimeoutError):  # a lost scheduler cannot be told goodbye
+            pass
+        finally:
+            logging.disable(logging.NOTSET)
+
+
+def _connect(address: str):
+    """A distributed.Client for `address`, or a one-line StudyError when it cannot be reached."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise StudyError("--scheduler needs dask.distributed: pip install 'ies-workbench[cluster]'") from None
+    try:
+        return Client(address, timeout="5s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise StudyError(f"cannot reach the Dask scheduler at {address} ({type(exc).__name__}); "
+                         "check the address (e.g. tcp://HOST:8786) and that the scheduler is running") from None
+
+
+#: what starting local worker processes costs (s): on C cores they win when the serial work exceeds this x C / (C - 1).
+#: Measured on the 2-core development machine shared with other work (a response study of 2-128 runs, --jobs 1
+#: against 2): below about 20 s of serial work --jobs 2 took 8-12 s longer; at 63 runs (about 75 s serial) it
+#: took 62 s against 73 s; at 127 runs the two were within the load's noise (81 and 94 s). The break-even lies near
+#: 60 s of serial work, hence 30 s.
+PARALLEL_OVERHEAD_S = 30.0
+
+
+def choose_jobs(jobs: int | None, work_s: float, cores: int | None = None, stream: Any = None) -> int:
+    """Worker processes for `work_s` seconds of remaining serial work: `jobs` as given (a warning line on `stream`,
+    stderr, when it exceeds the cores: the runs then compete for them), or with None one per core when the work
+    outweighs the workers' start (PARALLEL_OVERHEAD_S), else 1 (in this process)."""
+    cores = cores or os.cpu_count() or 1
+    stream = stream or sys.stderr
+    if jobs is not None:
+        if jobs > cores:
+            stream.write(f"warning: --jobs {jobs} is more than the {cores} CPU core(s): the runs compete for them and "
+                         f"take longer, not less; use --jobs {cores} or leave it out\n")
+        return jobs
+    if cores == 1:
+        return 1
+    return cores if work_s > PARALLEL_OVERHEAD_S * cores / (cores - 1) else 1
+
+
+def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultStore, *, jobs: int | None = 1,
+              scheduler: str | None = None, progress: bool = True, client: Any = None) -> tuple[dict[Task, dict], int]:
+    """Run every task whose result is not in `store`; return all results by task and how many ran now.
+
+    jobs: local worker processes (joblib/loky; 1 = in this process; None: `choose_jobs` after timing the first task
+    in this process, which also gives the cost estimate of the rest, `sim.stepped_sine.cost.announce_runs`).
+    scheduler: a Dask scheduler address (`client` may be passed instead, e.g. in tests): every task is submitted
+    to the cluster, whatever its size. Each result is saved as it arrives, so an interruption (Ctrl-C, a killed
+    process, a lost scheduler) loses only the tasks in flight; a lost scheduler is one StudyError line that names
+    `--resume`.
+    """
+    from tqdm import tqdm
+
+    if jobs is not None and jobs < 1:
+        raise StudyError(f"--jobs must be >= 1, got {jobs}")
+    version = model.version()
+    keyer = _keyer(model, seed, version)
+    keys = {task: keyer(task) for task in tasks}
+    unique: dict[str, Task] = {}
+    for task, key in keys.items():
+        if key not in unique and not store.has(key):
+            unique[key] = task
+    pending = list(unique.items())
+    total = len(set(keys.values()))
+    bar = tqdm(total=total, initial=total - len(pending), desc="tasks", unit="run",
+               disable=not progress, file=sys.stderr, dynamic_ncols=True)
+    try:
+        if scheduler is not None and client is None:
+            with dask_client(scheduler) as own:
+                _run_and_store(model, pending, seed, jobs, own, store, bar, total)
+        else:
+            _run_and_store(model, pending, seed, jobs, client, store, bar, total)
+    finally:
+        bar.close()
+    return {task: store.load(key) for task, key in keys.items()}, len(pending)
+
+
+def _run_and_store(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int | None, client: Any,
+                   store: ResultStore, bar: Any, total: int) -> None:
+    """Save each result as it arrives; a lost Dask scheduler becomes one StudyError line."""
+    from sim.stepped_sine.cost import announce_runs
+
+    done = total - len(pending)
+    if client is None and pending:  # locally the first task runs here: its time sizes the rest
+        key, task = pending[0]
+        started = time.perf_counter()
+        store.save(key, task, evaluate(model, task, seed))
+        done += 1
+        bar.update(1)
+        pending = pending[1:]
+        per_run = time.perf_counter() - started
+        announce_runs(len(pending), per_run, "interrupt with Ctrl-C and rerun with --resume to go on; fewer levels, "
+                                             "repetitions or points make it shorter")
+        jobs = choose_jobs(jobs, len(pending) * per_run) if pending else 1
+    try:
+        for key, task, result in _dispatch(model, pending, seed, jobs, client):
+            store.save(key, task, result)
+            done += 1
+            bar.update(1)
+    except Exception as exc:
+        if client is None or client.status == "running":
+            raise
+        address = getattr(client.scheduler, "address", "") or "the scheduler"
+        raise StudyError(f"lost the Dask scheduler {address} after {done} of {total} tasks ({type(exc).__name__}); "
+                         f"the finished tasks are kept in {store.folder}: start the scheduler (and workers) again "
+                         "and rerun the same command with --resume") from None
+
+
+def _dispatch(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int,
+              client: Any) -> Iterable[tuple[str, Task, dict]]:
+    """(key, task, result) of every pending task as it finishes: in this process (jobs 1, no client), in `jobs`
+    local processes (joblib/loky) or on a Dask cluster (`client`: one future per task, the model sent once)."""
+    if not pending:
+        return
+    by_key = {k: t for k, t in pending}
+    if client is not None:
+        from distributed import as_completed
+
+        # the model is sent once, as the result of a task rather than scattered data: when the workers holding it
+        # die (a batch job cancelled or out of walltime) the scheduler recomputes it, while scattered data is lost
+        remote_model = client.submit(_same, model, pure=False)
+        keys, tasks = zip(*pending)
+        # one graph update for all tasks (client.map) rather than one message per task
+        waiting = set(client.map(_run_one, [remote_model] * len(keys), keys, tasks, [seed] * len(keys), pure=False))
+        try:
+            for future in as_completed(list(waiting)):
+                key, result = future.result()
+                # forget a finished task at once: a result the client still holds lives on a worker, and when that
+                # worker's job ends the scheduler recomputes it (every finished task, again and again at each
+                # walltime); the result is on disk from here on
+                waiting.discard(future)
+                future.release()
+                yield key, by_key[key], result
+        finally:
+            if client.status == "running" and waiting:
+                client.cancel(list(waiting))
+        return
+    if jobs == 1:
+        for key, task in pending:
+            yield key, task, evaluate(model, task, seed)
+        return
+    from joblib import Parallel, delayed
+
+    calls = (delayed(_run_one)(model, key, task, seed) for key, task in pending)
+    for key, result in Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(calls):
+        yield key, by_key[key], result
