@@ -17,6 +17,9 @@ What is computed (`orbit_response`):
    a wall: the multiplier 1 of its free flight is a Jordan block), but they are the response a sphere at rest
    would keep. Impacting orbits may coexist with them (the sphere's own motion drives the walls). Where no start
    converges and the linear response never reaches the clearance, the level has only these (`impacts` False).
+
+`parameter_branch` follows the two-impact orbit in any other parameter (the higher modes' damping, r_cont, k_H) with
+its bifurcations: where it loses stability, how, where it ends (the fidelity report's stability boundary).
 """
 from __future__ import annotations
 
