@@ -146,7 +146,8 @@ def test_the_walk_sees_every_kind_of_import():
 #: Inside `sim`: sub-package -> the sub-packages it may import (besides itself). The simulator's parts in pipeline
 #: order: the shared layer; the coupled system; the integrators; the stepped-sine protocol and its measures; the host
 #: models (their fidelity variants read the measures' landmarks); signal analysis; the reduced (slow-flow) model;
-#: figures. `sim` itself (its lazy public names) and `sim.cli` (the commands) may import every part.
+#: the periodic orbits of the full model (they start from the slow flow's); figures. `sim` itself (its lazy public
+#: names) and `sim.cli` (the commands) may import every part.
 SIM_LAYERS: dict[str, set[str]] = {
     "common": set(),
     "model": {"common"},
@@ -155,6 +156,7 @@ SIM_LAYERS: dict[str, set[str]] = {
     "hosts": {"common", "model", "stepped_sine"},
     "analysis": {"common", "model", "integration", "stepped_sine", "hosts"},
     "reduced": {"common", "model", "integration", "stepped_sine", "hosts"},
+    "orbits": {"common", "model", "integration", "stepped_sine", "hosts", "reduced"},
     "plots": {"common", "model", "stepped_sine", "analysis"},
 }
 #: The written-down exceptions: (importing module, the part it may also import) with the reason.
