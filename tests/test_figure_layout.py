@@ -680,3 +680,18 @@ def test_an_unreliable_sobol_index_is_not_drawn_as_a_valid_one(tmp_path, monkeyp
     legend = [t.get_text().replace("\n", " ") for t in fig.axes[0].get_legend().get_texts()]
     assert any(text.startswith("NOT SMOOTH: index unreliable") for text in legend)
     assert not layout_problems(fig)
+
+
+def test_overlapping_ranges_of_mean_and_max_stay_apart(tmp_path, monkeypatch):
+    """At a strongly modulated level the runs' ranges of the resonant mean and max overlap (the rig's Fig. 6 at 5.3:
+    mean 0.05-0.20, max 0.08-0.25 a_noabs*): drawn side by side, neither bar hides the other, and the optimum's line
+    starts above them."""
+    data = overview()
+    i = LEVELS.index(5.3)
+    for key, value in (("resonant_mean", 0.10), ("resonant_mean_lo", 0.05), ("resonant_mean_hi", 0.20),
+                       ("resonant_max", 0.15), ("resonant_max_lo", 0.08), ("resonant_max_hi", 0.245)):
+        data[key][i] = value
+    found = []
+    monkeypatch.setattr(sim.common.files, "save_figure", lambda fig, path: found.append(layout_problems(fig)))
+    sim.plots.figures.plot_overview(data, tmp_path / "fig6.png", "overlapping ranges", paper_optimum=True)
+    assert found == [[]]
