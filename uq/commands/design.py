@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Any
 
 from sim.common.options import positive_int
+from sim.model.parameters import PARAMETERS
 from uq.commands.study import add_run_arguments, engine
 
 DESIGN_HELP = ("choose the clearance and the sphere (radius, material) for a host structure: the worst case of the "
@@ -20,7 +21,10 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--excitation", metavar="RANGE",
                         help="operating base amplitudes START:STOP[:COUNT] with units (e.g. 0.66um:6.6um:10) or base "
                              "accelerations (0.5m/s2:2m/s2); required")
-    parser.add_argument("--clearance", metavar="RANGE", help="clearances to consider (default 0.3mm:1.2mm:10)")
+    flags = sorted(PARAMETERS["g"].option.flags, key=lambda flag: flag != "--clearance")  # the clearance's names
+    parser.add_argument(*flags, dest="clearance", metavar="RANGE",
+                        help=f"clearances to consider (default 0.3mm:1.2mm:10); also {', '.join(flags[1:])} (the "
+                             "same quantity as in ies sweep)")
     parser.add_argument("--radius", metavar="RANGE", help="sphere radii (default the paper's 7.92mm)")
     parser.add_argument("--material", metavar="LIST", help="sphere materials, comma separated: brass, steel, tungsten "
                                                            "(default brass)")

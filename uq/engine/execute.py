@@ -512,7 +512,7 @@ def run_response_study(study: Study, *, out: Path | None = None, jobs: int | Non
     amplitude per eta with the spread of the runs, Sect. 5.2) and its resonant levels (Sect. 5.3), every
     stepped-sine run a task of the store (resumable, parallel, on a cluster)."""
     from sim.stepped_sine.tables import OVERVIEW_COLUMNS, SWEEP_COLUMNS, overview_data, overview_rows, sweep_rows
-    from sim.hosts.variants import landmarks
+    from sim.stepped_sine.landmarks import landmarks
 
     if study.series:
         return _run_response_series(study, out=out, jobs=jobs, scheduler=scheduler, resume=resume, progress=progress,
@@ -612,7 +612,7 @@ def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: 
     import csv
     import dataclasses
 
-    from sim.plots.figures import plot_motion
+    from sim.plots.figures import plot_motion, plot_trace
     from uq.outputs.figures import series_label
     from sim.analysis.trace import record_trace, write_trace
 
@@ -636,7 +636,7 @@ def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: 
         out.mkdir(parents=True, exist_ok=True)
         settings = {"integrator": visit.integrator, "seed": study.seed, "protocol": dataclasses.asdict(visit),
                     "series": sub, "study": study.name}
-        _, paths = write_trace(out, trace, settings, out / "trace.png")
+        _, paths = write_trace(out, trace, settings, out / "trace.png", draw=plot_trace)
         title = (f"{series_label(sub)}: $a_\\mathrm{{base}}/a_\\mathrm{{base}}^*$ = {level:g}, $\\eta$ = {trace.eta_actual:.4f} "
                  "(cf. Fig. C.1b), "
                  f"{trace.amplitudes.size} periods")
