@@ -1,4 +1,5 @@
-"""The simulation stage's words of the `ies` command line: `modes`, `sweep`, `overview`, `trace`.
+"""The simulation stage's words of the `ies` command line (`COMMANDS`): `modes`, `sweep`, `overview`, `trace`, and
+`impacts`, `modal-fit` from `sim.analysis.cli`.
 
 * `ies modes`: the modal model of the host structure (seed paper Sect. 3.1, Eq. 7, Appendix A), the built-in
   model of the seed rig (`sim.hosts.rig`) or a modal-model file (`sim.hosts.modal_file`); --save writes it as a file.

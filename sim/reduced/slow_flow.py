@@ -1,7 +1,7 @@
 r"""One-mode slow flow of the IES on a flexible host: the symmetric 1:1 orbit with two impacts per period
 (one per wall), its existence and stability, the predicted switch from strongly modulated (SMR) to almost
 periodic response (APR), a vectorised screening of designs, and the map of which orbits exist and are stable
-(issue 28, "Slow flow", "Which orbit the resonance sits on").
+(`ies design`'s screening).
 
 Source followed
 ---------------
@@ -66,7 +66,7 @@ A^ = A/g, tau = omega t, eta = Omega/omega, b = a_base/g.
     (one run at a_base/a_base* = 7.5, eta 0.96:1.0:21 up): with mode 1 alone the response is almost periodic
     with 2.0 significant impacts per period for eta = 0.960-0.970 and its resonant maximum at eta = 0.980 has
     3.7; the rig (9 modes) is almost periodic only at 0.972-0.980, maximum at 0.980 with 4.0. The maximum thus
-    sits beyond the symmetric two-impact orbit's stable range, on a multi-impact branch (issue 28).
+    sits beyond the symmetric two-impact orbit's stable range, on a multi-impact branch.
 
 Accuracy (tests/sim/reduced/test_slow_flow.py): against the exact orbit of the one-mode Newton model at the rig's eps
 the slow flow is within 0.15 % in tip amplitude and 0.003 rad in impact phase (the recoil terms of (2)-(4b)
@@ -476,7 +476,7 @@ class Screening:
 def screen(host: HostMode, clearances: np.ndarray, masses: np.ndarray | None, a_base: np.ndarray, r: float,
            eta_range: tuple[float, float] | None = None, *, radii: np.ndarray | None = None,
            density: float | None = None) -> Screening:
-    """Vectorised screening of designs (issue 28, `ies design`): for every clearance g (m), sphere mass m_a (kg)
+    """Vectorised screening of designs (`ies design`): for every clearance g (m), sphere mass m_a (kg)
     and base amplitude a_base (m) the predicted resonant tip amplitude (m) and regime.
 
     linear: the wall's linear resonant amplitude stays below g (no impacts), tip from the mode's frequency
@@ -643,7 +643,7 @@ def exact_orbit(model: SlowFlowModel, level: float, eta: float, guess: TwoImpact
                       multipliers=multipliers)
 
 
-# --- Which symmetric two-impact orbits exist and are stable against level and frequency (issue 28) ---------
+# --- Which symmetric two-impact orbits exist and are stable against level and frequency ---------------------
 
 #: `orbit_map` codes per (level, eta) cell, for the symmetric two-impact orbit of the one-mode Newton model.
 NO_ORBIT, STABLE, SYMMETRY_BREAKING, SADDLE = "none", "stable", "symmetry-breaking", "saddle"

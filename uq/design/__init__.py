@@ -1,4 +1,4 @@
-"""Design of an IES for a user's structure under uncertainty (issue 28, `ies design`): which clearance g and which
+"""Design of an IES for a user's structure under uncertainty (`ies design`): which clearance g and which
 sphere (radius R, material) keep the resonant tip amplitude lowest over an operating range of base excitation, in
 the worst case over the uncertain D_1, clearance tolerance and k_H factor (Table 2's intervals by default).
 
