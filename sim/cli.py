@@ -267,6 +267,7 @@ def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     from sim.model.system import build_system as build
 
     integrator = integrator_named(args.integrator)
+    integrator.run_step(dt_scale=args.dt_scale)  # a step scale it does not take: one line, before any work
     model = resolve_host(args).model
     values = {name: getattr(args, name, None) for name in PARAMETERS}
     settings = system_settings(values, SystemSettings(contact_law=args.contact_law))

@@ -283,10 +283,10 @@ def build_system(model: ModalModel, settings: SystemSettings, *, integrator: Any
     if settings.D1 is not None:
         model = model.with_damping(settings.D1)
     impactor = build_impactor(settings)
-    if impactor.contact_law.dissipative or impactor.friction > 0:
-        system_arrays(model, impactor)  # beam mass (Eq. 10) and phi_floor (friction): one line if missing
     if integrator is not None:
         integrator.check(impactor)
+    if impactor.contact_law.dissipative or impactor.friction > 0:
+        system_arrays(model, impactor)  # beam mass (Eq. 10) and phi_floor (friction): one line if missing
     return model, impactor
 
 

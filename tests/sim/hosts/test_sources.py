@@ -9,7 +9,6 @@ Files a new host source touches: the file that defines it (here this test) and t
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 from pathlib import Path
 
@@ -18,6 +17,7 @@ import pytest
 
 from sim.hosts.sources import HOST_SOURCES, HostModel, HostSource
 from sim.model.system import ModalModel
+from tests.support import interval_runs, tiny_design
 from uq.cli import main
 
 
@@ -106,14 +106,8 @@ def test_a_host_source_reaches_a_study_by_its_files(beam3_row, tmp_path) -> None
 
     beam = tmp_path / "rig.beam3"
     beam.write_text("117.4")
-    study = tmp_path / "beam.toml"
-    study.write_text("[study]\nkind = 'interval'\nrepetitions = 1\nmodal_model = 'rig.beam3'\n[parameters.D]\n"
-                     "[excitation]\nlevels = [7.4]\neta = { start = 0.98, stop = 0.99, n = 2 }\nwait = 0.02\n"
-                     "hold = 0.05\n[interval]\ninterior = 0\n")
-    out = tmp_path / "o"
-    assert main(["interval", str(study), "--out", str(out), "--quiet", "--jobs", "1", "--no-figures"]) == 0
-    with open(out / "runs.csv", newline="") as fh:
-        assert {float(r["D"]) for r in csv.DictReader(fh)} == {0.00075, 0.00085, 0.0009}  # its ends and the nominal point
+    _, runs = interval_runs(tmp_path, "modal_model = 'rig.beam3'\n[parameters.D]\n")
+    assert {float(r["D"]) for r in runs} == {0.00075, 0.00085, 0.0009}  # its ends and the nominal point
     rig = make_model("ies", modal_model=beam).with_rig().rig
     assert rig.source == "toy beam3 file rig.beam3" and rig.frequencies_hz[0] == 117.4
 
@@ -121,13 +115,7 @@ def test_a_host_source_reaches_a_study_by_its_files(beam3_row, tmp_path) -> None
 def test_a_host_source_reaches_the_design_by_its_files(beam3_row, tmp_path) -> None:
     beam = tmp_path / "rig.beam3"
     beam.write_text("117.4")
-    study = tmp_path / "design.toml"
-    study.write_text(f"[study]\nkind = 'design'\noutput = '{tmp_path / 'out'}'\n[design]\nexcitation = '3um'\n"
-                     f"clearance = '0.5mm:0.6mm:2'\nradius = '7.92mm'\ncandidates = 1\nreps = 1\nmodel = '{beam}'\n"
-                     "[excitation]\neta = { start = 0.98, stop = 0.99, n = 2 }\nwait = 0.02\nhold = 0.05\n")
-    assert main(["design", str(study), "--jobs", "1", "--quiet", "--no-figures"]) == 0
-    data = json.loads((tmp_path / "out" / "design.json").read_text())
+    data = tiny_design(tmp_path, beam)
     # the structure without IES is the toy's: phi_tip phi^T M b a_base / (2 D_1) at the lower end of D (Sect. 5)
     assert data["no_absorber"]["tip_m"] == pytest.approx([1.0 * 0.95 * 3e-6 / (2 * 0.00075)], rel=1e-14)
     assert data["host"]["omega_1_rad_per_s"] == pytest.approx(2 * np.pi * 117.4, rel=1e-12)
-

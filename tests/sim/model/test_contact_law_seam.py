@@ -14,7 +14,6 @@ Files a law with a constant of its own touches: the file that defines it (here t
 """
 from __future__ import annotations
 
-import csv
 import json
 import math
 
@@ -31,6 +30,7 @@ from sim.model import contact_law
 from sim.model.contact_law import LAWS, ContactLaw, ImpactReference, Law, contact_law_of, register
 from sim.model.parameters import PARAMETERS, CliOption, Feed, UncertainParameter
 from sim.model.system import Impactor, ModalModel, a_base_star, system_arrays
+from tests.support import interval_runs
 
 K_SPRING = 4e6  # N/m: a contact of ~0.3 ms on the sphere, a few steps of ode3 at its paper step
 
@@ -223,17 +223,7 @@ def test_the_toy_law_and_its_constant_through_ies_sweep(spring, model_file, caps
 
 def test_a_study_varies_the_laws_constant(spring, model_file, tmp_path):
     """An interval study lists the constant under its study key and runs it end to end (`ies interval`)."""
-    from uq.cli import main
-
-    study = tmp_path / "spring.toml"
-    study.write_text(f"[study]\nkind = 'interval'\nrepetitions = 1\ncontact_law = 'linear-spring'\n"
-                     f"modal_model = '{model_file}'\n[parameters.k_lin]\nmin = '2kN/mm'\nmax = '8kN/mm'\n"
-                     "[excitation]\nlevels = [7.4]\neta = { start = 0.98, stop = 0.99, n = 2 }\nwait = 0.02\n"
-                     "hold = 0.05\n[interval]\ninterior = 0\n")
-    out = tmp_path / "o"
-    assert main(["interval", str(study), "--out", str(out), "--quiet", "--jobs", "1", "--no-figures"]) == 0
-    with open(out / "runs.csv", newline="") as fh:
-        runs = list(csv.DictReader(fh))
+    _, runs = interval_runs(tmp_path, f"contact_law = 'linear-spring'\nmodal_model = '{model_file}'\n"
+                                      "[parameters.k_lin]\nmin = '2kN/mm'\nmax = '8kN/mm'\n")
     assert {float(r["k_lin_N_per_m"]) for r in runs} == {2e6, K_SPRING, 8e6}  # its ends and its nominal value
     assert len({r["mean"] for r in runs}) > 1
-

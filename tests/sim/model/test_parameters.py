@@ -12,7 +12,6 @@ Files a new physical input touches: the file that defines its row (here this tes
 """
 from __future__ import annotations
 
-import csv
 import json
 import math
 from dataclasses import replace
@@ -22,6 +21,7 @@ import pytest
 from sim.common.units import LENGTH_UNITS, Quantity
 from sim.model.parameters import (CLEARANCE_NOMINAL, K_H_NOMINAL, PARAMETERS, SPHERE_MASS, SPHERE_RADIUS, CliOption,
                                   Feed, Spread, SystemSettings, UncertainParameter, register_parameter)
+from tests.support import interval_runs, tiny_design
 from uq.cli import main
 
 
@@ -89,14 +89,7 @@ def test_a_new_input_reaches_the_impactor_through_ies_sweep(undersize, model_fil
 
 
 def test_a_study_varies_the_new_input(undersize, model_file, tmp_path):
-    study = tmp_path / "undersize.toml"
-    study.write_text(f"[study]\nkind = 'interval'\nrepetitions = 1\nmodal_model = '{model_file}'\n"
-                     "[parameters.undersize]\nmax = '5um'\n[excitation]\nlevels = [7.4]\n"
-                     "eta = { start = 0.98, stop = 0.99, n = 2 }\nwait = 0.02\nhold = 0.05\n[interval]\ninterior = 0\n")
-    out = tmp_path / "o"
-    assert main(["interval", str(study), "--out", str(out), "--quiet", "--jobs", "1", "--no-figures"]) == 0
-    with open(out / "runs.csv", newline="") as fh:
-        runs = list(csv.DictReader(fh))
+    out, runs = interval_runs(tmp_path, f"modal_model = '{model_file}'\n[parameters.undersize]\nmax = '5um'\n")
     assert sorted({float(r["dR_m"]) for r in runs}) == pytest.approx([0.0, 5e-6], rel=1e-15)
     meta = json.loads((out / "study.json").read_text())
     assert meta["study"]["parameters"]["dR"]["label"] == "sphere undersize dR"
@@ -112,10 +105,5 @@ def test_the_designs_box_gains_the_new_inputs_dimension(undersize, model_file, t
     points = problem.corners(sphere)
     assert len(points) == 17 and {p["dR"] for p in points[:-1]} == {0.0, 5e-6} and points[-1]["dR"] == 2.5e-6
     assert {p["g"] for p in points[:-1]} == {0.58e-3, 0.58e-3 + 0.032e-3}
-    study = tmp_path / "design.toml"
-    study.write_text(f"[study]\nkind = 'design'\noutput = '{tmp_path / 'out'}'\n[design]\nexcitation = '3um'\n"
-                     f"clearance = '0.5mm:0.6mm:2'\nradius = '7.92mm'\ncandidates = 1\nreps = 1\nmodel = '{model_file}'\n"
-                     "[excitation]\neta = { start = 0.98, stop = 0.99, n = 2 }\nwait = 0.02\nhold = 0.05\n")
-    assert main(["design", str(study), "--jobs", "1", "--quiet", "--no-figures"]) == 0
-    data = json.loads((tmp_path / "out" / "design.json").read_text())
+    data = tiny_design(tmp_path, model_file)
     assert data["verified"] and all(v["runs"] == 17 for v in data["verified"])
