@@ -31,10 +31,12 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--model", metavar="FILE", help="the host as a modal-model file (default: the built-in rig)")
     parser.add_argument("--objective", choices=("mean", "max"), help="the amplitude whose worst case is minimised: "
                                                                      "the resonant mean (default) or max")
-    parser.add_argument("--damping", metavar="LOW:HIGH", help="interval of D_1 (default Table 2: 0.00075:0.0009)")
+    D, g, k_H = (PARAMETERS[name].spread for name in ("D", "g", "k_H"))  # Table 2's intervals (the one vocabulary)
+    parser.add_argument("--damping", metavar="LOW:HIGH", help=f"interval of D_1 (default Table 2: {D.low:g}:{D.high:g})")
     parser.add_argument("--clearance-tolerance", metavar="LOW:HIGH",
-                        help="tolerance added to each clearance (default Table 2: 0:0.032mm)")
-    parser.add_argument("--k-H-factor", metavar="LOW:HIGH", help="factor on Eq. 8's k_H (default Table 2: 1:1.518)")
+                        help=f"tolerance added to each clearance (default Table 2: {g.low * 1e3:g}:{g.high * 1e3:g}mm)")
+    parser.add_argument("--k-H-factor", metavar="LOW:HIGH",
+                        help=f"factor on Eq. 8's k_H (default Table 2: {k_H.low:g}:{k_H.high:.4g})")
     parser.add_argument("--calibration", metavar="FILE",
                         help="`ies calibrate --json` output: its k_H / k_H* becomes the upper end of the k_H factor "
                              "(the crater's stiffening, as `ies reproduce` uses it)")

@@ -192,7 +192,9 @@ class IESModel:
         from sim.model.contact_law import law_named
         from sim.model.system import build_system
 
-        point = {"g": 1e-3, "k_H": 1e9, **params}
+        from sim.model.parameters import table2_parameters
+
+        point = {**{row.name: row.nominal for row in table2_parameters()}, **params}
         if not law_named(self._law_name()).takes_r_cont and point.get("friction", 0.0) == 0.0:
             return  # only Eq. 10 (the beam mass) and friction (the floor values) ask more of the model
         try:
