@@ -20,8 +20,8 @@ about 1 %; protocol, progress, tables and files below 1 %. The quadrature's arit
 change of its code (even inlining it) changes the last bits of the dissipation columns, which must stay bit for bit.
 
 Targets: the house's own cost, the command against its integrator's calls with the ledger, at most 10 % (asserted);
-the issue's target, the command against the bare integrator within 10 %, printed beside it (exact: 1.10-1.13, not
-met, the ledger's quadrature above; ode3 1.01).
+the issue's target, the command against the bare integrator within 10 %, printed beside it (exact: not met, the
+ledger's quadrature above; ode3: met).
 
 Run: pytest -m benchmark tests/benchmarks/test_sweep_overhead.py -s
 """
