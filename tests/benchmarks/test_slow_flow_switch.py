@@ -1,5 +1,5 @@
 """Check (c) of issue 28: the slow flow's predicted SMR -> APR switch (`sim.reduced.slow_flow.switch_level`,
-Eq. 9) against the full simulator's (`sim.stepped_sine.protocol.sweep`, landmarks of `sim.hosts.variants`) on five designs: the
+Eq. 9) against the full simulator's (`sim.stepped_sine.protocol.sweep`, landmarks of `sim.stepped_sine.landmarks`) on five designs: the
 paper's rig at g*, 0.5 g*, 2 g*, and a sphere half and twice as heavy (same k_H, Eq. 4 contact).
 
 Protocol as the fidelity studies (uq/studies/fidelity/baseline.toml): eta 0.96:1.0:21 up, 3 s wait, 5 s hold,
@@ -27,7 +27,7 @@ from sim.stepped_sine.protocol import SteppedSine, sweep
 from sim.reduced.slow_flow import SlowFlowModel, apr_branch, host_mode, switch_level
 from sim.hosts.rig import seed_rig_model
 from sim.model.system import CLEARANCE_NOMINAL, SPHERE_MASS, Impactor, Nominal
-from sim.hosts.variants import landmarks
+from sim.stepped_sine.landmarks import landmarks
 
 pytestmark = pytest.mark.benchmark
 LEVELS = np.arange(2.0, 9.01, 0.5)

@@ -89,13 +89,9 @@ def candidates(problem: DesignProblem, screened: Screened) -> list[Sphere]:
 
 def corners(problem: DesignProblem, sphere: Sphere) -> list[dict[str, float]]:
     """The uncertainty box of one design as task parameters (D, g, k_H, m_a in SI): its 8 corners, then the nominal
-    point (D's midpoint, the clearance and k_H of the design) for the monotonicity check."""
-    points = [{"D": D, "g": sphere.clearance + tol, "k_H": f * sphere.k_H, "m_a": sphere.mass}
-              for D in problem.D for tol in problem.clearance_tolerance for f in problem.k_H_factor]
-    nominal = {"D": 0.5 * sum(problem.D), "g": sphere.clearance + 0.5 * sum(problem.clearance_tolerance),
-               "k_H": 0.5 * sum(problem.k_H_factor) * sphere.k_H, "m_a": sphere.mass}
-    unique = {tuple(sorted(p.items())): p for p in points}
-    return [*unique.values(), nominal]
+    point (D's midpoint, the clearance and k_H of the design) for the monotonicity check; built from the parameter
+    rows (`DesignProblem.corners`)."""
+    return problem.corners(sphere)
 
 
 
