@@ -366,7 +366,9 @@ def interval_folder(folder: Path, output: str = "mean", levels: list[float] = LE
     """An interval study's files (study.json, points.csv, bands.csv): individual, joint and residual designs."""
     folder.mkdir(parents=True, exist_ok=True)
     outputs = ["mean", "max"] if output == "mean" else [output]
-    study = {"kind": "interval", "model": "ies", "repetitions": 3, "levels": levels, "parameters": PARAMETERS}
+    study = {"kind": "interval", "model": "ies", "repetitions": 3, "levels": levels,
+             "parameters": {**PARAMETERS, "_extras": {"k_H_best_estimate": 1.25 * K_H_STAR_SI}},
+             "interval": {"fix": {"k_H": 1.25 * K_H_STAR_SI}}}
     (folder / "study.json").write_text(json.dumps({"study": study, "outputs": outputs}))
     points, bands = [], []
     for level, regime in zip(levels, regimes):
@@ -387,6 +389,10 @@ def interval_folder(folder: Path, output: str = "mean", levels: list[float] = LE
     _write(folder / "points.csv", points)
     _write(folder / "bands.csv", bands)
     return folder
+
+
+#: k_H* of Table 2 in N/m^1.5 (282e3 N/mm^1.5)
+K_H_STAR_SI = 282e3 * 1e3**1.5
 
 
 def _band_row(design: str, output: str, level: float, lower: float, upper: float, nominal: float) -> dict:
@@ -670,8 +676,8 @@ def test_an_unreliable_sobol_index_is_not_drawn_as_a_valid_one(tmp_path, monkeyp
     unreliable_x = 1  # the level 6.7, the second tick
     bars = [p for p in ax.patches if isinstance(p, Rectangle) and p.get_gid() is None and p.get_height() != 0
             and abs(p.get_x() + p.get_width() / 2 - unreliable_x) < 0.45 and p.get_width() < 0.4]
-    others = [p for p in ax.patches if isinstance(p, Rectangle) and p.get_width() < 0.4 and p.get_height() != 0
-              and abs(p.get_x() + p.get_width() / 2 - unreliable_x) >= 0.45]
+    others = [p for p in ax.patches if isinstance(p, Rectangle) and p.get_gid() is None and p.get_width() < 0.4
+              and p.get_height() != 0 and abs(p.get_x() + p.get_width() / 2 - unreliable_x) >= 0.45]
     assert len(bars) == 2 * len(PARAMETERS) and all(not p.get_fill() and p.get_hatch() == "xx" for p in bars)
     assert others and all(p.get_fill() for p in others)
     whiskers = [seg for label, segs in _error_bars(ax) for seg in segs]
@@ -695,3 +701,38 @@ def test_overlapping_ranges_of_mean_and_max_stay_apart(tmp_path, monkeypatch):
     monkeypatch.setattr(sim.common.files, "save_figure", lambda fig, path: found.append(layout_problems(fig)))
     sim.plots.figures.plot_overview(data, tmp_path / "fig6.png", "overlapping ranges", paper_optimum=True)
     assert found == [[]]
+
+
+def test_box_figures_name_the_fixed_value_and_keep_r_on_its_scale(checked):
+    """Fig. 8's residual band says where k_H is fixed (its best estimate, in N/mm^1.5); Fig. D.3's axis shows r from
+    0.5 to 1 at least, not a magnified 0.80-0.90."""
+    fig8 = checked(draw_interval)["fig8.png"]
+    assert any("$k_H$ = 352$\\times 10^3$" in text and "(its best estimate)" in text for text in fig8["legend"])
+    (low, high), = checked(draw_interval_restitution)["figD3.png"]["ylim"]
+    assert low <= 0.5 and high >= 1.0
+
+
+def test_sobol_axis_is_the_range_of_an_index_and_the_noise_share_a_bar_of_its_own(checked, tmp_path, monkeypatch):
+    """Indices inside [0, 1] get an axis of [0, 1] (the wider one only where an estimate leaves it, see above); the
+    noise share is a bar beside the indices' bars, never a marker on them."""
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
+
+    folder = sobol_folder(tmp_path / "s")
+    rows = [{**r, "S1": 0.3, "S1_conf": 0.05, "ST": 0.35, "ST_conf": 0.05}
+            for r in csv.DictReader(open(folder / "sobol.csv"))]
+    _write(folder / "sobol.csv", rows)
+    drawn = {}
+    monkeypatch.setattr(uq.outputs.figures, "save_figure", lambda fig, path: drawn.setdefault("fig", fig) and Path(path))
+    uq.outputs.figures.sobol_figure(folder, PlotOptions(formats=(".png",)))
+    ax = drawn["fig"].axes[0]
+    low, high = ax.get_ylim()
+    assert -0.05 <= low <= 0.0 and 1.0 <= high <= 1.1
+    bars = [b for b in ax.patches if isinstance(b, Rectangle) and b.get_height() > 0 and b.get_width() < 1]
+    noise = [b for b in bars if b.get_gid() == "noise-share"]
+    assert noise, "the noise share is drawn as bars"
+    spans = sorted((b.get_x(), b.get_x() + b.get_width()) for b in bars)
+    assert all(a1 <= b0 + 1e-9 for (a0, a1), (b0, b1) in zip(spans, spans[1:])), "bars overlap"
+    assert not [line for line in ax.lines if line.get_marker() not in (None, "None", "", " ") and line.get_xdata().size
+                and "noise" in str(line.get_label())]
+    plt.close(drawn["fig"])

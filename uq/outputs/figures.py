@@ -205,6 +205,28 @@ def _level_step(levels: np.ndarray) -> float:
     return float(np.min(np.diff(unique))) if unique.size > 1 else 1.0
 
 
+#: the y range a restitution's band figure shows at least (Eq. D.1: r in (0, 1]; the paper's r ~ 0.8 inside)
+_RESTITUTION_AXIS = {"restitution": (0.5, 1.0), "restitution_wall": (0.5, 1.0)}
+
+
+def residual_label(study: dict) -> str:
+    """The residual band's legend entry with the values its parameters are fixed at ('residual: $k_H$ = 352x10^3
+    N/mm^1.5 fixed (its best estimate)')."""
+    fixed = study.get("interval", {}).get("fix", {})
+    best = study.get("parameters", {}).get("_extras", {}).get("k_H_best_estimate")
+    parts = [parameter_text(name, value) + " fixed" + (" (its best estimate)" if name == "k_H" and best is not None
+                                                       and np.isclose(value, best, rtol=1e-9) else "")
+             for name, value in fixed.items()]
+    return "residual: " + ", ".join(parts) if parts else "residual"
+
+
+def _unresolved_levels(band: dict, z: float = 2.0) -> list[float]:
+    """Levels whose band is narrower than z combined standard errors of its edges (the band is noise there)."""
+    width = band["upper"] - band["lower"]
+    noise = z * np.hypot(np.nan_to_num(band["lower_se"]), np.nan_to_num(band["upper_se"]))
+    return [float(lv) for lv, w, n in zip(band["level"], width, noise) if np.isfinite(w) and w < n]
+
+
 #: the joint-band figure of a banded output: (file stem, title, a level of the paper to mark (value, label) or None)
 BoxFigure = tuple[str, str, "tuple[float, str] | None"]
 
@@ -274,7 +296,7 @@ def interval_figures(folder: str | Path, options: PlotOptions | None = None, *, 
     if box:
         fig, ax = plt.subplots(figsize=(9.5, 4.8), layout="constrained")
         styles = {"joint": ("C0", 0.25, None, "all parameters (joint)"),
-                  "residual": ("C1", 0.0, "////", "residual, $k_H$ fixed at its best estimate")}
+                  "residual": ("C1", 0.0, "//", residual_label(meta["study"]))}
         step = _level_step(np.array([float(r["level"]) for r in bands]))
         if not discrete:
             shade_regimes(ax, list(regimes), list(regimes.values()))
@@ -292,11 +314,17 @@ def interval_figures(folder: str | Path, options: PlotOptions | None = None, *, 
             ax.axhline(reference[0], color="k", lw=1, ls="-.", alpha=0.6, label=reference[1])
         if discrete:
             ax.set_xticks(np.unique(band["level"]))
+        if output in _RESTITUTION_AXIS:  # r is a share of a rebound speed: shown from 0.5 to 1, not magnified noise
+            bottom, top = _RESTITUTION_AXIS[output]
+            ax.set_ylim(min(bottom, ax.get_ylim()[0]), max(top, ax.get_ylim()[1]))
+        unresolved = sorted({lv for d in box for lv in _unresolved_levels(_band(bands, d, output))})
+        box_notes = notes + (f"\nat {', '.join(f'{lv:g}' for lv in unresolved)} a band is narrower than the noise of "
+                             "its edges (2 SE): not resolved" if unresolved else "")
         ax.set_xlabel(LEVEL_LABEL)
         ax.set_ylabel(_YLABEL.get(output, output))
         ax.set_title(title, fontsize=10)
         ax.grid(alpha=0.3)
-        legend_beside(ax, title=notes)
+        legend_beside(ax, title=box_notes)
         paths += _save(fig, folder, stem, options)
         plt.close(fig)
 
@@ -331,9 +359,10 @@ _SOBOL_RANGE = (-0.25, 1.25)
 
 
 def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list[Path]:
-    """S1 and ST (with confidence bars) per parameter vs level, and the noise share, per output. The y axis shows
-    [-0.25, 1.25] around the indices' range [0, 1]; an estimate or interval end beyond it (sampling error of a
-    small n) is marked by a triangle at the edge, and the legend says so and what to do (a larger [sobol] n)."""
+    """S1 and ST (with confidence bars) per parameter vs level, and the noise share as a bar of its own, per output.
+    The y axis shows the indices' range [0, 1]; where an estimate or interval end leaves it (sampling error of a
+    small n) the axis widens to [-0.25, 1.25], an end beyond that is marked by a triangle at the edge, and the
+    legend says so and what to do (a larger [sobol] n)."""
     folder = Path(folder)
     options = options or PlotOptions()
     plt = pyplot()
@@ -349,20 +378,25 @@ def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list
              if r.get("smooth") == "0"}
     fig, axes = plt.subplots(1, len(outputs), figsize=(5.5 * len(outputs) + 3.0, 4.0), squeeze=False,
                              layout="constrained")
-    lo, hi = _SOBOL_RANGE
     for ax, o in zip(axes[0], outputs):
         sub = [r for r in rows if r["output"] == o]
         levels = sorted({float(r["level"]) for r in sub})
         names = list(dict.fromkeys(r["parameter"] for r in sub))
-        width = 0.8 / (2 * len(names))
+        width = 0.8 / (2 * len(names) + 1)  # S1 and ST of every parameter, then the noise share, side by side
         x = np.arange(len(levels))
+        every = np.array([float(r[f"{i}"]) + s * float(r[f"{i}_conf"]) for r in sub for i in ("S1", "ST")
+                          for s in (-1, 1)])
+        every = every[np.isfinite(every)]
+        # [0, 1] (the range of an index) unless an estimate or interval leaves it: then up to _SOBOL_RANGE
+        lo = _SOBOL_RANGE[0] if every.size and every.min() < -0.02 else -0.02
+        hi = _SOBOL_RANGE[1] if every.size and every.max() > 1.02 else 1.05
         beyond = False
         for k, pname in enumerate(names):
             pr = sorted((r for r in sub if r["parameter"] == pname), key=lambda r: float(r["level"]))
             for m, (idx, hatch) in enumerate((("S1", ""), ("ST", "//"))):
                 vals = np.array([float(r[idx]) for r in pr])
                 errs = np.array([float(r[f"{idx}_conf"]) for r in pr])
-                at = x + (2 * k + m - len(names)) * width + width / 2
+                at = x + (2 * k + m - len(names) - 0.5) * width + width / 2
                 # the whiskers end at the axis edge where they would run on (marked there by a triangle)
                 shown = np.array([np.clip(np.minimum(errs, vals - lo), 0, None),
                                   np.clip(np.minimum(errs, hi - vals), 0, None)])
@@ -380,7 +414,8 @@ def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list
                                 marker=marker, color="k", ms=5)
         noise = [float(r["noise_share"]) for r in sorted((r for r in var if r["output"] == o),
                                                          key=lambda r: float(r["level"]))]
-        ax.plot(x, noise, "kd:", label="noise share of the variance")
+        ax.bar(x + (len(names) - 0.5) * width + width / 2, noise, width, color="0.55", edgecolor="0.3", lw=0.6,
+               label="noise share of the variance", gid="noise-share")
         ax.axhspan(0.0, 1.0, color="0.9", zorder=0, lw=0, label="range of an index, [0, 1]")
         if beyond:
             ax.plot([], [], "k^", ls="none", ms=5,

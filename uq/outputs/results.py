@@ -140,12 +140,13 @@ def _with_se(value: float, se: float) -> str:
 def band_checks(row: dict) -> str:
     """The checks of one row of bands.csv in words: the monotonicity check (ok, failed: band widened, not tested)
     and where the nominal value lies outside the band (beyond or within the noise)."""
-    words = ["not tested" if row["tested"] == "0" else ("NOT MONOTONE (band widened)" if row["flagged"] == "1" else "ok")]
+    words = ["monotonicity not tested" if row["tested"] == "0" else
+             ("NOT MONOTONE (band widened)" if row["flagged"] == "1" else "monotone")]
     nominal, lower, upper = (float(row[k]) for k in ("nominal", "lower", "upper"))
-    if row["nominal_outside"] != "-1" and not lower <= nominal <= upper:
+    if row["nominal_outside"] != "-1" and not lower <= nominal <= upper:  # the figure's legend says it alike
         side = "above" if nominal > upper else "below"
-        words.append(f"nominal {side} the band" + (" BEYOND THE NOISE" if row["nominal_outside"] == "1"
-                                                   else " (within the noise)"))
+        words.append(f"nominal {side} its band, " + ("BEYOND the noise" if row["nominal_outside"] == "1"
+                                                    else "within the noise"))
     return "; ".join(words)
 
 
