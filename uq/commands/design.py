@@ -6,11 +6,12 @@ from pathlib import Path
 from typing import Any
 
 from sim.common.options import positive_int
-from uq.commands.study import add_run_arguments, engine
+from uq.commands.study import add_run_arguments, engine, print_files
 
 DESIGN_HELP = ("choose the clearance and the sphere (radius, material) for a host structure: the worst case of the "
-               "resonant tip amplitude over an excitation range and the uncertain D, clearance and k_H, screened by "
-               "the slow flow and verified by stepped-sine simulation (uq.design)")
+               "resonant tip amplitude over an excitation range and the uncertain D, clearance and k_H, with a margin to "
+               "the switch to the almost periodic response; screened by the slow flow, predicted by the similarity law "
+               "of the full model, verified by stepped-sine simulation (uq.design)")
 
 
 def add_design_arguments(parser: argparse.ArgumentParser) -> None:
@@ -25,8 +26,15 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--material", metavar="LIST", help="sphere materials, comma separated: brass, steel, tungsten "
                                                            "(default brass)")
     parser.add_argument("--model", metavar="FILE", help="the host as a modal-model file (default: the built-in rig)")
-    parser.add_argument("--objective", choices=("mean", "max"), help="the amplitude whose worst case is minimised: "
-                                                                     "the resonant mean (default) or max")
+    from uq.design.objectives import OBJECTIVES
+
+    parser.add_argument("--objective", metavar="NAME",
+                        help="what is minimised in the worst case (uq.design.objectives): "
+                             + "; ".join(f"{o.name}: {o.quantity}, {o.statistic} ({o.unit})" for o in OBJECTIVES.values())
+                             + f" (default {next(iter(OBJECTIVES))})")
+    parser.add_argument("--margin", metavar="FRACTION",
+                        help="the margin a design's switch to the almost periodic response must keep above the top of "
+                             "--excitation at every corner of the box, as a fraction in (0, 1] (default 0.2: 20 %%)")
     parser.add_argument("--damping", metavar="LOW:HIGH", help="interval of D_1 (default Table 2: 0.00075:0.0009)")
     parser.add_argument("--clearance-tolerance", metavar="LOW:HIGH",
                         help="tolerance added to each clearance (default Table 2: 0:0.032mm)")
@@ -34,7 +42,9 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--calibration", metavar="FILE",
                         help="`ies calibrate --json` output: its k_H / k_H* becomes the upper end of the k_H factor "
                              "(the crater's stiffening, as `ies reproduce` uses it)")
-    parser.add_argument("--candidates", type=positive_int, metavar="N", help="screened designs to verify (default 5)")
+    parser.add_argument("--candidates", type=positive_int, metavar="N",
+                        help="designs in the first verified batch, the best predicted (default 5); the search then "
+                             "verifies the best verified design's neighbours until it has them on every side")
     parser.add_argument("--reps", type=positive_int, metavar="N", help="repetitions per verification run (default 3)")
     parser.add_argument("--restitution", type=float, metavar="R",
                         help="modal restitution r (Eq. D.1) of the screening (default 0.86, the simulator's at the rig)")
@@ -42,6 +52,9 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
                         help="a design to verify beside the recommendation, e.g. the paper's 0.58mm,7.92mm,brass")
     parser.add_argument("--block-width", metavar="LENGTH", help="the host's block across the cavity (default 28mm)")
     parser.add_argument("--min-wall", metavar="LENGTH", help="thinnest wall left beside the cavity (default 5.5mm)")
+    parser.add_argument("--large", action="store_true", default=None,
+                        help="run a design above the size limit (20000 runs before the search goes on), whose estimate "
+                             "is refused otherwise")
     add_run_arguments(parser)
 
 
@@ -58,13 +71,13 @@ def design_problem(args: argparse.Namespace) -> tuple[Any, Path, Any]:
 
 def design_command(args: argparse.Namespace) -> int:
     """`ies design`: screen, verify and recommend (uq.design)."""
-    from uq.design.search import run_design
     from uq.design.results import design_table
+    from uq.design.search import run_design
 
     problem, out, cluster = design_problem(args)
     with engine(args, cluster) as client:
         result = run_design(problem, out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
                             progress=not args.quiet, figures=not args.no_figures, client=client)
     print(design_table(result))
-    print(f"wrote {len(result.files)} files to {result.folder}")
+    print_files(result.folder, result.files)
     return 0
