@@ -24,7 +24,9 @@ The predictor
 predicted, on a grid of own levels with the full stepped-sine simulator, and bisects each reference's switch
 bracket (last SMR level, first APR level] down to `resolution` levels. A level counts as APR when at least half of
 its repetitions reach their resonant level almost periodically (the majority rule of
-`sim.hosts.variants.landmarks`). `SimilarityLaw` then predicts, for any (kappa, D_1):
+`sim.hosts.variants.landmarks`). The switch is the first one from below (`ReferenceCurve.bracket`): far above it the
+response can turn strongly modulated again for a few levels (seen at 17-18 a_base*(g) on the cantilever of the
+design benchmarks), which `landmarks`' rule "APR from there on" would take for the switch. `SimilarityLaw` then predicts, for any (kappa, D_1):
 
 * the switch level: the references' bracket midpoints, interpolated linearly in log kappa and in D_1 (clamped
   outside the references); a reference without a switch on its grid makes the prediction a bound ("above" its
@@ -101,15 +103,20 @@ class ReferenceCurve:
         return self.apr >= APR_SHARE
 
     def bracket(self) -> tuple[float | None, float | None]:
-        """(last SMR level, first APR level) by the rule of `sim.hosts.variants.landmarks`: the first APR level is the
-        lowest from which every higher level is mostly APR (None if the top level is not), the last SMR level the
-        highest one below it that is not (None if there is none)."""
+        """(last SMR level, first APR level) of the first switch from below: the first APR level is the lowest mostly APR
+        level above the lowest one that is not (None if there is none), the last SMR level the one below it (None if
+        every level is APR). Mostly APR levels below the first SMR one (a rattle without a resonance, below the onset of
+        impacts) do not count, and neither does whatever follows the first switch (on the rig and the cantilever a
+        strongly modulated island far above it): a design must stay below the first."""
         apr = self.mostly_apr
-        tail = np.flatnonzero(np.cumprod(apr[::-1])[::-1])
-        first = float(self.levels[tail[0]]) if tail.size else None
-        below = np.flatnonzero(~apr[: tail[0] if tail.size else apr.size])
-        last = float(self.levels[below[-1]]) if below.size else None
-        return last, first
+        smr = np.flatnonzero(~apr)
+        if not smr.size:
+            return None, float(self.levels[0])
+        later = np.flatnonzero(apr[smr[0]:])
+        if not later.size:
+            return float(self.levels[-1]), None
+        first = smr[0] + later[0]
+        return float(self.levels[first - 1]), float(self.levels[first])
 
     def switch(self) -> Switch:
         last, first = self.bracket()
@@ -118,6 +125,20 @@ class ReferenceCurve:
         if last is None:
             return Switch(first, "below")
         return Switch(0.5 * (last + first), "found", first - last)
+
+    def clear_sides(self) -> tuple[float, float]:
+        """The response per a_noabs* at the highest level up to the switch bracket where no repetition is APR, and at
+        the lowest from it where every repetition is (the bracket's own levels, where the repetitions split, would
+        blur the jump); the bracket's levels where there are none."""
+        last, first = self.bracket()
+        if last is None or first is None:
+            return math.nan, math.nan
+        below = np.flatnonzero((self.levels <= last) & (self.apr == 0.0))
+        above = np.flatnonzero((self.levels >= first) & (self.apr == 1.0))
+        at_last = int(np.flatnonzero(self.levels == last)[0])
+        at_first = int(np.flatnonzero(self.levels == first)[0])
+        return (float(self.value[below[-1] if below.size else at_last]),
+                float(self.value[above[0] if above.size else at_first]))
 
     def side_value(self, level: float, apr_side: bool) -> float:
         """The response per a_noabs* at `level` on one side of this reference's switch, interpolated linearly over that
@@ -185,14 +206,13 @@ class SimilarityLaw:
         return s.kind != "above" and level >= s.level
 
     def jump(self, k: float, D: float) -> tuple[float, float]:
-        """The response per a_noabs* just below and just above the predicted switch (NaN without a switch)."""
+        """The response per a_noabs* on either side of the predicted switch (NaN without a switch): each reference's
+        nearest levels where all its repetitions agree (`ReferenceCurve.clear_sides`), blended."""
         s = self.switch(k, D)
         if s.kind != "found":
             return math.nan, math.nan
-        parts = self._blend(k, D)
-        below = sum(c.side_value(c.bracket()[0], False) * w for c, w in parts)
-        above = sum(c.side_value(c.bracket()[1], True) * w for c, w in parts)
-        return below, above
+        parts = [(c.clear_sides(), w) for c, w in self._blend(k, D)]
+        return sum(b * w for (b, _), w in parts), sum(a * w for (_, a), w in parts)
 
 
 #: one request of `reference_curves`' evaluate: (reference index, own level)
@@ -202,22 +222,33 @@ Request = tuple[int, float]
 def reference_curves(evaluate: Callable[[list[Request]], Sequence[Outcome]], references: Sequence[tuple[float, float]],
                      levels: Sequence[float], *, resolution: float = RESOLUTION) -> SimilarityLaw:
     """Simulate the references (kappa in N/m, D_1) on the own levels `levels`, then bisect each one's switch bracket down
-    to `resolution` levels. `evaluate` runs a batch of requests (reference index, own level) and returns their Outcomes in
-    order: one batch for the grid, one per bisection step (each batch holds every reference that still needs one, so
-    that a parallel evaluate keeps its workers busy)."""
+    to `resolution` levels. The grid is simulated in two passes: every other level first, then, per reference, the
+    levels below its first APR level (above it only the coarse levels are needed: designs there are on the almost
+    periodic side, and those runs are the slowest). `evaluate` runs a batch of requests (reference index, own level)
+    and returns their Outcomes in order; every batch holds all references that need a level, so that a parallel
+    evaluate keeps its workers busy."""
     grid = sorted({float(x) for x in levels})
     if not references or not grid or any(x <= 0 or not math.isfinite(x) for x in grid):
         raise SimulationInputError("similarity law: give at least one reference and positive own levels")
     if not resolution > 0:
         raise SimulationInputError(f"similarity law: the resolution must be > 0 levels, got {resolution!r}")
     data: list[dict[float, Outcome]] = [{} for _ in references]
-    batch: list[Request] = [(i, x) for i in range(len(references)) for x in grid]
+    coarse = sorted({*grid[::2], grid[-1]})
+    batch: list[Request] = [(i, x) for i in range(len(references)) for x in coarse]
+    filled = False
     curves: list[ReferenceCurve] = []
     while batch:
         for (i, x), outcome in zip(batch, evaluate(batch), strict=True):
             data[i][x] = outcome
         curves = [_curve(k, D, data[i]) for i, (k, D) in enumerate(references)]
         batch = []
+        if not filled:
+            filled = True
+            for i, curve in enumerate(curves):
+                first = curve.bracket()[1]
+                batch += [(i, x) for x in grid if x not in data[i] and (first is None or x < first)]
+            if batch:
+                continue
         for i, curve in enumerate(curves):
             last, first = curve.bracket()
             if last is not None and first is not None and first - last > resolution * (1 + 1e-9):

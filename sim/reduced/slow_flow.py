@@ -1,7 +1,6 @@
 r"""One-mode slow flow of the IES on a flexible host: the symmetric 1:1 orbit with two impacts per period
 (one per wall), its existence and stability, the predicted switch from strongly modulated (SMR) to almost
-periodic response (APR), a vectorised screening of designs, and the map of which orbits exist and are stable
-(issue 28, "Slow flow", "Which orbit the resonance sits on").
+periodic response (APR), a vectorised screening of designs, and the map of which orbits exist and are stable.
 
 Source followed
 ---------------
@@ -66,7 +65,7 @@ A^ = A/g, tau = omega t, eta = Omega/omega, b = a_base/g.
     (one run at a_base/a_base* = 7.5, eta 0.96:1.0:21 up): with mode 1 alone the response is almost periodic
     with 2.0 significant impacts per period for eta = 0.960-0.970 and its resonant maximum at eta = 0.980 has
     3.7; the rig (9 modes) is almost periodic only at 0.972-0.980, maximum at 0.980 with 4.0. The maximum thus
-    sits beyond the symmetric two-impact orbit's stable range, on a multi-impact branch (issue 28).
+    sits beyond the symmetric two-impact orbit's stable range, on a multi-impact branch.
 
 Accuracy (tests/sim/reduced/test_slow_flow.py): against the exact orbit of the one-mode Newton model at the rig's eps
 the slow flow is within 0.15 % in tip amplitude and 0.003 rad in impact phase (the recoil terms of (2)-(4b)
@@ -74,10 +73,11 @@ matter at that eps); a direct solve_ivp simulation settles on the exact orbit to
 fixed r (k_H does not enter; the similarity law then makes the response depend on g only through a_base/g),
 first-order averaging in eps and D, no friction, no gravity along x.
 
-Validity against the full simulator (check (c), tests/benchmarks/test_slow_flow_switch.py, one run): stepped
-sine as the fidelity studies (eta 0.96:1.0:21 up, 3 s + 5 s, exact integrator, seed 2024, 1 repetition), levels
-2-9 step 0.5 in units of each design's own a_base* (own g), r = the simulator's Eq. D.1 value at the wall;
-switch = (last SMR level, first APR level] of `sim.hosts.variants.landmarks`; "agrees" = within one grid step.
+Validity against the full simulator, measured (first table: an earlier run of 1 repetition per level and a design's
+r measured from its own runs; second: tests/benchmarks/test_slow_flow_switch.py, 2 repetitions): stepped sine as
+the fidelity studies (eta 0.96:1.0:21 up, 3 s + 5 s, exact integrator, seed 2024), levels 2-9 step 0.5 in units of
+each design's own a_base* (own g), r = the simulator's Eq. D.1 value at the wall; switch = (last SMR level, first
+APR level] of `sim.hosts.variants.landmarks`; "agrees" = within one grid step.
 
   design       g (mm)  m_a (g)  r (Eq. D.1)  simulated switch  slow flow (9)  agrees   APR level at 7.5 sim / (9)
   rig          0.580   17.7     0.857        5.5 -> 6.0        4.00           no       0.364 / 0.410
@@ -88,15 +88,26 @@ switch = (last SMR level, first APR level] of `sim.hosts.variants.landmarks`; "a
   mode 1 only  0.580   17.7     0.851        6.5 -> 7.0        4.15           no       0.326 / 0.395
   (the last row is a diagnostic: the rig's mode 1 alone with the damped contact law, r_cont = 0.86)
 
+  host, design          r      simulated switch  slow flow (9)  fold / switch
+  rig                   0.845  5.0 -> 5.5        4.29           0.82
+  rig m_a/2             0.901  2.0 -> 2.5        1.73           0.77
+  rig 2 m_a             0.784  none up to 9      12.87          (both beyond 9)
+  rig 2 g*              0.838  5.5 -> 6.0        4.47           0.78
+  cantilever m_a/2      0.831  4.5 -> 5.0        3.63           0.76
+  3D solid rig          0.843  5.5 -> 6.0        4.32           0.75
+
 The fold (9) comes out at 0.67-0.82 times the middle of the simulated switch interval on every design that
-switches (0.6-2.0 levels low; with mode 1 alone 2.6 levels low, so the higher modes are not the cause): the
+switches (0.6-2.6 levels low; with mode 1 alone 2.6 levels low, so the higher modes are not the cause): the
 fold is where the two-impact orbit starts to exist, a lower bound of the switch, and the stepped sine stays
-strongly modulated above it (the slow flow's boundary of the relaxation cycle is not modelled here); it follows the simulator's trends (clearance: weak; lighter sphere: much earlier; heavier: later) and
-the almost periodic level within 5-13 %. The simulated switches correspond to the fold at an r 0.02-0.09
-below the measured one (rig: 0.78-0.80). With the paper's r = 0.8 the fold of the rig lies at 5.43 (4.00 at
-the simulator's 0.857): lowering r by that much moves the switch up by 1.4 levels, the size of the gap
-between the paper's 6.7 and the simulator's 5.3-5.5; scaled by the same ratio (1.36) the simulator's switch
-would move to 7.2-7.5. So the lower r of the experiment can account for the paper's later switch.
+strongly modulated above it (the slow flow's boundary of the relaxation cycle is not modelled here); it follows
+the simulator's trends (clearance: weak; lighter sphere: much earlier; heavier: later) and the almost periodic level
+within 5-13 %. The switch that `ies design` uses is therefore not this fold but the similarity law of the full model
+(`sim.reduced.similarity`), which agrees with the simulated switch on every design above; the slow flow screens.
+The simulated switches correspond to the fold at an r 0.02-0.09 below the measured one (rig: 0.78-0.80). With the
+paper's r = 0.8 the fold of the rig lies at 5.43 (4.00 at the simulator's 0.857): lowering r by that much moves the
+switch up by 1.4 levels, the size of the gap between the paper's 6.7 and the simulator's 5.3-5.5; scaled by the
+same ratio (1.36) the simulator's switch would move to 7.2-7.5. So the lower r of the experiment can account for
+the paper's later switch.
 """
 from __future__ import annotations
 
@@ -476,7 +487,7 @@ class Screening:
 def screen(host: HostMode, clearances: np.ndarray, masses: np.ndarray | None, a_base: np.ndarray, r: float,
            eta_range: tuple[float, float] | None = None, *, radii: np.ndarray | None = None,
            density: float | None = None) -> Screening:
-    """Vectorised screening of designs (issue 28, `ies design`): for every clearance g (m), sphere mass m_a (kg)
+    """Vectorised screening of designs (`ies design`): for every clearance g (m), sphere mass m_a (kg)
     and base amplitude a_base (m) the predicted resonant tip amplitude (m) and regime.
 
     linear: the wall's linear resonant amplitude stays below g (no impacts), tip from the mode's frequency
@@ -643,7 +654,7 @@ def exact_orbit(model: SlowFlowModel, level: float, eta: float, guess: TwoImpact
                       multipliers=multipliers)
 
 
-# --- Which symmetric two-impact orbits exist and are stable against level and frequency (issue 28) ---------
+# --- Which symmetric two-impact orbits exist and are stable against level and frequency ---------------------
 
 #: `orbit_map` codes per (level, eta) cell, for the symmetric two-impact orbit of the one-mode Newton model.
 NO_ORBIT, STABLE, SYMMETRY_BREAKING, SADDLE = "none", "stable", "symmetry-breaking", "saddle"

@@ -6,7 +6,8 @@ one and the strongly modulated level within 25 %, on seven designs over three ho
 Hosts: the built-in rig (Timoshenko beam), a uniform steel cantilever of another length, section and mass
 (`tests/benchmarks/_cantilever.py`: 55 Hz, 1.30 kg, eps 5.2 % against the rig's 117 Hz, 1.57 kg, 3.5 %) and the 3D
 solid model of the rig (`sim.hosts.solid`, coarse mesh, quarter symmetry; needs `pip install ".[solid]"`, else its
-row is skipped). Spheres: the paper's brass sphere (m_a = 17.7 g), half and twice as heavy (same k_H, Eq. 4).
+row is skipped). Spheres: the paper's brass sphere (m_a = 17.7 g), half and twice as heavy (same k_H, Eq. 4); on the
+cantilever (modal restitution r about 0.70) the paper's sphere does not switch up to level 12, half of it does.
 
 Simulated: stepped sine as the fidelity studies (eta 0.96:1.0:21 up, 3 s wait, 5 s hold, base-velocity start,
 exact integrator, seed 2024), 2 repetitions per level, own levels a_base/a_base*(g) 2.0-9.0 in steps of 0.5 at the
@@ -62,7 +63,7 @@ def solid():
 #: design -> (host builder, clearance factor on g*, sphere mass factor on the paper's m_a)
 DESIGNS = {"rig": (seed_rig_model, 1.0, 1.0), "rig m_a/2": (seed_rig_model, 1.0, 0.5),
            "rig 2 m_a": (seed_rig_model, 1.0, 2.0), "rig 2 g*": (seed_rig_model, 2.0, 1.0),
-           "cantilever": (cantilever, 1.0, 1.0), "cantilever 2 m_a": (cantilever, 1.0, 2.0),
+           "cantilever": (cantilever, 1.0, 1.0), "cantilever m_a/2": (cantilever, 1.0, 0.5),
            "solid": (solid, 1.0, 1.0)}
 
 

@@ -108,7 +108,8 @@ def _clearance_curves(result: Any, path: Path) -> Path:
             left = min(min(p.clearances), min(edges)) * 1e3
             ax.axvspan(left - 0.05 * (max(p.clearances) - min(p.clearances)) * 1e3, max(edges) * 1e3,
                        color="0.85", lw=0, zorder=0,
-                       label=f"switch below {max(p.excitation) * 1e6:.3g} {MICROMETRE} + {p.margin:.0%} (predicted)")
+                       label=f"predicted to switch below the top ({max(p.excitation) * 1e6:.3g} {MICROMETRE}) + "
+                             f"{p.margin:.0%}")
         ax.set_xlabel("clearance $g$ (mm)")
         ax.set_ylabel(f"worst case of the {o.quantity} ({o.shown_in})")
         ax.set_title(f"{', '.join(p.materials)} sphere, $R$ = {R * 1e3:.2f} mm", fontsize="medium")

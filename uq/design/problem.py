@@ -101,7 +101,7 @@ class DesignProblem:
     objective: str = "mean"
     margin: float = MARGIN
     large: bool = False
-    candidates: int = 5
+    candidates: int = 3
     repetitions: int = 3
     restitution: float = RESTITUTION
     block_width: float = BLOCK_WIDTH
@@ -391,7 +391,7 @@ def protocol_of(table: Mapping[str, Any], where: str) -> dict[str, Any]:
 DESIGN_SETTINGS: dict[str, Any] = {
     "excitation": None, "clearance": "0.3mm:1.2mm:10", "radius": "7.92mm", "material": "brass", "model": None,
     "objective": "mean", "damping": None, "clearance_tolerance": None, "k_H_factor": None, "calibration": None,
-    "candidates": 5, "reps": 3, "restitution": None, "baseline": None, "block_width": None, "min_wall": None,
+    "candidates": 3, "reps": 3, "restitution": None, "baseline": None, "block_width": None, "min_wall": None,
     "margin": None, "large": False, "output": "ies-out/design"}
 
 

@@ -36,8 +36,9 @@ class Verified:
     over the repetitions, SI), the centre's value (nominal), the fraction of runs in the almost periodic regime, whether
     the centre left the corners' band beyond the repetition noise (monotonicity check); the runs; point_apr: per box
     point (corners, then the centre) and level (the operating ones, then the margin level) the share of its
-    repetitions that are almost periodic; margin_high: the objective's highest value over the box at the margin level
-    (SI); excitation: the base amplitudes (m) of those levels; prediction: the similarity law's
+    repetitions that are almost periodic; point_onset: per box point the base amplitude (m) of its first impacts
+    (Eq. 7, mode 1: below it a response is linear and its "almost periodic" label means nothing); margin_high: the
+    objective's highest value over the box at the margin level (SI); excitation: the base amplitudes (m) of those levels; prediction: the similarity law's
     (`uq.design.prediction.DesignPrediction`); round: the search round that verified it (0 = the first batch)."""
 
     sphere: Sphere
@@ -48,6 +49,7 @@ class Verified:
     outside: np.ndarray
     runs: int
     point_apr: np.ndarray | None = None
+    point_onset: np.ndarray | None = None
     margin_high: float = math.nan
     excitation: tuple[float, ...] = ()
     prediction: Any = None
@@ -59,11 +61,13 @@ class Verified:
         return float(np.max(np.maximum(self.high, self.nominal)))
 
     def apr_seen_at(self) -> float:
-        """The lowest verified base amplitude (m) at which some point of the box is mostly almost periodic (inf: none,
-        up to the margin level)."""
+        """The lowest verified base amplitude (m) at or above its first impacts at which some point of the box is mostly
+        almost periodic (inf: none, up to the margin level)."""
         if self.point_apr is None:
             return math.inf
-        hit = np.flatnonzero((self.point_apr >= 0.5).any(axis=0))
+        a = np.asarray(self.excitation)[None, :]
+        onset = np.zeros((self.point_apr.shape[0], 1)) if self.point_onset is None else self.point_onset[:, None]
+        hit = np.flatnonzero(((self.point_apr >= 0.5) & (a >= onset)).any(axis=0))
         return float(self.excitation[hit[0]]) if hit.size else math.inf
 
     def switch_worst(self) -> float:

@@ -190,9 +190,12 @@ def verify(problem: DesignProblem, objective: Objective, spheres: Sequence[Spher
     design's folder, resumable)."""
     from uq.engine.runner import Task
 
+    from sim.reduced.slow_flow import host_mode as mode_of
+
     excitation = np.array([*problem.excitation, margin_level(problem)])
     levels = levels_of(rig, excitation)
     omega_1 = float(rig.omega[0])
+    coupling = mode_of(rig).coupling
     boxes = {s: corners(problem, s) for s in spheres}
     tasks = [Task.make(p, L, rep) for s in spheres for p in boxes[s] for L in levels for rep in range(problem.repetitions)]
     results = run(tasks)
@@ -212,8 +215,9 @@ def verify(problem: DesignProblem, objective: Objective, spheres: Sequence[Spher
         low, high = value[:-1, :n_op].min(axis=0), value[:-1, :n_op].max(axis=0)
         nominal = value[-1, :n_op]
         outside = (nominal > high + 2.0 * se[-1, :n_op]) | (nominal < low - 2.0 * se[-1, :n_op])
+        onset = np.array([2.0 * p["D"] * p["g"] / coupling for p in boxes[s]])  # first impacts per point, Eq. 7
         out.append(Verified(s, low, high, nominal, apr[:, :n_op].mean(axis=0), outside,
-                            len(boxes[s]) * levels.size * problem.repetitions, point_apr=apr,
+                            len(boxes[s]) * levels.size * problem.repetitions, point_apr=apr, point_onset=onset,
                             margin_high=float(np.max(value[:, -1])), excitation=tuple(float(x) for x in excitation),
                             prediction=(predictions or {}).get(s), round=round_))
     return out

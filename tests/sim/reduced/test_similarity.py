@@ -38,8 +38,11 @@ def test_each_reference_switch_is_bisected_to_the_resolution_in_few_batches():
         s = curve.switch()
         assert s.kind == "found" and s.width <= 0.25 + 1e-12
         assert abs(s.level - switch_of(k, D)) <= 0.5 * s.width + 1e-12
-    assert calls[0] == len(REFERENCES) * len(own_levels(1.5, 12.0)) and len(calls) <= 4  # the grid, then <= 3 steps
-    assert all(n <= len(REFERENCES) for n in calls[1:])
+    grid = own_levels(1.5, 12.0)
+    assert calls[0] == len(REFERENCES) * len(grid[::2])  # every other level of the grid (its top among them)
+    below = sum(x < switch_of(k, D) for k, D in REFERENCES for x in grid[1::2])  # the rest only below each switch
+    assert calls[1] <= below + len(REFERENCES) and sum(calls) < len(REFERENCES) * len(grid) + 4 * len(REFERENCES)
+    assert len(calls) <= 5 and all(n <= len(REFERENCES) for n in calls[2:])  # then <= 3 bisection steps
 
 
 @pytest.mark.parametrize("k, D", [(2e5, 0.0008), (1.3e5, 0.00085), (3.9e5, 0.0009)])
@@ -72,13 +75,19 @@ def test_a_reference_without_a_switch_makes_the_prediction_a_lower_bound():
     assert law.switch(1e3, 0.00085).kind == "below"
 
 
-def test_a_noisy_level_inside_the_smr_part_does_not_move_the_switch():
-    """The majority rule of `landmarks`: the switch is where the APR levels begin for good; one APR level inside the
-    SMR part (a chaotic repetition) does not count."""
+def test_the_switch_is_the_first_from_below():
+    """An APR level below the first SMR one (a rattle below the onset of impacts) does not count, an SMR island far
+    above the switch does not move it, and an APR level inside the SMR part is the switch: a design must stay below
+    it."""
     def evaluate(batch):
-        return [Outcome(1.0 if level >= 6.0 or abs(level - 3.0) < 0.2 else 0.0, 0.1) for _, level in batch]
-    law = reference_curves(evaluate, [(1e5, 0.00085)], [2.0, 3.0, 4.0, 5.0, 7.0, 8.0])
+        return [Outcome(1.0 if level < 0.8 or 6.0 <= level < 15.0 or level >= 17.0 else 0.0, 0.1)
+                for _, level in batch]
+    law = reference_curves(evaluate, [(1e5, 0.00085)], own_levels(0.6, 20.0))
     assert law.switch(1e5, 0.00085).level == pytest.approx(6.0, abs=0.13)
+    def noisy(batch):
+        return [Outcome(1.0 if level >= 6.0 or abs(level - 3.0) < 0.2 else 0.0, 0.1) for _, level in batch]
+    law = reference_curves(noisy, [(1e5, 0.00085)], [2.0, 3.0, 4.0, 5.0, 7.0, 8.0])
+    assert law.switch(1e5, 0.00085).level == pytest.approx(2.9, abs=0.13)
 
 
 def test_grids_and_kappas():
