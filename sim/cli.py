@@ -1,10 +1,12 @@
-"""The simulation stage's words of the `ies` command line: `modes`, `sweep`, `overview`, `trace`.
+"""The simulation stage's words of the `ies` command line (`COMMANDS`): `modes`, `sweep`, `overview`, `trace`,
+`orbits` (implemented in `sim.orbits.cli`), and `impacts`, `modal-fit` from `sim.analysis.cli`.
 
 * `ies modes`: the modal model of the host structure (seed paper Sect. 3.1, Eq. 7, Appendix A), the built-in
   model of the seed rig (`sim.hosts.rig`) or a modal-model file (`sim.hosts.modal_file`); --save writes it as a file.
 * `ies sweep`: a stepped-sine frequency response like Fig. 5 (Sects. 5.1, 5.2).
 * `ies overview`: the resonant response level against the excitation level, like Fig. 6 (Sect. 5.3).
 * `ies trace`: time histories of one stepped-sine point, like Figs. 4 and 9a (Sects. 5.1, 5.5; `sim.analysis.trace`).
+* `ies orbits`: the periodic orbits with their stability and bifurcations (`sim.orbits`).
 * `ies impacts`, `ies modal-fit`: the analyses of measured or simulated signals (`sim.analysis.cli`).
 
 `add_commands(subparsers)` (at the end) registers them with the front door (`uq.cli`), which only dispatches. Heavy
@@ -29,6 +31,9 @@ SWEEP_HELP = "stepped-sine frequency response (mean and max amplitude per eta, s
 OVERVIEW_HELP = "resonant response level (largest mean and max over eta) vs excitation level a_base/a_base* (Fig. 6)"
 TRACE_HELP = ("time histories of one stepped-sine point sampled at --fs: tip, walls, sphere, accelerations, contact "
               "forces (CSV + JSON; Figs. 4, 9a)")
+
+ORBITS_HELP = ("periodic orbits (stable and unstable) with their bifurcations against eta at one or more levels, or "
+               "against the level at one eta (orbits.csv, results.nc, figure; sim.orbits)")
 
 SEQUENCE_CHOICES = ("up", "down", "up-down-up", "up-down-up-down-up")
 
@@ -545,18 +550,37 @@ def trace_command(args: argparse.Namespace) -> int:
     return 0
 
 
+# ---- ies orbits (sim.orbits.cli) --------------------------------------------------------------------------------
+
+def add_orbits_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies orbits`: its own (`sim.orbits.cli`) and the system's."""
+    from sim.orbits.cli import add_arguments
+
+    add_arguments(parser)
+    add_system_arguments(parser)
+
+
+def orbits_command(args: argparse.Namespace) -> int:
+    """`ies orbits`: periodic orbits with their stability and bifurcations (`sim.orbits`)."""
+    from sim.orbits.cli import run
+
+    return run(args, build_system, output_folder, system_data)
+
+
 # ---- registration with the front door -------------------------------------------------------------------------
 
 COMMANDS = (("modes", MODES_HELP, add_modes_arguments, modes_command),
             ("sweep", SWEEP_HELP, add_sweep_arguments, sweep_command),
             ("overview", OVERVIEW_HELP, add_overview_arguments, overview_command),
             ("trace", TRACE_HELP, add_trace_arguments, trace_command),
+            ("orbits", ORBITS_HELP, add_orbits_arguments, orbits_command),
             ("impacts", signal_cli.IMPACTS_HELP, signal_cli.add_impacts_arguments, signal_cli.impacts_command),
             ("modal-fit", signal_cli.MODAL_FIT_HELP, signal_cli.add_modal_fit_arguments, signal_cli.modal_fit_command))
 
 
 def add_commands(subparsers: Any) -> None:
-    """Register `modes`, `sweep`, `overview`, `trace`, `impacts` and `modal-fit` (COMMANDS) on the front door's subparsers (argparse)."""
+    """Register `modes`, `sweep`, `overview`, `trace`, `orbits`, `impacts` and `modal-fit` (COMMANDS) on the front door's
+    subparsers (argparse)."""
     for name, help_text, add_arguments, run in COMMANDS:
         parser = subparsers.add_parser(name, help=help_text, description=help_text)
         add_arguments(parser)

@@ -146,7 +146,8 @@ def test_the_walk_sees_every_kind_of_import():
 #: Inside `sim`: sub-package -> the sub-packages it may import (besides itself). The simulator's parts in pipeline
 #: order: the shared layer; the coupled system; the integrators; the stepped-sine protocol and its measures; the host
 #: models (their fidelity variants read the measures' landmarks); signal analysis; the reduced (slow-flow) model;
-#: figures. `sim` itself (its lazy public names) and `sim.cli` (the commands) may import every part.
+#: the periodic orbits of the full model (they start from the slow flow's); figures. `sim` itself (its lazy public
+#: names) and `sim.cli` (the commands) may import every part.
 SIM_LAYERS: dict[str, set[str]] = {
     "common": set(),
     "model": {"common"},
@@ -155,6 +156,7 @@ SIM_LAYERS: dict[str, set[str]] = {
     "hosts": {"common", "model", "stepped_sine"},
     "analysis": {"common", "model", "integration", "stepped_sine", "hosts"},
     "reduced": {"common", "model", "integration", "stepped_sine", "hosts"},
+    "orbits": {"common", "model", "integration", "stepped_sine", "hosts", "reduced"},
     "plots": {"common", "model", "stepped_sine", "analysis"},
 }
 #: The written-down exceptions: (importing module, the part it may also import) with the reason.
@@ -192,3 +194,54 @@ def test_no_import_cycles_between_modules_even_inside_functions(modules):
         graph[name] = {t for t in graph[name] if sim_part(t) != part}
     graph = {name: {t for t in targets if t not in ("sim", "uq")} for name, targets in graph.items()}
     assert find_cycle(graph) is None
+
+
+#: Inside `uq`: part -> the parts it may import (besides itself and `uq.errors`, which every part may use). The
+#: problem (study files, spaces, models, the method contract) imports no method, figure or engine; outputs (tables,
+#: NetCDF, figures) read what a problem is; the methods are a problem's sampling and analysis and write outputs; the
+#: engine runs a study with its method; the design runs its own search through the engine; the commands see all.
+#: `uq` itself (its lazy public names), `uq.cli` (the front door) and `uq.output_reference` (the page generated from
+#: every table) may import every part.
+UQ_LAYERS: dict[str, set[str]] = {
+    "problem": set(),
+    "outputs": {"problem"},
+    "methods": {"problem", "outputs"},
+    "engine": {"problem", "methods", "outputs"},
+    "design": {"problem", "outputs", "engine"},
+    "commands": {"problem", "methods", "engine", "outputs", "design"},
+}
+#: the written-down exceptions: (importing module, the part it may also import) with the reason (none yet)
+UQ_EXCEPTIONS: set[tuple[str, str]] = set()
+UQ_SHARED = ("uq", "uq.errors")
+
+
+def uq_part(module: str) -> str | None:
+    """The sub-package of `uq` a module (or the sub-package itself) belongs to; None for `uq`'s own modules: cli,
+    errors, output_reference."""
+    parts = module.split(".")
+    return parts[1] if parts[0] == "uq" and (len(parts) > 2 or len(parts) == 2 and parts[1] in UQ_LAYERS) else None
+
+
+def test_uq_parts_import_each_other_only_as_written_down(modules):
+    parts = {uq_part(m) for m in modules if uq_part(m)}
+    assert parts <= set(UQ_LAYERS), f"a new part of uq: add it to UQ_LAYERS ({parts - set(UQ_LAYERS)})"
+    wrong = []
+    for name, targets in import_graph(modules, top_level_only=False).items():
+        part = uq_part(name)
+        if part is None:
+            continue
+        for target in sorted(targets):
+            other = uq_part(target)
+            if not target.startswith("uq") or target in UQ_SHARED or other == part:
+                continue
+            if (other is None or other not in UQ_LAYERS[part]) and (name, other) not in UQ_EXCEPTIONS:
+                wrong.append(f"{name} imports {target}")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_the_study_reader_imports_no_method_figure_or_engine(modules):
+    """The reader of study files stays light: what it reads is declared by the methods handed to it."""
+    graph = import_graph(modules, top_level_only=False)
+    assert {t for t in graph["uq.problem.study"] if t.startswith("uq")} <= {"uq", "uq.errors", "uq.problem",
+                                                                             "uq.problem.cluster_settings",
+                                                                             "uq.problem.models", "uq.problem.space"}

@@ -107,7 +107,7 @@ def test_unknown_units_are_refused(tmp_path, model_file, capsys, option, value):
 
 def test_study_files_take_units_and_warn_on_slips(tmp_path, capsys):
     from uq.problem.space import K_H_STAR
-    from uq.problem.study import load_study
+    from uq.methods import load_study
 
     path = tmp_path / "s.toml"
     path.write_text("[study]\nkind = 'interval'\n[parameters.g]\nmax = '0.612 mm'\n[parameters.k_H]\n"

@@ -498,7 +498,30 @@ def draw_design(tmp: Path) -> None:
     plot_design_map(_design_result(tmp, (7.92e-3,), ("brass",)), tmp / "design-map-one-radius.png")
 
 
-FIGURES = {"response (fig5, fig6, figD2, figD3)": draw_response, "design (map, curves)": draw_design, "sweep": draw_sweep, "overview": draw_overview_command,
+def draw_orbits(tmp: Path) -> None:
+    """`ies orbits`'s figure: a two-impact curve (stable below 0.96, a Neimark-Sacker point, a fold), a switched
+    branch, the linear orbits and a stepped sine's points, on two levels."""
+    import sim.orbits.figures
+
+    eta = np.linspace(0.95, 0.972, 40)
+    upper, lower = 0.07 + 4.0 * (eta - 0.95), 0.03 + 1.5 * (eta - 0.95)
+    x = np.concatenate([eta, eta[::-1], np.linspace(0.96, 0.965, 5), np.linspace(0.95, 0.99, 9)])
+    y = np.concatenate([upper, lower[::-1], np.linspace(0.09, 0.1, 5), 0.016 + 2.0 * (np.linspace(0.95, 0.99, 9) - 0.95) ** 2 * 50])
+    branch = np.repeat([0, 0, 1, 2], [40, 40, 5, 9])
+    stable = (branch == 0) & (x < 0.96) & (np.arange(x.size) < 40)
+    labels = np.full(x.size, "", dtype=object)
+    labels[39], labels[20] = "fold", "neimark-sacker"
+    columns = {"eta": x, "amplitude": y, "branch": branch, "stable": stable.astype(int),
+               "impacts_per_period": np.where(branch == 2, 0.0, 2.0), "period_multiple": np.ones(x.size, dtype=int),
+               "origin": np.array(["slow-flow start"] * 80 + ["symmetry breaking at eta = 0.96"] * 5 + ["linear solution"] * 9),
+               "bifurcation": labels}
+    sweep = {"eta": np.linspace(0.95, 1.0, 11), "mean": 0.05 + 0.2 * np.exp(-((np.linspace(0.95, 1.0, 11) - 0.978) / 0.006) ** 2)}
+    sweep.update(mean_lo=sweep["mean"] * 0.9, mean_hi=sweep["mean"] * 1.1)
+    sim.orbits.figures.plot_orbits([(columns, "level 7.4", (0.95, 1.0), sweep), (columns, "level 9", (0.95, 1.0), None)],
+                                   tmp / "orbits.png", max_period=2, title="periodic orbits")
+
+
+FIGURES = {"response (fig5, fig6, figD2, figD3)": draw_response, "orbits": draw_orbits, "design (map, curves)": draw_design, "sweep": draw_sweep, "overview": draw_overview_command,
            "interval (fig7, fig8, nominal-levels)": draw_interval, "interval of r (figD3)": draw_interval_restitution,
            "sobol": draw_sobol, "series (fig11, figC1, compare)": draw_series, "trace": draw_trace,
            "motion": draw_motion, "modal-fit (fig9b)": draw_modal_fit, "calibrate": draw_calibrate,

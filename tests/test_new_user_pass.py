@@ -240,7 +240,7 @@ def test_ctrl_c_mentions_resume_only_where_it_exists(tmp_path, model_file, capsy
     err = capsys.readouterr().err
     assert "--resume" not in err and "no results were written" in err and len(err.splitlines()) == 1
     assert not (tmp_path / "res").exists()
-    monkeypatch.setattr("uq.engine.execute.run_interval_study", interrupt)
+    monkeypatch.setattr("uq.engine.execution.run_study", interrupt)
     assert main(["interval", str(STUDIES / "fig7-quick.toml"), "--out", str(tmp_path / "study")]) == 130
     assert "rerun with --resume" in capsys.readouterr().err
 

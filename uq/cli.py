@@ -1,8 +1,8 @@
 """The `ies` front door: one entry point that dispatches to the stages' own command modules.
 
 Each stage owns its words of the command line (`add_commands(subparsers)`, SALib's habit):
-`bem_contact.cli` (calibrate), `sim.cli` (modes, sweep, overview) and `uq.commands` (interval, sobol,
-reproduce). Each subcommand parser sets ``_run(args) -> exit code``. This module only builds the parser from
+`bem_contact.cli` (calibrate), `sim.cli` (modes, sweep, overview, trace, impacts, modal-fit) and `uq.commands`
+(interval, sobol, response: one per study kind of `uq.methods`; reproduce, plot, compare, design). Each subcommand parser sets ``_run(args) -> exit code``. This module only builds the parser from
 the dispatch table `STAGES`, hands `ies reproduce` the calibration as a callable (so that the uq stage never
 imports the contact stage), and turns the stages' errors into exit codes. It is the one module of uq that
 imports scans and bem_contact (their error classes and the calibration).

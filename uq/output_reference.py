@@ -9,36 +9,43 @@ from pathlib import Path
 from sim.analysis.cli import IMPACTS_JSON, MODAL_FIT_JSON
 from sim.analysis.trace import TRACE_CSV, TRACE_JSON
 from sim.common.outputs import OutputFile, describe
+from sim.orbits.tables import ORBITS_CSV
 from sim.stepped_sine.tables import OVERVIEW_CSV, OVERVIEW_JSON, SWEEP_CSV, SWEEP_JSON
-from uq.outputs.compare import COMPARE_CSV
 from uq.design.results import DESIGN_CSV, DESIGN_JSON, DESIGN_LEVELS_CSV
-from uq.engine.execute import (
-    BANDS_CSV,
-    POINTS_CSV,
-    RESULTS_NC,
-    RUNS_CSV,
-    SOBOL_CSV,
-    STUDY_JSON,
-    SURROGATE_CSV,
-    SWEEPS_CSV,
-    TASK_JSON,
-    VARIANCE_CSV,
-)
+from uq.methods import kinds
+from uq.outputs.compare import COMPARE_CSV
 from uq.outputs.reproduce_report import FILES
+from uq.outputs.tables import RESULTS_NC, RUNS_CSV, STUDY_JSON, TASK_JSON
 
 PAGE = Path(__file__).with_name("OUTPUTS.md")
+
+
+def method_tables() -> tuple[OutputFile, ...]:
+    """Every table the registered methods write (`uq.methods`), each once, in registry order."""
+    seen: dict[str, OutputFile] = {}
+    for methods in kinds().values():
+        for method in methods:
+            for table in method.tables:
+                seen.setdefault(table.file.file, table.file)
+    return tuple(seen.values())
+
+
+def study_commands() -> str:
+    """The study commands, as the heading names them."""
+    return ", ".join(f"`ies {kind}`" for kind in kinds())
+
+
 #: the sections of the page: (heading, the files it lists)
 SECTIONS: tuple[tuple[str, tuple[OutputFile, ...]], ...] = (
     ("Frequency responses and resonant levels (`ies sweep`, `ies overview`)", (SWEEP_CSV, SWEEP_JSON, OVERVIEW_CSV,
                                                                             OVERVIEW_JSON)),
     ("Time histories and signal analyses (`ies trace`, `ies impacts`, `ies modal-fit`)", (TRACE_CSV, TRACE_JSON,
                                                                                          IMPACTS_JSON, MODAL_FIT_JSON)),
-    ("Study folders (`ies interval`, `ies sobol`, `ies response`, `ies reproduce`)", (RUNS_CSV, POINTS_CSV, BANDS_CSV,
-                                                                                     SOBOL_CSV, VARIANCE_CSV,
-                                                                                     SURROGATE_CSV, SWEEPS_CSV, STUDY_JSON,
-                                                                                     TASK_JSON, RESULTS_NC)),
+    (f"Study folders ({study_commands()}, `ies reproduce`)", (RUNS_CSV, *method_tables(), STUDY_JSON, TASK_JSON,
+                                                              RESULTS_NC)),
     ("Several response studies side by side (`ies compare`)", (COMPARE_CSV,)),
     ("Designs (`ies design`)", (DESIGN_CSV, DESIGN_LEVELS_CSV, DESIGN_JSON)),
+    ("Periodic orbits (`ies orbits`)", (ORBITS_CSV,)),
 )
 
 INTRO = """# Output reference
@@ -60,12 +67,40 @@ and the docstring of `bem_contact.cli`.
 """
 
 
+def study_settings() -> str:
+    """The method tables of a study file ([KIND] with its ``method``): every setting of every registered method with
+    its default, its option and its meaning (`uq.problem.method.Setting`)."""
+    parts = ["## Study files: the methods' tables\n",
+             "A study file's `[study] kind` chooses the table of its method's settings; the common tables ([study], "
+             "[variant], [parameters.NAME], [excitation], [cluster]) are described in the docstring of "
+             "`uq.problem.study`. A kind with several methods chooses one with its table's `method` key (or the "
+             "command's `--method`); the first is the default.\n"]
+    for kind, methods in kinds().items():
+        for method in methods:
+            parts.append(f"### `[{kind}]` method = \"{method.name}\" (`ies {kind}`)\n\n{method.help}\n")
+            rows = ["| key | default | option | meaning |", "| --- | --- | --- | --- |"]
+            rows += [f"| `{s.key}` | {'computed' if s.default is None else f'`{_toml(s.default)}`'} | "
+                     f"{f'`{s.option}`' if s.option else ''} | {s.help} |" for s in method.settings]
+            parts.append("\n".join(rows) + "\n")
+    return "\n".join(parts)
+
+
+def _toml(value: object) -> str:
+    """A default as a study file writes it."""
+    if isinstance(value, (tuple, list)):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    return f'"{value}"' if isinstance(value, str) else repr(value)
+
+
 def render() -> str:
     """The page's text."""
     parts = [INTRO]
+    seen: set[str] = set()
     for heading, outputs in SECTIONS:
         parts.append(f"## {heading}\n")
-        parts.extend(describe(output) + "\n" for output in outputs)
+        parts.extend(describe(output) + "\n" for output in outputs if output.file not in seen)
+        seen.update(output.file for output in outputs)
+    parts.append(study_settings())
     parts.append("## What `ies reproduce` adds\n")
     parts.append("Beside each figure's study folder: `summary.txt` (the command, every table printed and the "
                  "paper's statement beside each), `FIG/table.txt` (one figure's printed table) and `index.md` "

@@ -1,6 +1,7 @@
 r"""One-mode slow flow of the IES on a flexible host: the symmetric 1:1 orbit with two impacts per period
 (one per wall), its existence and stability, the predicted switch from strongly modulated (SMR) to almost
-periodic response (APR), a vectorised screening of designs, and the map of which orbits exist and are stable.
+periodic response (APR), a vectorised screening of designs, and the map of which orbits exist and are stable
+(`ies design`'s screening).
 
 Source followed
 ---------------

@@ -20,7 +20,7 @@ TARGET_S = 90.0
 WARM_ALL = """
 from sim.integration.integrators import warm_up_all
 from uq.outputs.paper_figures import PAPER_FIGURES, figures_of_all
-from uq.problem.study import load_study
+from uq.methods import load_study
 models = [load_study(PAPER_FIGURES[figure].study_file(True)).make_model() for figure in figures_of_all()]
 warm_up_all(pair for model in models for pair in model.kernel_variants())
 """

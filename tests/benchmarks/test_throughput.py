@@ -25,7 +25,7 @@ import psutil
 import pytest
 
 from uq.engine.runner import ResultStore, Task, evaluate, prepare_output, run_tasks
-from uq.problem.study import parse_study
+from uq.methods import study_from as parse_study
 
 ROOT = Path(__file__).resolve().parents[2]
 N_TASKS = 24
@@ -162,7 +162,8 @@ def _slurm_row(measure, engine, tmp_path, monkeypatch) -> str:
         import dask
 
         from tests.cluster._slurm import LocalSlurm, SlurmUnavailable
-        from uq.engine.cluster import ClusterSettings, open_cluster
+        from uq.engine.cluster import open_cluster
+        from uq.problem.cluster_settings import ClusterSettings
     except ImportError as exc:
         return f"SLURM path not measured: {exc}"
     try:

@@ -77,8 +77,8 @@ def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
     `calibrate` unless --calibration FILE or --no-calibration) and run."""
     from uq.engine.runner import check_writable, dask_client
     from uq.outputs.paper_figures import figures_of_all
+    from uq.methods import load_study
     from uq.problem.space import calibrated_k_H
-    from uq.problem.study import load_study
 
     figures = figures_of_all() if args.figure == "all" else (args.figure,)
     studies = [load_study(study_file(f, args.quick)) for f in figures]
@@ -126,8 +126,8 @@ def _reproduce_figure(args: argparse.Namespace, figure: str, study: Any, client:
                       calibration: dict | None, calibrated: bool) -> tuple[dict | None, bool]:
     """One figure of `ies reproduce`: the calibration first if its study varies k_H and none was made yet, then
     the study, its figures and its table. Returns (the calibration, whether it was made)."""
-    from uq.engine.execute import run_interval_study, run_response_study
-    from uq.outputs.paper_figures import PAPER_FIGURES, STUDY_FIGURES, interval_table
+    from uq.engine.execution import run_study
+    from uq.outputs.paper_figures import PAPER_FIGURES
     from uq.problem.space import K_H_STAR, calibrated_k_H
     from uq.problem.study import with_calibration
 
@@ -144,15 +144,14 @@ def _reproduce_figure(args: argparse.Namespace, figure: str, study: Any, client:
         calibrated = True
     folder = out / figure
     print(f"{figure}: {study.source} -> {folder}/")
-    run = run_response_study if study.kind == "response" else run_interval_study
-    result = run(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet)
-    paths = STUDY_FIGURES[study.kind](result.folder)
+    result = run_study(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet)
+    paths = study.method.figures(result.folder)
     if row.traced:
-        from uq.engine.execute import series_traces
+        from uq.methods.response import series_traces
 
         paths += series_traces(study, folder, row.traced)
     s = result.summary
     print(f"{figure}: {s['tasks']} runs ({s['ran']} run now), {s['failed_runs']} failed, "
           f"{s['wall_time_s']:.1f} s; figures: {', '.join(p.name for p in paths)}")
-    (row.table if study.kind == "response" else interval_table)(folder, s, figure)
+    study.method.report(folder, s, figure)
     return calibration, calibrated

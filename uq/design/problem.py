@@ -424,7 +424,7 @@ def read_design_file(path: Any) -> DesignFile:
         settings.setdefault("output", data["study"]["output"])
     cluster = None
     if "cluster" in data:
-        from uq.engine.cluster import parse_cluster_table
+        from uq.problem.cluster_settings import parse_cluster_table
 
         cluster = parse_cluster_table(data["cluster"])
     return DesignFile(settings, {**PROTOCOL, **protocol_of(data.get("excitation", {}), f"{path}: [excitation]")},

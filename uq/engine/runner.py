@@ -20,25 +20,13 @@ import os
 import sys
 import time
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass, is_dataclass
+from dataclasses import asdict, is_dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 from sim.common.files import write_text
 from uq.errors import StudyError
-
-
-@dataclass(frozen=True)
-class Task:
-    """One model evaluation: parameter values (SI), level a_base / a_base*, repetition index."""
-
-    params: tuple[tuple[str, float], ...]
-    level: float
-    rep: int
-
-    @staticmethod
-    def make(params: Mapping[str, float], level: float, rep: int) -> "Task":
-        return Task(tuple(sorted((k, float(v)) for k, v in params.items())), float(level), int(rep))
+from uq.problem.tasks import Task
 
 
 def describe_model(model: Any) -> Any:
@@ -112,7 +100,7 @@ STUDY_MARK = "STUDY.txt"
 def prepare_output(folder: str | Path, *, resume: bool, study: tuple[str, str] | None = None) -> Path:
     """Create the output folder and check it can be written; refuse to overwrite finished results, and refuse
     `resume` into a folder that holds the tasks of another study. `study`: (name, key) of the study to run
-    (`uq.engine.execute.study_key`), kept in OUT/tasks/STUDY.txt."""
+    (`uq.engine.execution.study_key`), kept in OUT/tasks/STUDY.txt."""
     folder = Path(folder)
     store = ResultStore(folder)
     if not resume and store.count():

@@ -20,15 +20,26 @@ Two definitions of the indices, both written (`noise_free`, `with_noise`):
   that counts into every ST. They depend on the repetitions r through s.
 * S1_noise_free, ST_noise_free: V_i / V and V_Ti / V, the indices of the expected response (r -> infinity), what a
   regression surrogate fits (`uq.methods.surrogate`): S1 / (1 - s) and (ST - s) / (1 - s).
+
+The methods of Sobol' studies (``[study] kind = "sobol"``) share their analysis (`SobolMethod`: per output and level
+the indices, sobol.csv and variance.csv) and differ in their sampling and estimator: Saltelli's (`Saltelli`, here,
+the reference) and the polynomial-chaos surrogate's (`uq.methods.surrogate.PCE`).
 """
 from __future__ import annotations
 
+from abc import abstractmethod
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
 
 import numpy as np
 
+from sim.common.options import positive_int
+from sim.common.outputs import Column, OutputFile
 from uq.errors import StudyError
+from uq.problem.method import Analysis, Method, Plan, Runs, Table
 from uq.problem.space import ParameterSpace
+from uq.problem.study import Context, Setting, Study, check_number, numeric
 
 
 def sobol_sample(space: ParameterSpace, n: int, *, seed: int = 0) -> np.ndarray:
@@ -169,3 +180,168 @@ def sobol_indices(space: ParameterSpace, X: np.ndarray, Y: np.ndarray, *, num_re
                        ST=np.asarray(res["ST"]), ST_conf=np.asarray(res["ST_conf"]), variance=variance,
                        noise_variance=noise_variance, noise_share=noise_variance / variance,
                        failed_runs=int((~finite).sum()), confidence=confidence, message="", notes=notes)
+
+
+# ---- the methods of Sobol' studies -------------------------------------------------------------------------------
+
+SOBOL_CSV = OutputFile("sobol.csv", "ies sobol", "", (
+    Column("output", "", "mean or max"),
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("parameter", "", "the parameter's name"),
+    Column("S1", "-", "first-order Sobol' index of the repetition mean, the noise counted in (`uq.methods.sobol`)"),
+    Column("S1_conf", "-", "half-width of its confidence interval"),
+    Column("ST", "-", "total Sobol' index, the noise counted into it as an input of its own"),
+    Column("ST_conf", "-", "half-width of its confidence interval"),
+    Column("S1_noise_free", "-", "first-order index of the expected response: S1 / (1 - noise_share)"),
+    Column("S1_noise_free_conf", "-", "half-width of its confidence interval"),
+    Column("ST_noise_free", "-", "total index of the expected response: (ST - noise_share) / (1 - noise_share)"),
+    Column("ST_noise_free_conf", "-", "half-width of its confidence interval"),
+))
+
+
+VARIANCE_CSV = OutputFile("variance.csv", "ies sobol", "", (
+    Column("output", "", "mean or max"),
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("variance", "(a/a_noabs*)^2", "variance of the repetition-mean output over the sample"),
+    Column("noise_variance", "(a/a_noabs*)^2", "the part that is repetition noise (mean squared standard error)"),
+    Column("noise_share", "-", "noise_variance / variance"),
+    Column("failed_runs", "-", "runs that failed"),
+    Column("message", "", "why a level was not analysed (empty otherwise)"),
+))
+
+
+def _confidence(value: Any, context: Context) -> float:
+    value = float(check_number("[sobol] confidence", value))
+    if not 0 < value < 1:
+        raise StudyError(f"[sobol] confidence must lie in (0, 1), got {value}")
+    return value
+
+
+#: the settings every Sobol' method has (analysis settings: not part of the study's identity)
+SHARED_SETTINGS = (
+    numeric("bootstrap", 200, "bootstrap resamples of the confidence intervals", integer=True, identity=False),
+    Setting("confidence", 0.95, _confidence, "confidence level of the intervals", identity=False),
+)
+
+
+class SobolMethod(Method):
+    """What the Sobol' methods share: the kind, sobol.csv and variance.csv, and the analysis per output and level;
+    a method gives its sample (`sample`) and its estimator of the indices (`indices`), and may add notes, a table row
+    and summary values per level."""
+
+    kind = "sobol"
+    kind_help = "Sobol' sensitivity indices of the resonant response level per excitation level (SALib)"
+    tables = (Table(SOBOL_CSV, dims={"parameter": "parameter", "level": "level"}, split="output"),
+              Table(VARIANCE_CSV, dims={"level": "level"}, split="output"))
+
+    def finish(self, values: dict[str, Any], context: Context) -> dict[str, Any]:
+        if not context.space.varied:
+            raise StudyError("no parameter is varied; give at least one [parameters.NAME] with min < max")
+        return values
+
+    @abstractmethod
+    def sample(self, study: Study) -> np.ndarray:
+        """The sample of the varied parameters (values in SI), shape (points, k)."""
+
+    @abstractmethod
+    def indices(self, study: Study, X: np.ndarray, value: np.ndarray, se: np.ndarray,
+                regimes: list[str]) -> SobolResult:
+        """S1, ST of one output at one level from the repetition means `value` (and their standard errors `se`)."""
+
+    def level_notes(self, study: Study, result: SobolResult) -> list[str]:
+        """Warnings about one level's indices beyond the estimator's own notes."""
+        return []
+
+    def level_rows(self, output: str, level: float, result: SobolResult) -> dict[str, list[Any]]:
+        """A row of each of the method's own tables for one output and level (file name -> row)."""
+        return {}
+
+    def level_summary(self, result: SobolResult) -> dict[str, Any]:
+        """Values of study.json's summary.per_level beyond the noise share and the failed runs."""
+        return {}
+
+    def summary(self, study: Study, results: list[SobolResult]) -> dict[str, Any]:
+        """study.json's summary entries of the sample."""
+        return {}
+
+    def plan(self, study: Study) -> Plan:
+        X = self.sample(study)
+        return Plan([study.space.from_values(x) for x in X], {"X": X})
+
+    def analyse(self, study: Study, model: Any, plan: Plan, runs: Runs) -> Analysis:
+        """S1, ST with their confidence per output and level (sobol.csv, in both definitions of the indices), the
+        variance and its noise share per level (variance.csv)."""
+        out = Analysis(rows={"sobol.csv": [], "variance.csv": [], **{t.file.file: [] for t in self.tables[2:]}})
+        per_level: dict[str, dict] = {}
+        results = []
+        for o in model.banded_outputs:
+            value, se, _ = runs.stats[o]
+            for j, level in enumerate(study.levels):
+                res = self.indices(study, plan.extra["X"], value[:, j], se[:, j], list(runs.regimes[:, j]))
+                results.append(res)
+                where = f"{o} at level {level:g}"
+                out.warnings += [f"{where}: {note}" for note in res.notes]
+                if res.message:
+                    out.warnings.append(f"{where}: not analysed: {res.message}")
+                out.warnings += [f"{where}: {note}" for note in self.level_notes(study, res)]
+                free = res.noise_free()
+                for k, pname in enumerate(res.names):
+                    out.rows["sobol.csv"].append([o, level, pname, res.S1[k], res.S1_conf[k], res.ST[k], res.ST_conf[k],
+                                                  *(column[k] for column in free)])
+                out.rows["variance.csv"].append([o, level, res.variance, res.noise_variance, res.noise_share,
+                                                 res.failed_runs, res.message])
+                for name, row in self.level_rows(o, level, res).items():
+                    out.rows[name].append(row)
+                per_level[f"{o}@{level:g}"] = {"noise_share": res.noise_share, "failed_runs": res.failed_runs,
+                                               **self.level_summary(res)}
+        out.summary = {**self.summary(study, results), "per_level": per_level}
+        return out
+
+    def figures(self, folder: Path, options: Any = None) -> list[Path]:
+        """S1 and ST with their confidence intervals against the level (`uq.outputs.figures.sobol_figure`)."""
+        from uq.outputs.figures import sobol_figure
+
+        return sobol_figure(folder, options)
+
+    def report(self, folder: Path, summary: Mapping[str, Any], name: str) -> None:
+        """The indices with their confidence and the noise share per level (`uq.outputs.results.sobol_table`)."""
+        from uq.outputs.results import sobol_table
+
+        print(sobol_table(folder))
+
+
+def _power_of_two(value: Any, context: Context) -> int:
+    n = int(check_number("[sobol] n", value, integer=True))
+    if n < 2 or n & (n - 1):
+        raise StudyError(f"[sobol] n = {n} must be a power of two >= 2 (e.g. 64)")
+    return n
+
+
+class Saltelli(SobolMethod):
+    """Saltelli's sampling and SALib's estimators (Saltelli 2010, Jansen 1999): n (k + 2) points, the reference."""
+
+    name = "saltelli"
+    help = "Saltelli's sampling and SALib's estimators, the reference: n (k + 2) points"
+    settings = (Setting("n", 64, _power_of_two, "Saltelli's base sample size, a power of two: n (k + 2) points",
+                        option="--n", metavar="N", parse=positive_int, identity=False),
+                *SHARED_SETTINGS)
+
+    def sample(self, study: Study) -> np.ndarray:
+        return sobol_sample(study.space, study.settings["n"], seed=study.seed)
+
+    def indices(self, study: Study, X: np.ndarray, value: np.ndarray, se: np.ndarray,
+                regimes: list[str]) -> SobolResult:
+        s = study.settings
+        return sobol_indices(study.space, X, value, num_resamples=s["bootstrap"], confidence=s["confidence"],
+                             seed=study.seed, noise=se**2)
+
+    def level_notes(self, study: Study, result: SobolResult) -> list[str]:
+        from uq.outputs.results import sample_size_advice
+
+        if result.message:
+            return []
+        advice = sample_size_advice([*result.S1, *result.ST], [*result.S1_conf, *result.ST_conf], study.settings["n"])
+        return [advice] if advice else []
+
+    def summary(self, study: Study, results: list[SobolResult]) -> dict[str, Any]:
+        return {"base_sample": study.settings["n"]}

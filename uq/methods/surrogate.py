@@ -29,21 +29,26 @@ What is reported beside the indices:
   makes the response jump, and a polynomial then spreads the jump over every term. The response is flagged
   not smooth when the cross-validated error exceeds the noise's expected part by more than `max_misfit`, or when
   the points of one level fall into different regimes.
+
+The method (`PCE`, ``[sobol] method = "pce"``) shares the Sobol' analysis of `uq.methods.sobol.SobolMethod` and adds
+its fit per output and level (surrogate.csv).
 """
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from sim.common.options import positive_int
+from sim.common.outputs import Column, OutputFile
 from uq.errors import StudyError
-from uq.methods.sobol import SobolResult, with_noise
+from uq.methods.sobol import SHARED_SETTINGS, SobolMethod, SobolResult, with_noise
+from uq.problem.method import Table
 from uq.problem.space import ParameterSpace
-
-#: the methods of `[sobol] method`; Saltelli's sampling (`uq.methods.sobol`) is the default and the reference
-METHODS = ("saltelli", "pce")
+from uq.problem.study import Context, Study, numeric
 #: cross-validation folds (fewer when the design has fewer points)
 FOLDS = 10
 #: the default of `[sobol] max_misfit`: cross-validated error beyond the noise's part, share of the variance
@@ -224,3 +229,73 @@ def pce_indices(space: ParameterSpace, X: np.ndarray, y: np.ndarray, *, degree: 
                      confidence=confidence, message="", notes=notes,
                      degree=degree, terms=terms, points=y.size, cv_error=cv_error, noise_floor=floor,
                      regimes=distinct, smooth=not rough, rough="; ".join(rough))
+
+
+# ---- the method --------------------------------------------------------------------------------------------------
+
+SURROGATE_CSV = OutputFile("surrogate.csv", "ies sobol, method pce", "The polynomial-chaos surrogate's fit per "
+                           "output and level (`uq.methods.surrogate`).", (
+    Column("output", "", "mean or max"),
+    Column("level", "a_base/a_base*", "the excitation level"),
+    Column("points", "-", "the design's points (scrambled Sobol')"),
+    Column("degree", "-", "the basis' total degree"),
+    Column("terms", "-", "the polynomial terms LARS kept"),
+    Column("cv_error", "-", "10-fold cross-validated error, a share of the output variance"),
+    Column("noise_floor", "-", "the part of cv_error the repetition noise explains"),
+    Column("smooth", "-", "1 where the response is smooth, 0 not (NOT SMOOTH: indices unreliable), empty: not analysed"),
+    Column("regimes", "", "the regimes the design points fall into"),
+    Column("rough", "", "why it is not smooth"),
+))
+
+
+class PCE(SobolMethod):
+    """Sobol' indices from a polynomial-chaos surrogate of a scrambled Sobol' design (module docstring)."""
+
+    name = "pce"
+    help = ("a polynomial-chaos surrogate (OpenTURNS) of a scrambled Sobol' design: a tenth of the runs where the response "
+            "is smooth")
+    settings = (*SHARED_SETTINGS,
+                numeric("points", 0, "design points of the surrogate (default: 3 per polynomial term, rounded up to a "
+                        "power of 2)", integer=True, option="--points", metavar="N", parse=positive_int, identity=False),
+                numeric("degree", 2, "total polynomial degree (points >= C(k + degree, degree))", integer=True,
+                        option="--degree", metavar="P", parse=positive_int, identity=False),
+                numeric("max_misfit", MAX_MISFIT, "cross-validated error beyond the noise (share of the variance) above "
+                        "which the response is flagged not smooth", identity=False))
+    tables = (*SobolMethod.tables, Table(SURROGATE_CSV, dims={"level": "level"}, split="output"))
+
+    def finish(self, values: dict[str, Any], context: Context) -> dict[str, Any]:
+        values = super().finish(values, context)
+        k = len(context.space.varied)
+        values["points"] = values["points"] or default_points(k, values["degree"])
+        check_design(k, values["points"], values["degree"])
+        openturns()
+        return values
+
+    def sample(self, study: Study) -> np.ndarray:
+        return pce_sample(study.space, study.settings["points"], seed=study.seed)
+
+    def indices(self, study: Study, X: np.ndarray, value: np.ndarray, se: np.ndarray,
+                regimes: list[str]) -> PCEResult:
+        s = study.settings
+        return pce_indices(study.space, X, value, degree=s["degree"], noise=se**2, regimes=regimes,
+                           num_resamples=s["bootstrap"], confidence=s["confidence"], seed=study.seed,
+                           max_misfit=s["max_misfit"])
+
+    def level_notes(self, study: Study, result: PCEResult) -> list[str]:
+        if result.message or result.smooth:
+            return []
+        return [f"NOT SMOOTH: {result.rough}; the surrogate's indices are not reliable there: use method = "
+                "\"saltelli\""]
+
+    def level_rows(self, output: str, level: float, result: PCEResult) -> dict[str, list[Any]]:
+        return {"surrogate.csv": [output, level, result.points, result.degree, result.terms, result.cv_error,
+                                  result.noise_floor, int(result.smooth) if not result.message else "",
+                                  " ".join(result.regimes), result.rough]}
+
+    def level_summary(self, result: PCEResult) -> dict[str, Any]:
+        return {"cv_error": result.cv_error, "noise_floor": result.noise_floor,
+                "smooth": bool(result.smooth and not result.message)}
+
+    def summary(self, study: Study, results: list[PCEResult]) -> dict[str, Any]:
+        return {"method": "pce", "design_points": study.settings["points"], "degree": study.settings["degree"],
+                "smooth": all(r.smooth and not r.message for r in results)}

@@ -156,10 +156,10 @@ def base_dataset(study: Any, model: Any, points: Sequence[Mapping[str, float]], 
                  stats: Mapping[str, tuple] | None = None, regimes: np.ndarray | None = None) -> Any:
     """Coordinates (point with the parameters along it, level, repetition) and the runs (one variable per model
     output on point x level x repetition, and `error`), with the repetition statistics of each point and level
-    (`uq.engine.execute.statistics`: OUTPUT_rep_mean, OUTPUT_rep_se, OUTPUT_n_samples, regime) where given."""
+    (`uq.engine.execution.statistics`: OUTPUT_rep_mean, OUTPUT_rep_se, OUTPUT_n_samples, regime) where given."""
     import xarray as xr
 
-    from uq.engine.runner import Task
+    from uq.problem.tasks import Task
 
     names = study.space.names
     shape = (len(points), len(study.levels), study.repetitions)

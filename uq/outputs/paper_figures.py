@@ -216,6 +216,3 @@ def _study_kind(kind: str) -> Callable[[Path], bool]:
 register("ies interval", _study_kind("interval"))(interval_figures)
 register("response study (ies response, ies reproduce of a response figure)", _study_kind("response"))(response_figures)
 
-
-#: what draws a finished study's folder, by the study's kind (each figure of it through its row)
-STUDY_FIGURES: dict[str, Callable[[Path], list[Path]]] = {"interval": interval_figures, "response": response_figures}

@@ -46,7 +46,7 @@ class ResponseModel(Protocol):
     repetition, seed) to named scalar outputs, with the aggregation of the runs of one (point, level).
 
     The runner may also use optional hooks when a model has them: ``with_rig()``, ``warm_up()``,
-    ``resolved_protocol()``, ``describe()`` (`uq.engine.execute`, `uq.engine.runner`).
+    ``resolved_protocol()``, ``describe()`` (`uq.engine.execution`, `uq.engine.runner`).
     """
 
     @property

@@ -4,7 +4,7 @@ Layout (every table and key is optional except where noted; SI units)::
 
     [study]
     name = "fig7"
-    kind = "interval"            # "interval", "sobol" or "response" (required)
+    kind = "interval"            # a kind of `uq.methods.METHODS`: "interval", "sobol" or "response" (required)
     model = "ies"                # "ies" (the simulator), "ishigami", or "package.module:function"
     modal_model = "rig.toml"     # optional, model "ies": a modal-model file (`ies modes --save`), relative to
                                  # this file, instead of the built-in rig
@@ -45,30 +45,9 @@ Layout (every table and key is optional except where noted; SI units)::
     sequence = "up-down-up"
     integrator = "exact"
 
-    [interval]
-    designs = ["individual", "joint", "residual"]
-    interior = 1                 # interior points per axis (individual) / in the box (joint, residual)
-    z = 2.0                      # noise multiple below which a monotonicity violation is not flagged
-    fix = { k_H = "best_estimate" }   # parameters held fixed in the residual band
-
-    [sobol]
-    method = "saltelli"          # "saltelli" (SALib's sampling, the reference) or "pce" (a polynomial-chaos
-                                 # surrogate, uq.methods.surrogate: far fewer runs for a smooth response)
-    n = 64                       # saltelli: base sample size (power of two); n (k + 2) points
-    bootstrap = 200
-    confidence = 0.95
-    points = 32                  # pce: design points (scrambled Sobol'; default 3 per term, to a power of 2)
-    degree = 2                   # pce: total degree of the polynomials (points >= C(k + degree, degree))
-    max_misfit = 0.1             # pce: cross-validated error beyond the noise (share of the variance) above
-                                 # which the response is flagged not smooth
-
-    [response]                   # kind "response": the frequency responses and resonant levels of the nominal
-    figures = ["fig5", "fig6"]   # point (the parameters' nominal values) at every level, as Figs. 5 and 6, and
-                                 # "figD2", "figD3": impacts per period and r at the resonant eta (Appendix D),
-                                 # "fig11", "figC1": the resonant mean of each value of `series` (Sect. 5.5,
-                                 # Appendix C)
-    series = { r_cont = [1.0, 0.99, 0.9] }   # optional: the whole study once per value of one listed
-                                 # parameter (a response study each, in OUT/NAME=VALUE), as Fig. 11
+    [interval]                   # the method's own table, named after the kind: [interval], [sobol] or
+    designs = ["individual"]     # [response]; its keys are the method's settings (`uq.methods`; every key with
+                                 # its default and meaning: uq/OUTPUTS.md, "Study files")
 
     [cluster]                    # optional: run on a batch cluster (uq.engine.cluster; the --cluster-* options win)
     kind = "slurm"               # slurm (tested), pbs, sge, lsf, oar, moab, htcondor
@@ -84,43 +63,69 @@ from __future__ import annotations
 import math
 import sys
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 from sim.model.parameters import PARAMETERS
-from uq.engine.cluster import ClusterSettings, parse_cluster_table
 from uq.errors import StudyError
+from uq.problem.cluster_settings import ClusterSettings, parse_cluster_table
 from uq.problem.models import ResponseModel, make_model
 from uq.problem.space import Parameter, ParameterSpace, plausibility_warning, resolve_k_H, resolve_value
 
-KINDS = ("interval", "sobol", "response")
-DESIGNS = ("individual", "joint", "residual")
-_KEYS = {
+#: the tables every study may have; the method's own table is named after its kind (`Method.kind`)
+COMMON_TABLES = {
     "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output", "outputs", "contact_law"},
     "variant": {"sphere_mass_factor", "higher_mode_damping"},
     "parameters": None,  # one sub-table per parameter
     "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "perturb", "repetition",
                    "start", "dt_scale"},
-    "interval": {"designs", "interior", "z", "fix"},
-    "sobol": {"n", "bootstrap", "confidence", "method", "points", "degree", "max_misfit"},
-    "response": {"figures", "series"},
-    "cluster": None,  # checked by uq.engine.cluster.parse_cluster_table
+    "cluster": None,  # checked by uq.problem.cluster_settings.parse_cluster_table
 }
 _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
 
 
-def _response_figure_names() -> tuple[str, ...]:
-    """The figures a response study may draw: the response rows of `uq.outputs.paper_figures.PAPER_FIGURES` (imported here:
-    it brings the figure code)."""
-    from uq.outputs.paper_figures import response_figure_names
+@dataclass(frozen=True)
+class Context:
+    """What a method's settings are read against: the study's kind, parameter space, the folder that relative paths
+    in the file start from, and the file read (for warnings)."""
 
-    return response_figure_names()
+    kind: str
+    space: ParameterSpace
+    base_dir: Path = Path(".")
+    source: str = ""
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One key of a method's study-file table, and its command-line option if a user may give it there.
+
+    key: the key in the table (``[KIND] KEY``) and in study.json; default: its value when neither gives it (a
+    default computed from other settings is set in `Method.finish`); read(value, context): the checked
+    value, or a one-line `StudyError` naming ``[KIND] KEY``; option, metavar, parse, help: the option of `ies KIND`
+    (parse: argparse's type; None: the study file only); identity: part of the study's identity, so that
+    ``--resume`` continues a folder only with the same value (False for analysis settings and sample sizes whose
+    samples are nested: a study grown with --resume reuses its runs).
+    """
+
+    key: str
+    default: Any
+    read: Callable[[Any, Context], Any]
+    help: str
+    option: str | None = None
+    metavar: str | None = None
+    parse: Callable[[str], Any] | None = None
+    identity: bool = True
+
 
 
 @dataclass(frozen=True, kw_only=True)
 class Study:
-    """A resolved, validated study (see the module docstring for the file layout); built with named fields."""
+    """A resolved, validated study (see the module docstring for the file layout); built with named fields.
+
+    method: the method that runs it (a `uq.problem.method.Method` of `uq.methods.METHODS`), settings: its checked
+    settings (`Method.settings`),
+    table: the method's table as the file gave it (the command line's options are read over it, `with_settings`)."""
 
     name: str
     kind: str
@@ -130,25 +135,15 @@ class Study:
     repetitions: int
     seed: int
     output: Path
+    method: Any
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    table: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
     protocol: Mapping[str, Any] = field(default_factory=dict)
-    designs: tuple[str, ...] = ("individual",)
-    interior: int = 1
-    z: float = 2.0
-    fix: Mapping[str, float] = field(default_factory=dict)
-    sobol_n: int = 64
-    bootstrap: int = 200
-    confidence: float = 0.95
     source: str = ""
     modal_model: Path | None = None
-    figures: tuple[str, ...] = field(default_factory=lambda: _response_figure_names())
     variant: Mapping[str, float] = field(default_factory=dict)
     outputs: tuple[str, ...] = ()
     contact_law: str = "hertz"
-    series: tuple[str, tuple[float, ...]] | None = None
-    sobol_method: str = "saltelli"
-    surrogate_points: int = 0
-    surrogate_degree: int = 2
-    max_misfit: float = 0.1
     #: where the study runs ([cluster], uq.engine.cluster); not part of its results, so left out of to_dict and the key
     cluster: ClusterSettings | None = None
 
@@ -158,44 +153,38 @@ class Study:
                           modal_model=self.modal_model, variant=self.variant, outputs=self.outputs,
                           contact_law=self.contact_law)
 
+    def context(self) -> Context:
+        """What its method's settings are read against (`uq.problem.method.Context`)."""
+        return Context(self.kind, self.space, Path(self.source).parent if self.source else Path("."), self.source)
+
     def to_dict(self) -> dict:
-        """The resolved study as plain data (written to the results' metadata)."""
+        """The resolved study as plain data (study.json's "study", results.nc's attribute): the common keys and the
+        method's settings under its kind (`Method.describe`)."""
+        return {**self.common_dict(), **self.method.describe(self.settings)}
+
+    def identity(self) -> dict:
+        """What defines the study's runs, for `--resume`: the resolved study without its output folder and file, and
+        of the method's settings those that are part of its identity (`Method.identity`)."""
+        common = {k: v for k, v in self.common_dict().items() if k not in ("output", "source")}
+        return {**common, **self.method.identity(self.settings)}
+
+    def common_dict(self) -> dict:
+        """The resolved study without its method's settings, as plain data."""
         return {
             "name": self.name, "kind": self.kind, "model": self.model,
             "modal_model": None if self.modal_model is None else str(self.modal_model), "seed": self.seed,
             "repetitions": self.repetitions, "output": str(self.output), "source": self.source,
             "levels": list(self.levels), "protocol": dict(self.protocol), "parameters": self.space.to_dict(),
-            "interval": {"designs": list(self.designs), "interior": self.interior, "z": self.z, "fix": dict(self.fix)},
-            "sobol": {"n": self.sobol_n, "bootstrap": self.bootstrap, "confidence": self.confidence,
-                      **({"method": "pce", "points": self.surrogate_points, "degree": self.surrogate_degree,
-                          "max_misfit": self.max_misfit} if self.sobol_method == "pce" else {})},
-            "response": {"figures": list(self.figures)}, "variant": dict(self.variant),
-            "outputs": list(self.outputs), "contact_law": self.contact_law,
-            **({"series": {self.series[0]: list(self.series[1])}} if self.series else {}),
+            "variant": dict(self.variant), "outputs": list(self.outputs), "contact_law": self.contact_law,
         }
-
-    def series_studies(self) -> list[tuple[str, "Study"]]:
-        """[(folder name NAME=VALUE, the study with that parameter fixed at VALUE)] of [response] series; [] without."""
-        if not self.series:
-            return []
-        from dataclasses import replace
-
-        name, values = self.series
-        out = []
-        for value in values:
-            params = tuple(p.fixed_at(value) if p.name == name else p for p in self.space.parameters)
-            space = ParameterSpace(params, self.space.extras)
-            out.append((f"{name}={value:g}", replace(self, space=space, series=None, name=f"{self.name} {name}={value:g}")))
-        return out
 
 
 def with_calibration(study: Study, k_H_cal: float) -> Study:
     """The study with k_H's upper bound at a calibrated k_H (N/m^1.5; `ies calibrate`), as the paper does with its BEM
     result 1.52 k_H* (Sect. 4.1): the best estimate stays (1.25 k_H* by default) unless the calibration falls below
-    it, then it is the midpoint of k_H's lower bound and the calibrated value. A calibrated k_H below k_H* (Eq. 8)
-    is refused with one line: a crater stiffens the contact."""
-    from dataclasses import replace
-
+    it, then it is the midpoint of k_H's lower bound and the calibrated value (and a setting that fixes k_H at its
+    best estimate, the residual band of Fig. 8, follows it). A calibrated k_H below k_H* (Eq. 8) is refused with one
+    line: a crater stiffens the contact."""
     from uq.problem.space import K_H_BEST_ESTIMATE, K_H_STAR
 
     if k_H_cal < K_H_STAR:
@@ -208,12 +197,17 @@ def with_calibration(study: Study, k_H_cal: float) -> Study:
         best = 0.5 * (k.min + k_H_cal)
     params = tuple(replace(p, max=max(k_H_cal, p.min)) if p.name == "k_H" else p for p in space.parameters)
     new_space = ParameterSpace(params, {**space.extras, "k_H_best_estimate": best, "k_H_calibrated": k_H_cal})
-    fix = {**study.fix, "k_H": best} if "k_H" in study.fix else dict(study.fix)
-    return replace(study, space=new_space, fix=fix)
+    settings = dict(study.settings)
+    fix = settings.get("fix")
+    if isinstance(fix, Mapping) and "k_H" in fix:
+        settings["fix"] = {**fix, "k_H": best}
+    return replace(study, space=new_space, settings=settings)
 
 
-def load_study(path: str | Path) -> Study:
-    """Read and validate a study file; errors are one-line `StudyError`s naming the file."""
+def read_study(path: str | Path, methods: Mapping[str, Any], elsewhere: Mapping[str, str] | None = None) -> Study:
+    """Read and validate a study file against the methods of a registry (`uq.methods.load_study` passes its own);
+    errors are one-line `StudyError`s naming the file. `elsewhere`: kinds that another command runs (kind ->
+    that command), refused with its name."""
     path = Path(path)
     try:
         data = tomllib.loads(path.read_text())
@@ -226,37 +220,82 @@ def load_study(path: str | Path) -> Study:
     except UnicodeDecodeError:
         raise StudyError(f"{path} is not a text (TOML) file")
     try:
-        return parse_study(data, base_dir=path.parent, source=str(path))
+        return parse_study(data, methods, base_dir=path.parent, source=str(path), elsewhere=elsewhere)
     except StudyError as exc:
         raise StudyError(f"{path}: {exc}") from None
 
 
-def _number(table: str, key: str, value: Any, *, integer: bool = False, positive: bool = True) -> float:
+def check_number(where: str, value: Any, *, integer: bool = False, positive: bool = True,
+                 minimum: float | None = None, maximum: float | None = None) -> float:
+    """`value` of a study file's key `where` ("[table] key") checked: a finite number (an integer with `integer`),
+    positive unless `positive` is False, within [minimum, maximum] where given; else a one-line StudyError."""
     ok = isinstance(value, int) if integer else isinstance(value, (int, float))
     if isinstance(value, bool) or not ok or not math.isfinite(value):
         kind = "an integer" if integer else "a number"
-        raise StudyError(f"[{table}] {key} must be {kind}, got {value!r}")
+        raise StudyError(f"{where} must be {kind}, got {value!r}")
     if positive and value <= 0:
-        raise StudyError(f"[{table}] {key} must be positive, got {value!r}")
+        raise StudyError(f"{where} must be positive, got {value!r}")
+    if minimum is not None and value < minimum or maximum is not None and value > maximum:
+        bounds = (f"between {minimum:g} and {maximum:g}" if minimum is not None and maximum is not None
+                  else f">= {minimum:g}" if minimum is not None else f"<= {maximum:g}")
+        raise StudyError(f"{where} must be {bounds}, got {value!r}")
     return value
 
 
-def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: str = "") -> Study:
-    """Validate the parsed TOML of a study (see `load_study`)."""
+def numeric(key: str, default: float, help: str, *, integer: bool = False, positive: bool = True,
+            minimum: float | None = None, maximum: float | None = None, **option: Any) -> Setting:
+    """A setting whose value is a number checked by `check_number` (the error names ``[KIND] KEY``); `option`: the
+    Setting's option, metavar, parse and identity."""
+    def read(value: Any, context: Context) -> float:
+        checked = check_number(f"[{context.kind}] {key}", value, integer=integer, positive=positive, minimum=minimum,
+                               maximum=maximum)
+        return int(checked) if integer else float(checked)
+
+    return Setting(key, default, read, help, **option)
+
+
+def _number(table: str, key: str, value: Any, *, integer: bool = False, positive: bool = True) -> float:
+    return check_number(f"[{table}] {key}", value, integer=integer, positive=positive)
+
+
+def _kinds(methods: Mapping[str, Any]) -> dict[str, list[Any]]:
+    """kind -> its methods, in registry order (the first is the kind's default)."""
+    kinds: dict[str, list[Any]] = {}
+    for method in methods.values():
+        kinds.setdefault(method.kind, []).append(method)
+    return kinds
+
+
+def parse_study(data: Mapping[str, Any], methods: Mapping[str, Any], *, base_dir: Path = Path("."),
+                source: str = "", elsewhere: Mapping[str, str] | None = None) -> Study:
+    """Validate the parsed TOML of a study (see `read_study`)."""
+    kinds = _kinds(methods)
+    elsewhere = dict(elsewhere or {})
+    known_tables = {**COMMON_TABLES, **{kind: None for kind in kinds}}
     for table in data:
-        if table not in _KEYS:
-            raise StudyError(f"unknown table [{table}]; known: {', '.join('[' + t + ']' for t in _KEYS)}")
+        if table not in known_tables and table not in elsewhere:
+            raise StudyError(f"unknown table [{table}]; known: {', '.join('[' + t + ']' for t in known_tables)}")
         if not isinstance(data[table], Mapping):
             raise StudyError(f"'{table}' must be a table ([{table}])")
-        allowed = _KEYS[table]
+        allowed = COMMON_TABLES.get(table)
         if allowed is not None:
             for key in data[table]:
                 if key not in allowed:
                     raise StudyError(f"unknown key '{key}' in [{table}]; known: {', '.join(sorted(allowed))}")
     head = data.get("study", {})
-    kind = head.get("kind")
-    if kind not in KINDS:
-        raise StudyError(f"[study] kind must be one of {', '.join(KINDS)}, got {kind!r}")
+    every_kind = ", ".join([*kinds, *elsewhere])
+    if "kind" not in head:
+        raise StudyError(f"[study] kind is missing: say what the study computes, one of {every_kind} "
+                         "(e.g. kind = \"interval\")")
+    kind = head["kind"]
+    if kind in elsewhere:
+        raise StudyError(f"this is a {kind} study: run it with `{elsewhere[kind]} FILE`")
+    if kind not in kinds:
+        raise StudyError(f"[study] kind must be one of {every_kind}, got {kind!r}")
+    for table in data:
+        if table in kinds and table != kind:
+            raise StudyError(f"[{table}] applies to kind = \"{table}\" only; this is a{'n' if kind[0] in 'aeiou' else ''} "
+                             f"{kind} study: remove the table or change the kind")
     model_spec = head.get("model", "ies")
     if not isinstance(model_spec, str):
         raise StudyError(f"[study] model must be a string, got {model_spec!r}")
@@ -293,52 +332,22 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         raise StudyError("[excitation] levels lists a value twice")
     protocol = _parse_protocol(exc)
 
-    iv = data.get("interval", {})
-    designs = tuple(iv.get("designs", ["individual"]))
-    for d in designs:
-        if d not in DESIGNS:
-            raise StudyError(f"[interval] unknown design '{d}'; known: {', '.join(DESIGNS)}")
-    interior = int(_number("interval", "interior", iv.get("interior", 1), integer=True, positive=False))
-    if interior < 0:
-        raise StudyError(f"[interval] interior must be >= 0, got {interior}")
-    z = float(_number("interval", "z", iv.get("z", 2.0), positive=False))
-    fix = _parse_fix(iv.get("fix", {"k_H": "best_estimate"} if "k_H" in space.names else {}), space, base_dir, source)
-    if "residual" in designs and not fix:
-        raise StudyError("[interval] the residual design needs fixed parameters: fix = { k_H = \"best_estimate\" }")
-
-    sb = data.get("sobol", {})
-    sobol_n = int(_number("sobol", "n", sb.get("n", 64), integer=True))
-    if sobol_n < 2 or sobol_n & (sobol_n - 1):
-        raise StudyError(f"[sobol] n = {sobol_n} must be a power of two >= 2 (e.g. 64)")
-    bootstrap = int(_number("sobol", "bootstrap", sb.get("bootstrap", 200), integer=True))
-    confidence = float(_number("sobol", "confidence", sb.get("confidence", 0.95)))
-    if not 0 < confidence < 1:
-        raise StudyError(f"[sobol] confidence must lie in (0, 1), got {confidence}")
-    if kind == "sobol" and not space.varied:
-        raise StudyError("no parameter is varied; give at least one [parameters.NAME] with min < max")
-    method, points, degree, max_misfit = _parse_surrogate(sb, kind, space)
-    known = _response_figure_names()
-    figures = data.get("response", {}).get("figures", list(known))
-    if not isinstance(figures, list) or not figures or any(f not in known for f in figures):
-        raise StudyError(f"[response] figures must be a list from {', '.join(known)}, got {figures!r}")
-    if kind == "response" and model_spec != "ies":
-        raise StudyError("a response study runs the simulator: model = \"ies\"")
-
+    table = data.get(kind, {})
+    context = Context(kind, space, base_dir, source)
+    method, settings = method_settings(kinds[kind], table, context)
+    if method.models is not None and model_spec not in method.models:
+        raise StudyError(f"a{'n' if kind[0] in 'aeiou' else ''} {kind} study runs the simulator: model = \"ies\"")
     outputs = head.get("outputs", [])
     if not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs) or len(set(outputs)) != len(outputs):
         raise StudyError(f"[study] outputs must be a list of distinct output names, e.g. [\"mean\", \"restitution\"], got {outputs!r}")
     contact_law = _parse_contact_law(head, space)
-    series = _parse_series(data.get("response", {}).get("series"), kind, space)
     cluster = parse_cluster_table(data["cluster"]) if "cluster" in data else None
-    study = Study(name=name, kind=kind, model=model_spec, space=space, levels=levels, repetitions=reps, seed=seed,
-                  output=output, protocol=protocol, designs=designs, interior=interior, z=z, fix=fix,
-                  sobol_n=sobol_n, bootstrap=bootstrap, confidence=confidence, source=source,
-                  modal_model=modal_model, figures=tuple(figures), variant=variant, outputs=tuple(outputs),
-                  contact_law=contact_law, series=series, sobol_method=method,
-                  surrogate_points=points, surrogate_degree=degree, max_misfit=max_misfit,
-                  cluster=cluster)
-    for _, one in study.series_studies():
-        _parse_contact_law({"contact_law": contact_law}, one.space)  # every value in range
+    study = Study(name=name, kind=kind, method=method, settings=settings, table=dict(table), model=model_spec,
+                  space=space, levels=levels, repetitions=reps, seed=seed, output=output, protocol=protocol,
+                  source=source, modal_model=modal_model, variant=variant, outputs=tuple(outputs),
+                  contact_law=contact_law, cluster=cluster)
+    for _, one in method.substudies(study):
+        _parse_contact_law({"contact_law": contact_law}, one.space)  # every value of a series in range
     model = study.make_model()  # unknown model -> one line now
     from sim.model.contact_law import DEFAULT_LAW
 
@@ -346,82 +355,70 @@ def parse_study(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: 
         model.check()  # an unreadable modal file -> one line now
     if "friction" in space.names:  # every mu of the study: >= 0, and > 0 needs ode3 and the floor values
         k_t = space["k_t"].min if "k_t" in space.names else model.optional_parameter("k_t").nominal
-        for mu in (space["friction"].min, space["friction"].max, *(study.series[1] if study.series else ())):
+        series = [one.space["friction"].nominal for _, one in method.substudies(study)]
+        for mu in (space["friction"].min, space["friction"].max, *series):
             model.check_physics({"friction": mu, "k_t": k_t})
     return study
 
 
-def _parse_surrogate(sb: Mapping[str, Any], kind: str, space: ParameterSpace) -> tuple[str, int, int, float]:
-    """[sobol] method, points, degree, max_misfit (`uq.methods.surrogate`): (method, design points, degree, allowed misfit)."""
-    from uq.methods.surrogate import MAX_MISFIT, METHODS
-
-    method = sb.get("method", "saltelli")
-    if method not in METHODS:
-        raise StudyError(f"[sobol] method must be one of {', '.join(METHODS)}, got {method!r}")
-    own = sorted({"points", "degree", "max_misfit"} & set(sb))
-    if method != "pce" and own:
-        raise StudyError(f"[sobol] {', '.join(own)} only appl{'ies' if len(own) == 1 else 'y'} to method = \"pce\"")
-    degree = int(_number("sobol", "degree", sb.get("degree", 2), integer=True))
-    points = int(_number("sobol", "points", sb["points"], integer=True)) if "points" in sb else 0
-    max_misfit = float(_number("sobol", "max_misfit", sb.get("max_misfit", MAX_MISFIT)))
-    if method == "pce":
-        return surrogate_settings(kind, len(space.varied), points, degree) + (max_misfit,)
-    return method, points, degree, max_misfit
-
-
-def surrogate_settings(kind: str, k: int, points: int, degree: int) -> tuple[str, int, int]:
-    """("pce", design points, degree) checked for a study of `kind` with `k` varied parameters (`points` 0: the
-    default of `uq.methods.surrogate.default_points`); a one-line StudyError for a kind without a surrogate, too few
-    points for the degree, or OpenTURNS missing."""
-    from uq.methods.surrogate import check_design, default_points, openturns
-
-    if kind != "sobol":
-        raise StudyError(f"method \"pce\" (a surrogate of the Sobol' indices) applies to kind = \"sobol\" only; "
-                         f"a{'n' if kind[0] in 'aeiou' else ''} {kind} study has no surrogate")
-    points = points or default_points(k, degree)
-    check_design(k, points, degree)
-    openturns()
-    return "pce", points, degree
-
-
-def with_sobol_method(study: Study, method: str | None = None, points: int | None = None,
-                      degree: int | None = None) -> Study:
-    """The study with the command line's `--method`, `--points`, `--degree` (None: the study file's), checked as
-    the study file's keys are (one-line StudyError)."""
-    from dataclasses import replace
-
-    from uq.methods.surrogate import METHODS
-
-    method = method or study.sobol_method
-    if method not in METHODS:
-        raise StudyError(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
-    if method != "pce":
-        if points is not None or degree is not None:
-            raise StudyError("--points and --degree apply to --method pce only")
-        return replace(study, sobol_method=method)
-    keep = study.sobol_method == "pce"
-    points = points if points is not None else (study.surrogate_points if keep else 0)
-    degree = degree if degree is not None else study.surrogate_degree
-    _, points, degree = surrogate_settings(study.kind, len(study.space.varied), points, degree)
-    return replace(study, sobol_method="pce", surrogate_points=points, surrogate_degree=degree)
+def method_settings(candidates: list[Any], table: Mapping[str, Any], context: Context,
+                    given: Mapping[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
+    """The method of a kind's table and its checked settings: the table's ``method`` key chooses among the kind's
+    `candidates` (the first by default; `given`'s ``method``, from the command line, wins, and then the table's keys
+    of the kind's other methods are dropped); every setting from `given` (the command line's options), else the
+    table, else its default; one line (StudyError) for an unknown key, a key of another method or a bad value."""
+    given = dict(given or {})
+    kind = context.kind
+    names = [m.name for m in candidates]
+    chosen = given.pop("method", None)
+    table = dict(table)
+    from_file = table.pop("method", names[0])
+    name = chosen or from_file
+    if name not in names:
+        where = "--method" if chosen else f"[{kind}] method"
+        raise StudyError(f"{where} must be one of {', '.join(names)}, got {name!r}")
+    method = candidates[names.index(name)]
+    own = {s.key for s in method.settings}
+    if chosen and chosen != from_file:  # the command line switched the method: the file's keys of the other go
+        table = {k: v for k, v in table.items() if k in own}
+    others: dict[str, list[str]] = {}
+    for m in candidates:
+        if m is not method:
+            for s in m.settings:
+                if s.key not in own:
+                    others.setdefault(s.key, []).append(m.name)
+    for source, keys in (("table", table), ("options", given)):
+        misplaced = sorted(k for k in keys if k in others)
+        if misplaced:
+            if source == "options":
+                options = [next(s.option for m in candidates for s in m.settings if s.key == k) for k in misplaced]
+                raise StudyError(f"{', '.join(o or k for o, k in zip(options, misplaced))} appl"
+                                 f"{'ies' if len(misplaced) == 1 else 'y'} to method "
+                                 f"{' or '.join(others[misplaced[0]])} only, not {method.name}")
+            raise StudyError(f"[{kind}] {', '.join(misplaced)} only appl{'ies' if len(misplaced) == 1 else 'y'} to "
+                             + " or ".join(f"method = \"{m}\"" for m in others[misplaced[0]]))
+        unknown = sorted(k for k in keys if k not in own)
+        if unknown:
+            raise StudyError(f"unknown key '{unknown[0]}' in [{kind}]; known: {', '.join(sorted(own | {'method'}))}")
+    values: dict[str, Any] = {}
+    for s in method.settings:
+        if s.key in given:
+            values[s.key] = s.read(given[s.key], context)
+        elif s.key in table:
+            values[s.key] = s.read(table[s.key], context)
+        else:
+            values[s.key] = s.default
+    return method, method.finish(values, context)
 
 
-def _parse_series(table: Any, kind: str, space: ParameterSpace) -> tuple[str, tuple[float, ...]] | None:
-    """[response] series = { NAME = [values] }: one listed parameter and its distinct values (kind "response")."""
-    if table is None:
-        return None
-    if kind != "response":
-        raise StudyError("[response] series only applies to kind = \"response\"")
-    if not isinstance(table, Mapping) or len(table) != 1:
-        raise StudyError(f"[response] series must name one parameter and its values, e.g. series = {{ r_cont = [1.0, 0.99] }}, "
-                         f"got {table!r}")
-    (name, values), = table.items()
-    if name not in space.names:
-        raise StudyError(f"[response] series: '{name}' is not a parameter of the study; list it as [parameters.{name}]")
-    if not isinstance(values, list) or not values or len(set(values)) != len(values):
-        raise StudyError(f"[response] series: {name} needs a list of distinct values, got {values!r}")
-    return name, tuple(float(_number("response", f"series.{name}", v, positive=False)) for v in values)
-
+def with_settings(study: Study, methods: Mapping[str, Any], given: Mapping[str, Any]) -> Study:
+    """The study with settings given on the command line (key -> value, ``method`` to switch among the kind's
+    methods), read over the file's table as the file's own keys are (one-line StudyError)."""
+    given = {k: v for k, v in given.items() if v is not None}
+    if not given:
+        return study
+    method, settings = method_settings(_kinds(methods)[study.kind], study.table, study.context(), given)
+    return replace(study, method=method, settings=settings)
 
 def _parse_contact_law(head: Mapping[str, Any], space: ParameterSpace) -> str:
     """[study] contact_law (a law of `sim.model.contact_law.LAWS`: Eq. 4 "hertz" or Eq. 10 "hertz-damped");
@@ -513,7 +510,7 @@ def _check_param_table(name: str, spec: Any) -> Mapping[str, Any]:
     return spec
 
 
-def _parse_fix(fix: Any, space: ParameterSpace, base_dir: Path, source: str) -> dict[str, float]:
+def read_fixed_values(fix: Any, space: ParameterSpace, base_dir: Path, source: str) -> dict[str, float]:
     if not isinstance(fix, Mapping):
         raise StudyError(f"[interval] fix must be a table like {{ k_H = \"best_estimate\" }}, got {fix!r}")
     out = {}

@@ -28,7 +28,7 @@ def test_sobol_command_on_ishigami(tmp_path, capsys):
     for suffix in ("png", "pdf"):
         assert (tmp_path / "o" / f"sobol.{suffix}").stat().st_size > 1000
     meta = json.loads((tmp_path / "o" / "study.json").read_text())
-    assert meta["study"]["sobol"]["n"] == 64 and meta["summary"]["base_sample"] == 512
+    assert meta["study"]["sobol"]["n"] == 512 and meta["summary"]["base_sample"] == 512  # what ran: --n over the file
 
 
 def test_sobol_bad_sample_size_writes_nothing(tmp_path, capsys):
@@ -41,19 +41,19 @@ def test_sobol_bad_sample_size_writes_nothing(tmp_path, capsys):
 
 
 def test_noisy_model_noise_share_and_no_false_flags(tmp_path):
-    from uq.problem.study import load_study
-    from uq.engine.execute import run_interval_study, run_sobol_study
+    from uq.engine.execution import run_study
+    from uq.methods import load_study
 
     text = "[study]\nkind = '{kind}'\nmodel = 'uq.problem.test_functions:noisy_linear'\nrepetitions = {reps}\nseed = 3\n" + AB
     path = tmp_path / "i.toml"
     path.write_text(text.format(kind="interval", reps=8) + "[interval]\ndesigns = ['individual', 'joint']\ninterior = 3\n")
-    res = run_interval_study(load_study(path), out=tmp_path / "i", progress=False)
+    res = run_study(load_study(path), out=tmp_path / "i", progress=False)
     assert all(res.summary["monotone"].values()), res.warnings  # noise does not trip the check
     band = {r["design"]: r for r in rows(tmp_path / "i" / "bands.csv")}
     assert float(band["joint"]["lower"]) == pytest.approx(1.0, abs=4 * 0.2 / np.sqrt(8))  # level 1 + 0
     assert float(band["joint"]["upper"]) == pytest.approx(4.0, abs=4 * 0.2 / np.sqrt(8))  # level 1 + 1 + 2
     path.write_text(text.format(kind="sobol", reps=4) + "[sobol]\nn = 128\n")
-    res = run_sobol_study(load_study(path), out=tmp_path / "s", progress=False)
+    res = run_study(load_study(path), out=tmp_path / "s", progress=False)
     # Var(ybar) = Var(a + 2 b) + sigma^2 / r = 5/12 + 0.01; noise share = 0.01 / (5/12 + 0.01)
     share = float(rows(tmp_path / "s" / "variance.csv")[0]["noise_share"])
     assert share == pytest.approx(0.01 / (5 / 12 + 0.01), rel=0.25)
@@ -94,14 +94,14 @@ def test_calibrated_k_H_becomes_the_upper_bound():
     from uq.commands.reproduce import study_file
     from uq.problem.study import with_calibration
     from uq.problem.space import K_H_STAR
-    from uq.problem.study import load_study
+    from uq.methods import load_study
 
     study = load_study(study_file("fig8", quick=True))
     cal = with_calibration(study, 1.48 * K_H_STAR)
     assert cal.space["k_H"].max == pytest.approx(1.48 * K_H_STAR)
-    assert cal.fix["k_H"] == pytest.approx(1.25 * K_H_STAR)
+    assert cal.settings["fix"]["k_H"] == pytest.approx(1.25 * K_H_STAR)
     low = with_calibration(study, 1.1 * K_H_STAR)  # below the paper's best estimate: use the midpoint
-    assert low.fix["k_H"] == pytest.approx(1.05 * K_H_STAR)
+    assert low.settings["fix"]["k_H"] == pytest.approx(1.05 * K_H_STAR)
 
 
 def tiny_reproduction(tmp_path, monkeypatch, extra=""):

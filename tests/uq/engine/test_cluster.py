@@ -7,7 +7,8 @@ import sys
 import pytest
 
 from uq.cli import build_parser, main
-from uq.engine.cluster import ClusterSettings, _cluster_kwargs, cluster_settings, parse_cluster_table
+from uq.engine.cluster import _cluster_kwargs, cluster_settings
+from uq.problem.cluster_settings import ClusterSettings, parse_cluster_table
 from uq.errors import StudyError
 
 STUDY = """
@@ -104,8 +105,8 @@ def test_every_study_command_takes_the_cluster_options():
 
 def test_the_cluster_table_is_not_part_of_the_study_key(tmp_path):
     """The same study on a cluster or locally has the same key: --resume continues it on either."""
-    from uq.engine.execute import study_key
-    from uq.problem.study import load_study
+    from uq.engine.execution import study_key
+    from uq.methods import load_study
 
     local = load_study(study(tmp_path))
     (tmp_path / "c").mkdir()

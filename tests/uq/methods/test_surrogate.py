@@ -100,8 +100,8 @@ BAD = [
     ("[study]\nkind = 'sobol'\nmodel = 'ishigami'\n[sobol]\nmethod = 'pce'\npoints = 12\ndegree = 3\n", [],
      "points = 12 is too few for degree 3 in 3 parameters (20 polynomial terms)"),
     ("[study]\nkind = 'sobol'\nmodel = 'ishigami'\n", ["--method", "pce", "--points", "9"], "too few for degree 2"),
-    ("[study]\nkind = 'sobol'\nmodel = 'ishigami'\n", ["--method", "pce", "--n", "64"], "--n is Saltelli's"),
-    ("[study]\nkind = 'sobol'\nmodel = 'ishigami'\n", ["--points", "40"], "apply to --method pce only"),
+    ("[study]\nkind = 'sobol'\nmodel = 'ishigami'\n", ["--method", "pce", "--n", "64"], "--n applies to method saltelli only"),
+    ("[study]\nkind = 'sobol'\nmodel = 'ishigami'\n", ["--points", "40"], "--points applies to method pce only"),
     ("[study]\nkind = 'sobol'\nmodel = 'ishigami'\n[sobol]\nmethod = 'kriging'\n", [], "method must be one of"),
     ("[study]\nkind = 'sobol'\nmodel = 'ishigami'\n[sobol]\ndegree = 3\n", [], "degree only applies to method"),
 ]

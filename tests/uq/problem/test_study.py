@@ -7,9 +7,8 @@ import numpy as np
 import pytest
 
 from uq.cli import main
-from uq.errors import StudyError
 from uq.problem.space import K_H_STAR, calibrated_k_H, resolve_k_H, table2_space
-from uq.problem.study import load_study
+from uq.methods import load_study
 
 MINIMAL = """
 [study]
@@ -64,7 +63,12 @@ def test_resolved_study_lists_every_setting(tmp_path):
     (MINIMAL + "[parameters.k_H]\nmin = -1.0\n", "must be a positive number"),
     (MINIMAL + "[parameters.D]\nmax = 1.5\n", "must be below 1"),
     (MINIMAL + "[parameters.g]\nnominal = 0.7e-3\n", "outside [min, max]"),
-    (MINIMAL + "[sobol]\nn = 100\n", "power of two"),
+    (MINIMAL + "[sobol]\nn = 100\n", "[sobol] applies to kind = \"sobol\" only; this is an interval study"),
+    (MINIMAL.replace("interval", "sobol") + "[parameters.g]\n[sobol]\nn = 100\n", "power of two"),
+    (MINIMAL + "[interval]\nz = -1\n", "[interval] z must be >= 0"),
+    ("[excitation]\nlevels = [6.7]\n", "[study] kind is missing: say what the study computes, one of interval, sobol, "
+                                        "response, design"),
+    ("[study]\nkind = 'design'\n", "run it with `ies design FILE`"),
     (MINIMAL + "[extras]\n", "unknown table [extras]"),
     ("[study]\nkind = 'grid'\n", "kind must be one of"),
     (MINIMAL + "[interval]\ndesigns = ['diagonal']\n", "unknown design 'diagonal'"),
