@@ -52,9 +52,6 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
                         help="a design to verify beside the recommendation, e.g. the paper's 0.58mm,7.92mm,brass")
     parser.add_argument("--block-width", metavar="LENGTH", help="the host's block across the cavity (default 28mm)")
     parser.add_argument("--min-wall", metavar="LENGTH", help="thinnest wall left beside the cavity (default 5.5mm)")
-    parser.add_argument("--large", action="store_true", default=None,
-                        help="run a design above the size limit (20000 runs before the search goes on), whose estimate "
-                             "is refused otherwise")
     add_run_arguments(parser)
 
 
@@ -64,7 +61,7 @@ def design_problem(args: argparse.Namespace) -> tuple[Any, Path, Any]:
     from uq.design import problem as d
 
     file = d.read_design_file(args.study) if args.study is not None else d.DesignFile()
-    given = {name: getattr(args, name) for name in d.DESIGN_SETTINGS if getattr(args, name, None) is not None}
+    given = {name: getattr(args, name) for name in d.DESIGN_SETTINGS if getattr(args, name, None) not in (None, False)}
     settings = {**d.DESIGN_SETTINGS, **file.settings, **given}
     return d.problem_of(settings, file.protocol), Path(args.out or settings["output"]), file.cluster
 

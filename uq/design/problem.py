@@ -45,10 +45,9 @@ PROTOCOL = {"eta_start": 0.96, "eta_stop": 1.01, "n_eta": 26, "wait": 2.0, "hold
 MARGIN = 0.2
 
 
-#: the most values a range may have (COUNT), and the most simulation runs a design may plan before any work unless
-#: `--large` (about 3 h on one core at the rig's 0.5 s per run)
+#: the most values a range may have (COUNT); a design's runs are limited as a study's (`uq.problem.tasks.MAX_RUNS`,
+#: `--allow-large`), estimated at about SECONDS_PER_RUN each on one core (the rig's stepped sine of PROTOCOL)
 MAX_COUNT = 1000
-RUN_LIMIT = 20000
 SECONDS_PER_RUN = 0.5
 
 
@@ -100,7 +99,7 @@ class DesignProblem:
     k_H_factor: tuple[float, float] = K_H_FACTOR
     objective: str = "mean"
     margin: float = MARGIN
-    large: bool = False
+    allow_large: bool = False
     candidates: int = 3
     repetitions: int = 3
     restitution: float = RESTITUTION
@@ -392,7 +391,7 @@ DESIGN_SETTINGS: dict[str, Any] = {
     "excitation": None, "clearance": "0.3mm:1.2mm:10", "radius": "7.92mm", "material": "brass", "model": None,
     "objective": "mean", "damping": None, "clearance_tolerance": None, "k_H_factor": None, "calibration": None,
     "candidates": 3, "reps": 3, "restitution": None, "baseline": None, "block_width": None, "min_wall": None,
-    "margin": None, "large": False, "output": "ies-out/design"}
+    "margin": None, "allow_large": False, "output": "ies-out/design"}
 
 
 @dataclass(frozen=True)
@@ -465,7 +464,7 @@ def problem_of(settings: Mapping[str, Any], protocol: Mapping[str, Any] = PROTOC
         fields["restitution"] = float(value["restitution"])
     if value["margin"] is not None:
         fields["margin"] = _number(value["margin"], "--margin", "a fraction in (0, 1], e.g. 0.2 for 20 %")
-    fields["large"] = bool(value["large"])
+    fields["allow_large"] = bool(value["allow_large"])
     if value["baseline"] is not None:
         fields["baseline"] = parse_baseline(value["baseline"], radii, materials)
     problem = dataclasses.replace(problem, **fields)

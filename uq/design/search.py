@@ -15,7 +15,6 @@ import numpy as np
 from uq.design.objectives import Objective, objective_named
 from uq.design.prediction import DesignPrediction, Predictor, box
 from uq.design.problem import (
-    RUN_LIMIT,
     SECONDS_PER_RUN,
     DesignProblem,
     Sphere,
@@ -92,16 +91,19 @@ def first_runs(problem: DesignProblem) -> tuple[int, int]:
 
 
 def check_size(problem: DesignProblem) -> None:
-    """Refuse, before any work, a design whose first batch and references exceed RUN_LIMIT runs unless `large`, with
-    the estimate in the line."""
+    """Refuse, before any work, a design whose first batch and references exceed a study's run limit
+    (`uq.problem.tasks.MAX_RUNS`) unless `allow_large`, with the estimate in the line."""
+    from uq.problem.tasks import MAX_RUNS
+
     verify, references = first_runs(problem)
     total = verify + references
-    if total > RUN_LIMIT and not problem.large:
+    if total > MAX_RUNS and not problem.allow_large:
         raise StudyError(f"this design would run at least {total} simulations before its search adds neighbours "
                          f"({verify} to verify the first {min(problem.candidates, len(problem.grid()))} design(s) at "
                          f"{len(problem.excitation)} levels, {problem.repetitions} repetitions; up to {references} for the "
-                         f"similarity references), about {duration(total * SECONDS_PER_RUN)} on one core; the limit is "
-                         f"{RUN_LIMIT}: give fewer levels, candidates or repetitions, or pass --large")
+                         f"similarity references), about {duration(total * SECONDS_PER_RUN)} on one core; a design runs at "
+                         f"most {MAX_RUNS:,} without --allow-large: give fewer levels, candidates or repetitions, or pass "
+                         "--allow-large")
 
 
 def ranked(problem: DesignProblem, predictions: Mapping[Sphere, DesignPrediction]) -> list[Sphere]:
@@ -343,7 +345,7 @@ def run_design(problem: DesignProblem, out: Any, *, jobs: int | None = 1, schedu
 
 #: settings that change how many designs are verified, not what a run computes: a design resumed with another value
 #: reuses every finished run
-UNKEYED = ("candidates", "margin", "large")
+UNKEYED = ("candidates", "margin", "allow_large")
 
 
 def design_key(problem: DesignProblem, model: Any) -> str:

@@ -167,7 +167,7 @@ def test_ranges_read_units_counts_and_accelerations():
     (["--excitation", "2um:8um", "--min-wall", "20mm"], "two walls of 20 mm leave no room in the 28 mm block"),
     (["--excitation", "2um:8um", "--objective", "loudness"], "--objective must be one of mean, max"),
     (["--excitation", "0.66um:6.6um:100000000"], "COUNT 100000000 is more than 1000 values"),
-    (["--excitation", "0.66um:6.6um:1000", "--reps", "20"], "the limit is 20000: give fewer levels"),
+    (["--excitation", "0.66um:6.6um:1000", "--reps", "20"], "at most 20,000 without --allow-large: give fewer levels"),
 ])
 def test_each_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, args, phrase):
     out = tmp_path / "out"
