@@ -43,7 +43,7 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
                         help="`ies calibrate --json` output: its k_H / k_H* becomes the upper end of the k_H factor "
                              "(the crater's stiffening, as `ies reproduce` uses it)")
     parser.add_argument("--candidates", type=positive_int, metavar="N",
-                        help="designs in the first verified batch, the best predicted (default 3); the search then "
+                        help="designs in the first verified batch, the best predicted (default 5); the search then "
                              "verifies the best verified design's neighbours until it has them on every side")
     parser.add_argument("--reps", type=positive_int, metavar="N", help="repetitions per verification run (default 3)")
     parser.add_argument("--restitution", type=float, metavar="R",

@@ -117,7 +117,8 @@ class Predictor:
         return min(REFERENCE_REPS, self.problem.repetitions)
 
     def plan(self, sphere: Sphere) -> tuple[list[tuple[float, float]], list[tuple[float, float, float]], list[float]]:
-        """The references (kappa, D), their realisations (g, k_H, D) and the own levels of one sphere's law."""
+        """The references (kappa, D), their realisations (g, k_H, D) and the own levels of the law of `sphere`'s radius
+        and material (its clearance does not matter)."""
         from sim.reduced.similarity import kappa, own_levels, reference_kappas
 
         p = self.problem
@@ -144,11 +145,11 @@ class Predictor:
         """Build the law of every sphere (radius, material) among `spheres` that has none yet."""
         from sim.reduced.similarity import reference_curves
 
-        for sphere in dict.fromkeys(Sphere(0.0, s.radius, s.material) for s in spheres):
+        for sphere in spheres:
             key = (sphere.radius, sphere.material)
             if key in self.laws:
                 continue
-            references, realisations, levels = self.plan(Sphere(self.problem.clearances[0], *key))
+            references, realisations, levels = self.plan(sphere)
             counted = [0]
             evaluate = self._evaluator(realisations, sphere.mass, counted)
             law = reference_curves(evaluate, references, levels)

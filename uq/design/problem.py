@@ -49,6 +49,8 @@ MARGIN = 0.2
 #: `--allow-large`), estimated at about SECONDS_PER_RUN each on one core (the rig's stepped sine of PROTOCOL)
 MAX_COUNT = 1000
 SECONDS_PER_RUN = 0.5
+#: the most (design, level) pairs the slow flow screens at once (its arrays: tens of MB)
+MAX_SCREENED = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -100,7 +102,7 @@ class DesignProblem:
     objective: str = "mean"
     margin: float = MARGIN
     allow_large: bool = False
-    candidates: int = 3
+    candidates: int = 5
     repetitions: int = 3
     restitution: float = RESTITUTION
     block_width: float = BLOCK_WIDTH
@@ -159,6 +161,12 @@ class DesignProblem:
         if self.baseline is not None and not self.fits(self.baseline):
             raise StudyError(f"--baseline: {self.baseline.label()} needs a {self.baseline.cavity() * 1e3:.2f} mm cavity;"
                              f" {self.room() * 1e3:.2f} mm fit between {self.min_wall * 1e3:g} mm walls")
+        screened = len(self.clearances) * len(self.radii) * len(self.materials) * len(self.excitation)
+        if screened > MAX_SCREENED:
+            raise StudyError(f"the grid of {len(self.clearances)} clearances x {len(self.radii)} radii x "
+                             f"{len(self.materials)} materials at {len(self.excitation)} levels is {screened:,} "
+                             f"(design, level) pairs, more than the {MAX_SCREENED:,} the screening holds in memory: give "
+                             "fewer values to --clearance, --radius or --excitation")
         if not any(self.fits(s) for s in self.grid()):
             raise StudyError(f"no design fits: the cavity 2R + 2g must stay within {self.room() * 1e3:.2f} mm "
                              f"({self.block_width * 1e3:g} mm block, walls of {self.min_wall * 1e3:g} mm); "
@@ -390,7 +398,7 @@ def protocol_of(table: Mapping[str, Any], where: str) -> dict[str, Any]:
 DESIGN_SETTINGS: dict[str, Any] = {
     "excitation": None, "clearance": "0.3mm:1.2mm:10", "radius": "7.92mm", "material": "brass", "model": None,
     "objective": "mean", "damping": None, "clearance_tolerance": None, "k_H_factor": None, "calibration": None,
-    "candidates": 3, "reps": 3, "restitution": None, "baseline": None, "block_width": None, "min_wall": None,
+    "candidates": 5, "reps": 3, "restitution": None, "baseline": None, "block_width": None, "min_wall": None,
     "margin": None, "allow_large": False, "output": "ies-out/design"}
 
 

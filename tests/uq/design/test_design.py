@@ -167,6 +167,8 @@ def test_ranges_read_units_counts_and_accelerations():
     (["--excitation", "2um:8um", "--min-wall", "20mm"], "two walls of 20 mm leave no room in the 28 mm block"),
     (["--excitation", "2um:8um", "--objective", "loudness"], "--objective must be one of mean, max"),
     (["--excitation", "0.66um:6.6um:100000000"], "COUNT 100000000 is more than 1000 values"),
+    (["--excitation", "1um:6um:1000", "--clearance", "0.1mm:0.5mm:1000", "--radius", "5mm:7mm:10"],
+     "more than the 2,000,000 the screening holds"),
     (["--excitation", "0.66um:6.6um:1000", "--reps", "20"], "at most 20,000 without --allow-large: give fewer levels"),
 ])
 def test_each_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, args, phrase):
@@ -326,6 +328,9 @@ def test_admissible_needs_the_margin_and_no_almost_periodic_run_anywhere_in_the_
     assert not seen.admissible(TOP, 0.2) and seen.switch_worst() == pytest.approx(problem.excitation[1])
     assert seen.switch_kind() == "verified"
     assert not v.admissible(TOP, v.margin(TOP) + 0.01)
+    # an almost periodic label below a point's first impacts (a rattle, no resonance of the IES) does not count
+    rattle = dataclass_replace(seen, point_onset=np.full(9, problem.excitation[1] * 1.01))
+    assert rattle.admissible(TOP, 0.2) and rattle.apr_seen_at() == math.inf
 
 
 def dataclass_replace(obj, **changes):
