@@ -190,14 +190,13 @@ def verify(problem: DesignProblem, objective: Objective, spheres: Sequence[Spher
     """Stage 3: every corner and the centre of the box of every design at every operating level and at the margin
     level (`margin_level`), each with the problem's repetitions, through `run` (the study runner: cached in the
     design's folder, resumable)."""
-    from uq.engine.runner import Task
-
     from sim.reduced.slow_flow import host_mode as mode_of
+    from uq.engine.runner import Task
 
     excitation = np.array([*problem.excitation, margin_level(problem)])
     levels = levels_of(rig, excitation)
     omega_1 = float(rig.omega[0])
-    coupling = mode_of(rig).coupling
+    mode = mode_of(rig)
     boxes = {s: corners(problem, s) for s in spheres}
     tasks = [Task.make(p, L, rep) for s in spheres for p in boxes[s] for L in levels for rep in range(problem.repetitions)]
     results = run(tasks)
@@ -217,7 +216,7 @@ def verify(problem: DesignProblem, objective: Objective, spheres: Sequence[Spher
         low, high = value[:-1, :n_op].min(axis=0), value[:-1, :n_op].max(axis=0)
         nominal = value[-1, :n_op]
         outside = (nominal > high + 2.0 * se[-1, :n_op]) | (nominal < low - 2.0 * se[-1, :n_op])
-        onset = np.array([2.0 * p["D"] * p["g"] / coupling for p in boxes[s]])  # first impacts per point, Eq. 7
+        onset = np.array([first_impacts(dataclasses.replace(mode, D=p["D"]), p["g"]) for p in boxes[s]])
         out.append(Verified(s, low, high, nominal, apr[:, :n_op].mean(axis=0), outside,
                             len(boxes[s]) * levels.size * problem.repetitions, point_apr=apr, point_onset=onset,
                             margin_high=float(np.max(value[:, -1])), excitation=tuple(float(x) for x in excitation),
@@ -239,9 +238,9 @@ def search(problem: DesignProblem, predictor: Predictor, verify_batch: Callable[
     predicted designs (and the baseline), then, round by round, the unverified neighbours (`neighbours`) of the best
     verified design (`best_of`), until it has verified neighbours on every axis or the grid ends there. Returns the
     verified designs (best first) and the rounds."""
-    grid_designs = set(problem.grid())
+    grid = set(problem.grid())
     fitting = [screened.designs[i] for i in np.argsort(screened.worst, kind="stable")
-               if np.isfinite(screened.worst[i]) and screened.designs[i] in grid_designs]
+               if np.isfinite(screened.worst[i]) and screened.designs[i] in grid]
     spheres = list(dict.fromkeys((s.radius, s.material) for s in fitting))[: problem.candidates]
     first_spheres = [s for s in fitting if (s.radius, s.material) in spheres]
     predictor.ensure(first_spheres)
@@ -251,7 +250,6 @@ def search(problem: DesignProblem, predictor: Predictor, verify_batch: Callable[
         predictor.ensure([problem.baseline])
         batch.append(problem.baseline)
     verified: dict[Sphere, Verified] = {}
-    grid = set(problem.grid())
     trail = Search()
     while batch:
         log(f"round {len(trail.rounds) + 1}: verifying {len(batch)} design(s): "

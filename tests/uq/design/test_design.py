@@ -32,6 +32,12 @@ hold = 0.2
 """
 
 
+#: one sphere, two clearances: the smallest design a search walks (the objective's extension test)
+SMALL = TINY.replace('clearance = "0.4mm:0.7mm:4"', 'clearance = "0.4mm:0.5mm:2"').replace(
+    'radius = "6mm:7.92mm:2"', 'radius = "7.92mm"').replace('material = "brass,tungsten"', 'material = "tungsten"').replace(
+    'baseline = "0.58mm,7.92mm,brass"\n', "")
+
+
 def exit_code(argv):
     """main's exit code, whether it returns it or argparse raises SystemExit."""
     try:
@@ -117,7 +123,7 @@ def test_a_new_objective_is_one_row_and_runs_ies_design_end_to_end(tmp_path, cap
                        "m/s^2", "m/s^2", 1.0, rms_acceleration,
                        lambda tip, omega_1: omega_1**2 * np.asarray(tip) / math.sqrt(2.0))
     monkeypatch.setitem(do.OBJECTIVES, row.name, row)
-    study = tiny_study(tmp_path)
+    study = tiny_study(tmp_path, text=SMALL)
     assert main(["design", str(study), "--jobs", "1", "--quiet", "--no-figures", "--objective", "rms-acceleration",
                  "--out", str(tmp_path / "acc")]) == 0
     printed = capsys.readouterr().out
