@@ -6,7 +6,7 @@ margin above the top of that range at every corner of the box.
 
 Why the margin. An IES works best just below that switch (Sect. 5.3: the optimum at a_base/a_base* ~ 6.7 lies at the
 switch): below it the response is strongly modulated and low, above it the amplitude jumps several-fold onto the
-almost periodic branch (on the cantilever of the design benchmarks 3.8x). A design whose worst corner switches
+almost periodic branch (3.5x on the cantilever of the design benchmarks, 4.1x on the rig in the README's example). A design whose worst corner switches
 within the range, or just above it, is one tolerance away from that jump; `--margin` (default 20 %) is the distance a
 design must keep, and the recommendation says where its amplitude jumps and by how much.
 
@@ -14,7 +14,8 @@ Method, in three stages (`uq.design.search`):
 
 1. **Screening** by the slow flow (`sim.reduced.slow_flow.screen`, milliseconds for the whole grid): the onset of
    impacts, the trends with the sphere's mass and which spheres to predict first. Its switch (the fold of Eq. 9) is
-   only a lower bound of the full model's (0.54-0.82 of it on the hosts measured), so it does not decide.
+   only a lower bound of the full model's (0.75-0.82 of it on the rig, its 3D solid model and a cantilever), so it
+   does not decide.
 2. **Prediction** by the similarity law of the full model (`sim.reduced.similarity`, `uq.design.prediction`): for a
    host and a sphere the normalised response at the own level a_base/a_base*(g) depends on g and k_H only through
    kappa = k_H g^(1/2), so a few references per sphere (kappa across the grid and the box, both ends of D_1),
