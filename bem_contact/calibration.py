@@ -18,6 +18,7 @@ import numpy as np
 
 from bem_contact.errors import ContactInputError
 from bem_contact.solvers import DEFAULT_SOLVER, solve_contact
+from sim.model.materials import hertz_constant_of
 
 GapMaker = Callable[[int], tuple[np.ndarray, float]]
 
@@ -172,7 +173,7 @@ def calibrate_k_H(
     k_coarse, _ = fit_k_H(coarse.deltas, coarse.forces)
     k_star = ratio = None
     if R is not None:
-        k_star = 4.0 / 3.0 * math.sqrt(R) * E_star  # Eq. 8 with E* given directly
+        k_star = hertz_constant_of(R, E_star)  # Eq. 8 with E* given directly
         ratio = k / k_star
     return Calibration(
         k_H=k, k_H_error=abs(k - k_coarse), fit_residual=residual, deltas=fine.deltas, forces=fine.forces,

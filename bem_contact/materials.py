@@ -1,10 +1,13 @@
-"""Elastic materials of the two bodies in contact and their combined moduli (seed paper, Table 1, Eq. 8)."""
+"""Elastic materials of the two bodies in contact and their combined moduli (seed paper, Table 1, Eq. 8). Table 1's
+values and Eq. 8 are `sim.model.materials`'s (the one vocabulary); this module adds the shear modulus and Mindlin's
+tangential combination that the BEM needs."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 
 from bem_contact.errors import ContactInputError
+from sim.model.materials import BRASS_E, BRASS_NU, HOST_E, HOST_NU, contact_modulus_of, hertz_constant_of
 
 
 @dataclass(frozen=True)
@@ -34,13 +37,13 @@ class Material:
 
 
 # Table 1 of the seed paper.
-STEEL = Material(E=207e9, nu=0.3, name="steel (host structure, Table 1)")
-BRASS = Material(E=102e9, nu=0.3, name="brass (IES sphere, Table 1)")
+STEEL = Material(E=HOST_E, nu=HOST_NU, name="steel (host structure, Table 1)")
+BRASS = Material(E=BRASS_E, nu=BRASS_NU, name="brass (IES sphere, Table 1)")
 
 
 def contact_modulus(a: Material, b: Material) -> float:
     """Contact modulus E* = [(1 - nu_a^2)/E_a + (1 - nu_b^2)/E_b]^-1 in Pa (the bracket of Eq. 8)."""
-    return 1.0 / ((1.0 - a.nu**2) / a.E + (1.0 - b.nu**2) / b.E)
+    return contact_modulus_of(a.E, a.nu, b.E, b.nu)
 
 
 def tangential_modulus(a: Material, b: Material) -> float:
@@ -52,4 +55,4 @@ def k_H_star(R: float, a: Material, b: Material) -> float:
     """Hertzian spring constant of a sphere of radius R (m) on a flat wall, Eq. 8: (4/3) sqrt(R) E*, in N/m^1.5."""
     if not (math.isfinite(R) and R > 0):
         raise ContactInputError(f"sphere radius R = {R!r} m must be a finite number > 0 (the IES: 7.92e-3)")
-    return 4.0 / 3.0 * math.sqrt(R) * contact_modulus(a, b)
+    return hertz_constant_of(R, contact_modulus(a, b))

@@ -9,7 +9,8 @@ the JSON object of `ies calibrate --json`, and `calibrate_default` that object f
 with every default, which `ies reproduce` uses as the upper bound of k_H. `tangential` gives k_t of the stuck sphere.
 
 The scans stage is imported here because reading a scan and pressing on it is the pipeline's arrow
-scans -> bem_contact. Heavy imports stay inside the functions (`ies --help` reads the defaults from here).
+scans -> bem_contact. Heavy imports stay inside the functions (`ies --help` reads the defaults from here); the paper's
+sphere, clearance and k_t come from the one vocabulary, `sim.model.parameters`.
 """
 from __future__ import annotations
 
@@ -17,14 +18,15 @@ import sys
 from dataclasses import dataclass
 from typing import Any, Callable
 
-SPHERE_RADIUS = 7.92e-3  # m, Sect. 2
-SPHERE_WEIGHT = 0.0177 * 9.81  # N, m_a g: the normal load of Appendix C
-K_T_PAPER = 22e6  # N/m, Appendix C: "stiffness 22 kN/mm"
+from sim.model.parameters import (CLEARANCE_NOMINAL, GRAVITY, K_T_PAPER, SPHERE_FLATTENING, SPHERE_MASS,  # noqa: F401
+                                  SPHERE_RADIUS)
+
+SPHERE_WEIGHT = SPHERE_MASS * GRAVITY  # N, m_a g: the normal load of Appendix C
 DEFAULT_GRID = 256
 DEFAULT_TANGENTIAL_GRID = 96  # BEM k_t within 0.1 % of Mindlin's at the weight
 DEFAULT_SIDE_MM = 2.5  # contact radius at 40 um is 0.56 mm: the domain holds it with room to spare
-PAPER_FLATTENING_MM = 0.02  # Sect. 4.1: sphere diameter 15.80 mm in the flattened regions, 15.84 nominal
-PAPER_CLEARANCE_MM = 0.58  # Sect. 4.1: (17 - 15.84) / 2
+PAPER_FLATTENING_MM = SPHERE_FLATTENING * 1e3  # Sect. 4.1: sphere diameter 15.80 mm in the flattened regions, 15.84 nominal
+PAPER_CLEARANCE_MM = CLEARANCE_NOMINAL * 1e3  # Sect. 4.1: (17 - 15.84) / 2
 DEFAULT_DENOISE_UM = 90.0  # = scans.contact.DEFAULT_DENOISE (not imported here: `ies --help` stays light)
 NOISY_RAW = 0.1e-6  # m: raw-scan noise beyond which k_H is biased by more than about half a percent
 

@@ -49,15 +49,14 @@ import scipy.ndimage as ndi
 from scans.errors import ScanError
 from scans.raster import HoleReport, fill_holes
 from scans.surface import LevelledSurface, outside_scan
+from sim.model.parameters import CLEARANCE_NOMINAL, SPHERE_FLATTENING, SPHERE_RADIUS
 
-#: the IES radius (Sect. 4.1: nominal diameter 15.84 mm)
-PAPER_RADIUS = 7.92e-3
+#: the IES radius (Sect. 4.1: nominal diameter 15.84 mm), the sphere's flattening per side (Sect. 4.1: 15.84 mm ->
+#: 15.80 mm across the flattened regions) and the nominal clearance (Sect. 4.1: (17 - 15.84) / 2 mm), from the one
+#: vocabulary of the paper's quantities
+PAPER_RADIUS, PAPER_FLATTENING, PAPER_CLEARANCE = SPHERE_RADIUS, SPHERE_FLATTENING, CLEARANCE_NOMINAL
 #: the largest indentation of the paper's simulations (Sect. 4.1, Fig. 3c)
 PAPER_DELTA_MAX = 40e-6
-#: the sphere's flattening per side (Sect. 4.1: 15.84 mm -> 15.80 mm across the flattened regions)
-PAPER_FLATTENING = 0.02e-3
-#: nominal clearance (Sect. 4.1: (17 - 15.84) / 2 mm)
-PAPER_CLEARANCE = 0.58e-3
 PLACEMENTS = ("centroid", "deepest")
 #: width (standard deviation, m) of the default second-order Gaussian denoising of the wall (module docstring)
 DEFAULT_DENOISE = 90e-6

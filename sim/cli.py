@@ -44,37 +44,9 @@ def add_modes_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies modes`."""
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
     parser.add_argument("--save", metavar="FILE", help="write the model as a modal-model file (.toml)")
-    from sim.hosts.sources import add_source_options
+    from sim.hosts.sources import add_host_arguments
 
-    add_source_options(parser.add_mutually_exclusive_group())  # sim.hosts.sources.HOST_SOURCES: --model, --solid, ...
-    parser.add_argument("--variant", default=None, metavar="NAME",
-                        help="updating variant of the built-in rig: joint-spring (default) or effective-modulus; "
-                             "with --solid a variant of the solid model (sim.hosts.variants.SOLID_VARIANTS: beam-neck, "
-                             "updated, updated-400, updated-contact+2mm, updated-contact+4mm, updated-hertz-patch, "
-                             "updated-patch-3mm)")
-    parser.add_argument("--n-modes", dest="n_modes", type=int, default=9, metavar="N",
-                        help="x-bending modes to keep (default 9, as the paper; built-in rig, --solid, --from-calculix)")
-    parser.add_argument("--joint-stiffness", dest="joint_stiffness", type=float, default=None, metavar="N_PER_M",
-                        help="built-in rig, variant joint-spring: fix the beam-block joint's translational stiffness "
-                             "(N/m; inf = rigid) and re-update E and the neck to f1..f4 and f9 (10-60 s)")
-    solid = parser.add_argument_group("3D solid model (--solid) and CalculiX (--from-calculix)")
-    solid.add_argument("--mesh", metavar="LEVEL|JOB.inp",
-                       help="--solid: mesh level coarse (default, ~1 min), medium or fine; --from-calculix: the job's .inp")
-    solid.add_argument("--geometry", metavar="FILE",
-                       help="--solid: TOML file with [geometry] (sim.hosts.solid.SolidGeometry fields, m) and [material] "
-                            "(E in Pa, nu, rho in kg/m^3) tables; missing keys keep the rig's defaults")
-    solid.add_argument("--patch-radius", dest="patch_radius", type=float, default=0.0, metavar="M",
-                       help="--solid: average the wall values over a circle of this radius (m) on each wall face")
-    solid.add_argument("--wall-left", dest="wall_left", metavar="NSET", help="--from-calculix: node set of the left wall")
-    solid.add_argument("--wall-right", dest="wall_right", metavar="NSET", help="--from-calculix: node set of the right wall")
-    solid.add_argument("--tip", metavar="NSET", help="--from-calculix: node set of the measurement point")
-    solid.add_argument("--dat", metavar="JOB.dat", help="--from-calculix: the job's .dat (default: beside the .frd)")
-    solid.add_argument("--floor", metavar="NSET",
-                       help="--from-calculix: node set of the cavity floor under the sphere (phi_floor, for friction)")
-    solid.add_argument("--beam-mass", dest="beam_mass", type=float, metavar="KG",
-                       help="--from-calculix: mass of the beam's free length without the block in kg (for Eq. 10)")
-    solid.add_argument("--units", default="m-kg-s", choices=("m-kg-s", "mm-t-s"),
-                       help="--from-calculix: the job's consistent units (default m-kg-s)")
+    add_host_arguments(parser)  # sim.hosts.sources.HOST_SOURCES: --model, --solid, ...; --variant, --n-modes, FE options
 
 
 def describe_modes(model: Any, rig: Any = None) -> dict:
@@ -166,14 +138,15 @@ def modes_command(args: argparse.Namespace) -> int:
 # ---- the system and the protocol, shared by ies sweep and ies overview ---------------------------------------
 
 def add_system_arguments(parser: argparse.ArgumentParser) -> None:
-    """Model and impactor options: --model, --no-impactor, --contact-law and one option per parameter of
-    `sim.model.parameters.PARAMETERS` that has one (Table 2's D, g, k_H; r_cont, friction, k_t)."""
+    """Host and impactor options: the host's (`sim.hosts.sources.add_host_arguments`: --model, --solid, ...),
+    --no-impactor, --contact-law and one option per parameter of `sim.model.parameters.PARAMETERS` that has one
+    (Table 2's D, g, k_H; r_cont, friction, k_t; a contact law's own constant), with its aliases."""
+    from sim.hosts.sources import add_host_arguments
+    from sim.model.contact_law import DEFAULT_LAW, LAWS
     from sim.model.parameters import PARAMETERS
 
-    parser.add_argument("--model", metavar="FILE", help="modal-model file (default: the built-in model of the seed rig)")
+    add_host_arguments(parser)
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
-    from sim.model.contact_law import DEFAULT_LAW, LAWS
-
     laws = "; ".join(f"{name} ({law.summary}"
                      + (")" if law.collocation else ", the exact integrator takes its contacts by Dormand-Prince)")
                      for name, law in LAWS.items())
@@ -182,8 +155,8 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
     for name, parameter in PARAMETERS.items():
         option = parameter.option
         if option is not None:
-            parser.add_argument(option.flag, dest=name, type=option.parse, default=None, metavar=option.metavar,
-                                help=option.help)
+            parser.add_argument(*option.flags, dest=name, type=option.parse or parameter.option_value, default=None,
+                                metavar=option.metavar, help=option.help_text())
 
 
 def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int) -> None:
@@ -217,10 +190,14 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
                              "for a lead-in before the first point, then every point waits and holds at its nominal "
                              "frequency; each-point: every point its own offset, each sample interpolated back onto "
                              "the grid from the frequencies simulated")
-    parser.add_argument("--integrator", default="exact", metavar="NAME",
-                        help="time integrator: exact (default; closed-form free flight, located contacts) or ode3 (the paper's fixed step)")
+    from sim.integration.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
+
+    choices = " or ".join(f"{name} ({'default; ' if name == DEFAULT_INTEGRATOR else ''}{record.summary})"
+                          for name, record in INTEGRATORS.items())
+    parser.add_argument("--integrator", default=DEFAULT_INTEGRATOR, metavar="NAME", help=f"time integrator: {choices}")
+    scaled = " and ".join(name for name, record in INTEGRATORS.items() if record.dt_scale)
     parser.add_argument("--dt-scale", dest="dt_scale", type=float, default=1.0, metavar="X",
-                        help="ode3 step as a multiple of the paper's 2 pi/(15 omega_9) (default 1)")
+                        help=f"{scaled} step as a multiple of the paper's 2 pi/(15 omega_9) (default 1)")
 
 
 def add_simulation_arguments(parser: argparse.ArgumentParser, *, default_reps: int, figure: str, stem: str) -> None:
@@ -284,39 +261,51 @@ def parse_levels(text: str) -> list[float]:
 
 
 def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
-    """(modal model, impactor or None) of the system and impactor options (Eqs. 3-7, Table 2), built and checked by
-    `sim.model.system.build_system` from the options of `sim.model.parameters.PARAMETERS`."""
-    from sim.hosts.rig import seed_rig_model
-    from sim.hosts.sources import model_file
+    """(modal model, impactor or None) of the host and impactor options (Eqs. 3-7, Table 2): the host through the
+    one resolver (`sim.hosts.sources.resolve_host`), the impactor built and checked by `sim.model.system.build_system`
+    from the options of `sim.model.parameters.PARAMETERS` and the integrator's record (its law, friction)."""
+    from sim.hosts.sources import resolve_host
+    from sim.integration.integrators import integrator_named
     from sim.model.parameters import PARAMETERS, SystemSettings, system_settings
     from sim.model.system import build_impactor
     from sim.model.system import build_system as build
 
-    model = model_file(args.model) if args.model else seed_rig_model(n_modes=9)
+    integrator = integrator_named(args.integrator)
+    model = resolve_host(args).model
     values = {name: getattr(args, name, None) for name in PARAMETERS}
     settings = system_settings(values, SystemSettings(contact_law=args.contact_law))
     if args.no_impactor:  # the impactor's values are checked all the same
         build_impactor(settings)
         return (model if settings.D1 is None else model.with_damping(settings.D1)), None
-    return build(model, settings, integrator=args.integrator)
+    return build(model, settings, integrator=integrator)
 
 
 def system_data(model: Any, impactor: Any) -> dict:
-    """The JSON keys of the simulated system: `model` (its source), `impactor` (`mass_kg`, `g_m`,
-    `k_H_N_per_m1p5`, `contact_law`, `r_cont`, `friction` (mu), `k_t_N_per_m`; None without impactor) and `D1`
-    (damping ratio of mode 1)."""
-    return {"model": model.source, "D1": float(model.damping_ratios[0]),
-            "impactor": None if impactor is None else {"mass_kg": impactor.mass, "g_m": impactor.clearance,
-                                                       "k_H_N_per_m1p5": impactor.k_H,
-                                                       "contact_law": impactor.contact_law.name,
-                                                       "r_cont": impactor.contact_law.r_cont,
-                                                       "friction": impactor.friction, "k_t_N_per_m": impactor.k_t}}
+    """The JSON keys of the simulated system: `model` (its source), the host's parameters (`D1`, the damping ratio of
+    mode 1) and `impactor`: `contact_law` and every other row's key (`sim.model.parameters.UncertainParameter.json_key`:
+    `mass_kg`, `g_m`, `k_H_N_per_m1p5`, `r_cont`, `friction` (mu), `k_t_N_per_m`, a law's own constant, ...; a row
+    that feeds no field of its own only when it was given); None without impactor."""
+    from sim.model.parameters import PARAMETERS, SystemSettings
+    from sim.model.system import settings_of
+
+    host_rows = [row for row in PARAMETERS.values() if row.feeds.field == "D1"]
+    data = {"model": model.source, **{row.json_key: float(model.damping_ratios[0]) for row in host_rows}}
+    if impactor is None:
+        return {**data, "impactor": None}
+    settings: SystemSettings = settings_of(model, impactor)
+    values = {"contact_law": impactor.contact_law.name}
+    for row in PARAMETERS.values():
+        if row not in host_rows and (value := row.reported(settings)) is not None:
+            values[row.json_key] = value
+    return {**data, "impactor": values}
 
 
 def build_protocol(args: argparse.Namespace) -> Any:
     """The `sim.stepped_sine.protocol.SteppedSine` of the protocol options (Sect. 5.1; 15 s wait without impactor)."""
+    from sim.integration.integrators import integrator_named
     from sim.stepped_sine.protocol import SteppedSine
 
+    integrator_named(args.integrator).run_step(dt_scale=args.dt_scale)  # a step scale it does not take: one line now
     start, stop, n = parse_grid(args.eta, "--eta")
     wait = args.wait if args.wait is not None else (15.0 if args.no_impactor else 3.0)
     return SteppedSine(eta_start=start, eta_stop=stop, n_eta=n, sequence=args.sequence, wait=wait,
@@ -509,6 +498,7 @@ def add_trace_arguments(parser: argparse.ArgumentParser) -> None:
 def trace_command(args: argparse.Namespace) -> int:
     """`ies trace`: time histories of one stepped-sine point (Sects. 5.1, 5.5; Figs. 4, 9a)."""
     from sim.analysis.trace import SAMPLE_COST_S, check_trace_settings, record_trace, trace_samples, write_trace
+    from sim.plots.figures import plot_trace
     from sim.common.files import check_writable, dumps, report_written, write_or_fallback
     from sim.integration.integrators import warm_up
     from sim.stepped_sine.cost import announce, check_trace_memory, cost_per_simulated_second, simulated_seconds
@@ -536,7 +526,7 @@ def trace_command(args: argparse.Namespace) -> int:
         plot = Path(args.plot) if args.plot else None
         data, written = write_or_fallback(
             lambda where: write_trace(where, trace, settings, plot if where == folder or plot is None else where / plot.name,
-                                      started), folder, "trace")
+                                      started, draw=plot_trace), folder, "trace")
     if args.json:
         print(dumps(data))
         report_written(written, json_mode=True)

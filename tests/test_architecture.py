@@ -143,27 +143,18 @@ def test_the_walk_sees_every_kind_of_import():
     assert find_cycle({"a": {"b"}, "b": set()}) is None
 
 
-#: Inside `sim`: sub-package -> the sub-packages it may import (besides itself). The simulator's parts in pipeline
-#: order: the shared layer; the coupled system; the integrators; the stepped-sine protocol and its measures; the host
-#: models (their fidelity variants read the measures' landmarks); signal analysis; the reduced (slow-flow) model;
-#: the periodic orbits of the full model (they start from the slow flow's); figures. `sim` itself (its lazy public
-#: names) and `sim.cli` (the commands) may import every part.
-SIM_LAYERS: dict[str, set[str]] = {
-    "common": set(),
-    "model": {"common"},
-    "integration": {"common", "model"},
-    "stepped_sine": {"common", "model", "integration"},
-    "hosts": {"common", "model", "stepped_sine"},
-    "analysis": {"common", "model", "integration", "stepped_sine", "hosts"},
-    "reduced": {"common", "model", "integration", "stepped_sine", "hosts"},
-    "orbits": {"common", "model", "integration", "stepped_sine", "hosts", "reduced"},
-    "plots": {"common", "model", "stepped_sine", "analysis"},
-}
-#: The written-down exceptions: (importing module, the part it may also import) with the reason.
-SIM_EXCEPTIONS = {
-    # `ies trace` writes its figure with its data, all or nothing (inside the function that writes both)
-    ("sim.analysis.trace", "plots"),
-}
+#: Inside `sim`, the simulator's parts as a pipeline: the shared layer; the coupled system and the paper's vocabulary;
+#: the host models; the integrators; the stepped-sine protocol, its measures and the paper's landmarks; signal
+#: analysis; the reduced (slow-flow) model; the periodic orbits of the full model (they start from the slow flow's);
+#: figures. A part may import the parts before it, none after it. `sim` itself (its lazy public names) and `sim.cli`
+#: (the commands) may import every part.
+SIM_PIPELINE = ("common", "model", "hosts", "integration", "stepped_sine", "analysis", "reduced", "orbits", "plots")
+#: sub-package -> the sub-packages it may import (besides itself): those before it in SIM_PIPELINE
+SIM_LAYERS: dict[str, set[str]] = {part: set(SIM_PIPELINE[:i]) for i, part in enumerate(SIM_PIPELINE)}
+#: The written-down exceptions: (importing module, the part after it that it may also import), each with its reason
+#: in a comment. None at present: `ies trace` hands its figure's drawing function to `sim.analysis.trace.write_trace`,
+#: and the paper's Fig. 6 landmarks are measured in `sim.stepped_sine.landmarks`, not among the host models.
+SIM_EXCEPTIONS: set[tuple[str, str]] = set()
 
 
 def sim_part(module: str) -> str | None:

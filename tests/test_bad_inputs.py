@@ -349,7 +349,7 @@ def test_bad_contact_law_options_create_nothing(tmp_path, model_file, capsys, mo
 # ---- dry friction (Appendix C) ----------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("args, phrase", [
-    (["--friction", "-0.1", "--integrator", "ode3"], "the friction coefficient must be >= 0"),
+    (["--friction", "-0.1", "--integrator", "ode3"], "the friction coefficient mu must be >= 0"),
     (["--friction", "0.07", "--k-t", "-5", "--integrator", "ode3"], "k_t (N/m) must be a positive number"),
     (["--friction", "0.07", "--integrator", "ode3"], "has no 'phi_floor'"),  # the three-mode file has no floor values
     (["--friction", "0.07"], "in the ode3 integrator only"),

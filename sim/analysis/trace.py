@@ -16,7 +16,7 @@ import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -221,11 +221,16 @@ def impact_list(trace: Trace) -> dict[str, Any]:
 
 
 def write_trace(folder: Path, trace: Trace, settings: dict[str, Any], plot: str | Path | None = None,
-                started: float | None = None) -> tuple[dict[str, Any], list[Path | str]]:
+                started: float | None = None, *, draw: Callable[..., None] | None = None
+                ) -> tuple[dict[str, Any], list[Path | str]]:
     """Write trace.csv and trace.json into `folder` (and Figs. 4 / 9a to `plot`), all or nothing; returns (the JSON
-    data, the paths written). started: time.perf_counter() at the command's start (for wall_time_s)."""
-    from sim.plots.figures import plot_trace
+    data, the paths written). started: time.perf_counter() at the command's start (for wall_time_s); draw: the
+    figure's drawing function draw(data, t, q_tip, v_tip, path) (`sim.plots.figures.plot_trace`), handed in by the
+    caller with `plot` (the analysis imports no figure code: the figures sit above it)."""
     from sim.common.files import dumps, write_csv, write_text
+
+    if plot and draw is None:
+        raise ValueError("write_trace: a plot needs its drawing function (draw=sim.plots.figures.plot_trace)")
 
     data = trace_data(trace, settings)
     written: list[Path | str] = []
@@ -235,7 +240,7 @@ def write_trace(folder: Path, trace: Trace, settings: dict[str, Any], plot: str 
             data["wall_time_s"] = time.perf_counter() - started
         written.append(write_text(folder / "trace.json", dumps(data) + "\n"))
         if plot:
-            plot_trace(data, trace.signal.t, trace.signal["q_tip"], trace.signal["v_tip"], plot)
+            draw(data, trace.signal.t, trace.signal["q_tip"], trace.signal["v_tip"], plot)
             written.append(plot)
     except BaseException:
         for path in written:  # all or nothing

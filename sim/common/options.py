@@ -7,19 +7,15 @@ exit code 2, nothing computed or written. Used by `sim.cli`, `bem_contact.cli` a
   computation never ends in an unsupported format.
 * `figure_formats`, `level_list`: ``ies plot``'s formats (png,pdf) and levels (5.3,6.7).
 * `positive_int`: counts such as ``--jobs``, ``--reps``, ``--n``.
-* `clearance`, `hertz_constant`: g and k_H (Table 2) as SI numbers or with a unit (`sim.common.units`), with a warning
-  line on stderr for an implausible magnitude.
+
+The options of the paper's parameters (``--g 0.58mm``, ``--k-H``, ...) take their value type from their row of
+`sim.model.parameters.PARAMETERS` (`UncertainParameter.option_value`: units, bounds and plausible range in one place).
 """
 from __future__ import annotations
 
 import argparse
 import functools
-import math
-import sys
 from pathlib import Path
-
-from sim.common.errors import SimulationInputError
-from sim.common.units import CLEARANCE, K_H, K_T, Quantity, implausible, parse_quantity
 
 
 @functools.lru_cache(maxsize=1)
@@ -69,41 +65,3 @@ def positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be a positive integer (1 or more), got {value}")
     return value
-
-
-def quantity_value(text: str, quantity: Quantity) -> float:
-    """The SI value of `text` (`sim.common.units.parse_quantity`); an implausible magnitude is one warning line."""
-    try:
-        value = parse_quantity(text, quantity)
-    except SimulationInputError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-    warning = implausible(value, quantity)
-    if warning:
-        sys.stderr.write(f"warning: {warning}\n")
-    return value
-
-
-def clearance(text: str) -> float:
-    """The clearance g in m: ``0.58e-3``, ``0.58mm``, ``580um``."""
-    return quantity_value(text, CLEARANCE)
-
-
-def tangential_stiffness(text: str) -> float:
-    """The tangential stiffness k_t of the floor contact in N/m: ``22e6``, ``22kN/mm`` (Appendix C)."""
-    return quantity_value(text, K_T)
-
-
-def friction_coefficient(text: str) -> float:
-    """The Coulomb coefficient mu of the floor contact (-), >= 0 (0: no friction)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number; give the friction coefficient, e.g. 0.07") from None
-    if not math.isfinite(value) or value < 0:
-        raise argparse.ArgumentTypeError(f"the friction coefficient must be >= 0 (0: no friction, e.g. 0.07), got {text}")
-    return value
-
-
-def hertz_constant(text: str) -> float:
-    """The Hertzian spring constant k_H in N/m^1.5: ``8.918e9``, ``282e3N/mm^1.5``."""
-    return quantity_value(text, K_H)

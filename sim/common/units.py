@@ -4,8 +4,9 @@ The uncertain contact parameters of the seed paper (Table 2) are easy to type in
 clearance g* = 0.58 mm and the Hertzian spring constant k_H* = 282e3 N/mm^1.5 (Eq. 8) are quoted in mm, while
 the code works in SI units (m, N/m^1.5). `parse_quantity` reads ``0.58e-3``, ``"0.58mm"``, ``"580 um"`` or
 ``"282e3 N/mm^1.5"`` and returns SI; `implausible` names a magnitude outside the physically plausible range
-and the value that was probably meant (e.g. ``--g 0.58`` is 0.58 m, probably 0.58 mm). The command line
-(`sim.common.options`) and the study files (`uq.problem.study`) both read g and k_H through this module.
+and the value that was probably meant (e.g. ``--g 0.58`` is 0.58 m, probably 0.58 mm). The rows of
+`sim.model.parameters.PARAMETERS` name their quantity here: the command line, the study files (`uq.problem.space`) and
+`ies design` (`uq.design.problem`) read g, k_H, k_t and R through this module.
 """
 from __future__ import annotations
 
@@ -31,8 +32,13 @@ class Quantity:
         return min((f"{value / factor:.4g} {unit}" for unit, factor in self.units.items()), key=len)
 
 
-#: a length such as the clearance g (Table 2: 0.58-0.612 mm); plausible 0.01-10 mm
-CLEARANCE = Quantity("clearance g", "m", {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6}, (1e-5, 1e-2), "0.58mm")
+#: the units of a length
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6}
+#: a length such as the clearance g (Table 2: 0.58-0.612 mm); plausible 0.01-10 mm, on the command line, in study
+#: files and in `ies design`'s ranges alike
+CLEARANCE = Quantity("clearance g", "m", LENGTH_UNITS, (1e-5, 1e-2), "0.58mm")
+#: the sphere's radius R (Sect. 2: 7.92 mm); plausible 0.5-100 mm
+RADIUS = Quantity("sphere radius R", "m", LENGTH_UNITS, (0.5e-3, 0.1), "7.92mm")
 #: the Hertzian spring constant k_H (Eq. 8: 282e3 N/mm^1.5 = 8.918e9 N/m^1.5); plausible 1e6-1e14 N/m^1.5
 K_H = Quantity("Hertzian spring constant k_H", "N/m^1.5", {"N/m^1.5": 1.0, "N/mm^1.5": 1e3**1.5}, (1e6, 1e14), "282e3N/mm^1.5")
 #: the tangential stiffness k_t of the floor contact (Appendix C: 22 kN/mm = 2.2e7 N/m); plausible 1e4-1e10 N/m

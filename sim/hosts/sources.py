@@ -1,10 +1,14 @@
-"""Where `ies modes` takes the modal model of the host structure from (seed paper Sect. 3.1, Eq. 7): `HOST_SOURCES`,
-one row per source.
+"""Where every command and study takes the modal model of the host structure from (seed paper Sect. 3.1, Eq. 7):
+`HOST_SOURCES`, one row per source, and `resolve_host`, the one resolver that serves `ies modes`, `ies sweep` /
+`overview` / `trace` (`sim.cli`), the studies (`uq.problem.models.IESModel`) and `ies design` (`uq.design.problem`).
 
 A row (`HostSource`) names the source, the option that selects it (argparse keywords; None for the default, the
-built-in rig) and the function that builds its `HostModel` from the command's options. `ies modes` adds every row's
-option to one group of mutually exclusive choices and builds the model through `host_model`, which holds the checks
-shared by all sources. Adding a source (another FE tool, a measured modal model) is adding a row.
+built-in rig), the function that builds its `HostModel` from the options, and the file kinds it reads (suffixes;
+`reads`, `load`): a path given to ``--model`` or a study's ``modal_model`` goes to the source that reads its kind (a
+modal-model file by default). Every simulation command adds every row's option to one group of mutually exclusive
+choices (`add_host_arguments`) and builds the model through `resolve_host`, which holds the checks shared by all
+sources; the studies and the design name a file. Adding a source (another FE tool, a measured modal model) is adding
+a row: it reaches every command by its option and, when it reads a file kind, every study and design by its files.
 
 The rows: the built-in Timoshenko model of the seed rig (`sim.hosts.rig`, Appendix A; optionally re-updated with a
 fixed joint stiffness), a modal-model file (`sim.hosts.modal_file`), the 3D solid model (`sim.hosts.solid`, its
@@ -26,8 +30,9 @@ from sim.model.system import ModalModel
 
 @dataclass(frozen=True)
 class HostModel:
-    """What a source gives `ies modes`: the modal model, the built-in rig's updating summary (`sim.hosts.rig.RigModes`,
-    or None), the provenance written with --save (or None) and report lines printed above the table."""
+    """What a source gives: the modal model, the built-in rig's updating summary (`sim.hosts.rig.RigModes`, or None;
+    computed for `ies modes` only), the provenance written with --save (or None) and report lines printed above
+    `ies modes`'s table."""
 
     model: ModalModel
     rig: Any = None
@@ -39,13 +44,17 @@ class HostModel:
 class HostSource:
     """One row of `HOST_SOURCES`: name; flag, the option that selects it (None: the default source) with its argparse
     keywords `flag_kwargs` (dest = the name's identifier unless given); fe_options: whether it reads the FE options
-    (--mesh, --geometry, --wall-left, ...; refused with the other sources); build: the model from the options."""
+    (--mesh, --geometry, --wall-left, ...; refused with the other sources); build: the model from the options;
+    reads: the file suffixes it reads (".frd"), load: the model of such a file (a path given to --model or to a
+    study's modal_model goes there)."""
 
     name: str
     flag: str | None
     flag_kwargs: Mapping[str, Any]
     build: Callable[[argparse.Namespace], HostModel]
     fe_options: bool = False
+    reads: tuple[str, ...] = ()
+    load: Callable[[str], HostModel] | None = None
 
     @property
     def dest(self) -> str:
@@ -70,6 +79,17 @@ def model_file(path: str) -> ModalModel:
 
     model = load_modal_model(path)
     return dataclasses.replace(model, source=f"file {path} ({model.source})")
+
+
+def host_file(path: str | Path) -> HostModel:
+    """The host of a file: the row of `HOST_SOURCES` that reads its suffix (`HostSource.reads`), a modal-model file
+    (`model_file`) otherwise."""
+    path = str(path)
+    suffix = Path(path).suffix.lower()
+    for row in HOST_SOURCES.values():
+        if row.load is not None and suffix in row.reads:
+            return row.load(path)
+    return HostModel(model_file(path))
 
 
 def solid_geometry(path: str | None) -> tuple[Any, Any]:
@@ -127,7 +147,8 @@ def fixed_joint_model(stiffness: float, variant: str, n_modes: int) -> tuple[Mod
 
 def built_in_rig(args: argparse.Namespace) -> HostModel:
     """The built-in Timoshenko model of the seed rig (Appendix A), variant --variant, --n-modes modes; with
-    --joint-stiffness re-updated with that joint stiffness. Carries its updating summary (f1..f9)."""
+    --joint-stiffness re-updated with that joint stiffness. Carries its updating summary (f1..f9) when asked
+    (`resolve_host`'s summary)."""
     from sim.hosts.rig import DEFAULT_VARIANT, rig_modes, seed_rig_model, variant_parameters
 
     variant = args.variant or DEFAULT_VARIANT
@@ -136,15 +157,15 @@ def built_in_rig(args: argparse.Namespace) -> HostModel:
         model, params, provenance, report = fixed_joint_model(args.joint_stiffness, variant, args.n_modes)
     else:
         model, params = seed_rig_model(n_modes=args.n_modes, variant=variant), variant_parameters(variant)
-    rig = rig_modes(params, n_modes=max(args.n_modes, 9))  # its updating summary needs f1..f9
+    rig = rig_modes(params, n_modes=max(args.n_modes, 9)) if args.summary else None  # the summary needs f1..f9
     return HostModel(model, rig, provenance, report)
 
 
 def modal_model_file(args: argparse.Namespace) -> HostModel:
-    """A modal-model file (--model FILE, `sim.hosts.modal_file`)."""
+    """A model file (--model FILE): a modal-model file (`sim.hosts.modal_file`) or a file kind another row reads."""
     if args.variant is not None:
         raise SimulationInputError("--variant selects a built-in rig model; it cannot be used with --model")
-    return HostModel(model_file(args.model))
+    return host_file(args.model)
 
 
 def solid_model(args: argparse.Namespace) -> HostModel:
@@ -195,7 +216,8 @@ def calculix_job(args: argparse.Namespace) -> HostModel:
 HOST_SOURCES: dict[str, HostSource] = {row.name: row for row in (
     HostSource("rig", None, {}, built_in_rig),
     HostSource("file", "--model", {"dest": "model", "metavar": "FILE",
-                                   "help": "read a modal-model file instead of the built-in seed rig"}, modal_model_file),
+                                   "help": "read a modal-model file (`ies modes --save`; or a file kind another "
+                                           "source reads) instead of the built-in seed rig"}, modal_model_file),
     HostSource("solid", "--solid", {"action": "store_true",
                                     "help": "the rig as a 3D solid finite-element model (sim.hosts.solid; needs pip "
                                             "install '.[solid]')"}, solid_model, fe_options=True),
@@ -213,10 +235,56 @@ def add_source_options(group: Any) -> None:
             group.add_argument(row.flag, **{"dest": row.dest, **row.flag_kwargs})
 
 
-def host_model(args: argparse.Namespace) -> HostModel:
-    """The model `ies modes` shows: the row of `HOST_SOURCES` its options select (the first row without one), after
-    the checks every source shares (the number of modes, the options that belong to another source); one
-    `SimulationInputError` line for anything wrong."""
+#: the host options every source may read, with their defaults (`add_host_arguments`); the defaults are what a
+#: study or a design gets (`resolve_host` with a mapping)
+HOST_OPTIONS: dict[str, Any] = {"variant": None, "n_modes": 9, "joint_stiffness": None, "mesh": None, "geometry": None,
+                                "patch_radius": 0.0, "wall_left": None, "wall_right": None, "tip": None, "dat": None,
+                                "floor": None, "beam_mass": None, "units": "m-kg-s"}
+
+
+def add_host_arguments(parser: argparse.ArgumentParser) -> None:
+    """The host options of every simulation command (`ies modes`, `sweep`, `overview`, `trace`): one option per row of
+    `HOST_SOURCES` (mutually exclusive), the built-in rig's variant, modes and joint stiffness, and the FE options."""
+    add_source_options(parser.add_mutually_exclusive_group())
+    parser.add_argument("--variant", default=None, metavar="NAME",
+                        help="updating variant of the built-in rig: joint-spring (default) or effective-modulus; "
+                             "with --solid a variant of the solid model (sim.hosts.variants.SOLID_VARIANTS: beam-neck, "
+                             "updated, updated-400, updated-contact+2mm, updated-contact+4mm, updated-hertz-patch, "
+                             "updated-patch-3mm)")
+    parser.add_argument("--n-modes", dest="n_modes", type=int, default=HOST_OPTIONS["n_modes"], metavar="N",
+                        help="x-bending modes to keep (default 9, as the paper; built-in rig, --solid, --from-calculix)")
+    parser.add_argument("--joint-stiffness", dest="joint_stiffness", type=float, default=None, metavar="N_PER_M",
+                        help="built-in rig, variant joint-spring: fix the beam-block joint's translational stiffness "
+                             "(N/m; inf = rigid) and re-update E and the neck to f1..f4 and f9 (10-60 s)")
+    solid = parser.add_argument_group("3D solid model (--solid) and CalculiX (--from-calculix)")
+    solid.add_argument("--mesh", metavar="LEVEL|JOB.inp",
+                       help="--solid: mesh level coarse (default, ~1 min), medium or fine; --from-calculix: the job's .inp")
+    solid.add_argument("--geometry", metavar="FILE",
+                       help="--solid: TOML file with [geometry] (sim.hosts.solid.SolidGeometry fields, m) and [material] "
+                            "(E in Pa, nu, rho in kg/m^3) tables; missing keys keep the rig's defaults")
+    solid.add_argument("--patch-radius", dest="patch_radius", type=float, default=HOST_OPTIONS["patch_radius"],
+                       metavar="M", help="--solid: average the wall values over a circle of this radius (m) on each wall face")
+    solid.add_argument("--wall-left", dest="wall_left", metavar="NSET", help="--from-calculix: node set of the left wall")
+    solid.add_argument("--wall-right", dest="wall_right", metavar="NSET", help="--from-calculix: node set of the right wall")
+    solid.add_argument("--tip", metavar="NSET", help="--from-calculix: node set of the measurement point")
+    solid.add_argument("--dat", metavar="JOB.dat", help="--from-calculix: the job's .dat (default: beside the .frd)")
+    solid.add_argument("--floor", metavar="NSET",
+                       help="--from-calculix: node set of the cavity floor under the sphere (phi_floor, for friction)")
+    solid.add_argument("--beam-mass", dest="beam_mass", type=float, metavar="KG",
+                       help="--from-calculix: mass of the beam's free length without the block in kg (for Eq. 10)")
+    solid.add_argument("--units", default=HOST_OPTIONS["units"], choices=("m-kg-s", "mm-t-s"),
+                       help="--from-calculix: the job's consistent units (default m-kg-s)")
+
+
+def resolve_host(options: argparse.Namespace | Mapping[str, Any] | None = None, *, summary: bool = False) -> HostModel:
+    """The host model of a command's options or of a study's or a design's settings (a mapping such as
+    {"model": "rig.toml", "n_modes": 9}; missing options take `HOST_OPTIONS`' defaults): the row of `HOST_SOURCES`
+    the options select (the first row without an option when none does), after the checks every source shares (the
+    number of modes, the options that belong to another source); one `SimulationInputError` line for anything wrong.
+    summary: also the built-in rig's updating summary (`ies modes`)."""
+    given = vars(options) if isinstance(options, argparse.Namespace) else dict(options or {})
+    args = argparse.Namespace(**{**HOST_OPTIONS, **{row.dest: None for row in HOST_SOURCES.values()}, **given,
+                                 "summary": summary})
     if not 1 <= args.n_modes <= 30:
         raise SimulationInputError(f"--n-modes must lie in 1..30, got {args.n_modes}")
     chosen = [row for row in HOST_SOURCES.values() if row.selected(args)]
@@ -225,8 +293,14 @@ def host_model(args: argparse.Namespace) -> HostModel:
         others = [row.flag for row in HOST_SOURCES.values() if row.flag is not None]
         raise SimulationInputError("--joint-stiffness re-updates the built-in rig; drop "
                                    + ", ".join(others[:-1]) + f" and {others[-1]}")
-    if not source.fe_options and any(getattr(args, dest, None) not in (None, False) for dest, _ in FE_OPTIONS):
+    if not source.fe_options and any(getattr(args, dest, None) not in (None, False, HOST_OPTIONS.get(dest))
+                                     for dest, _ in FE_OPTIONS):
         owners = [row.flag for row in HOST_SOURCES.values() if row.fe_options]
         flags = [flag for _, flag in FE_OPTIONS]
         raise SimulationInputError(", ".join(flags[:-1]) + f" and {flags[-1]} belong to " + " or ".join(owners))
     return source.build(args)
+
+
+def host_model(args: argparse.Namespace) -> HostModel:
+    """The model `ies modes` shows (`resolve_host` with the rig's updating summary)."""
+    return resolve_host(args, summary=True)

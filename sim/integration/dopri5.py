@@ -18,7 +18,7 @@ import numpy as np
 from sim.integration import flight
 from sim.integration.flight import COUNT, GRAZE, NONFINITE, OK, ONSET, OVERLAP, REGULAR, RELEASE, STALLED
 from sim.integration.jit import kernel
-from sim.model.contact_law import uses_rate, wall_dissipation, wall_force
+from sim.model.contact_law import onset_exponent, uses_rate, wall_dissipation, wall_force
 
 
 class ButcherTableau(NamedTuple):
@@ -301,11 +301,14 @@ def contact(Y, t, t_stop, h, at_onset, work, cst):
     length is found by Newton iteration. Returns (t, h_next, released, status, extra_onsets). With
     par.h_fixed > 0 the step is fixed (order studies) and only cut at t_stop and at the release.
 
-    work.memo[0], [1]: err / (v^1.5 s^2.5) of the last onset / release step (v: contact speed, s: length).
-    The embedded error estimate of these steps grows like s^2.5 (the force ~ u^3 is integrated exactly only
-    by the 5th-order solution), so their length is predicted from that law instead of by trial.
+    work.memo[0], [1]: err / (v^p s^(p+1)) of the last onset / release step (v: contact speed, s: length, p the
+    law's onset exponent, `sim.model.contact_law.Law.exponent`: 1.5 for Hertz). The embedded error estimate of these
+    steps grows like s^(p+1) (Hertz's force ~ u^3 on the time map is integrated exactly only by the 5th-order
+    solution), so their length is predicted from that law instead of by trial.
     """
     par = cst.par
+    p = onset_exponent(cst.law)  # a compile-time constant per law
+    p1 = p + 1.0
     K, Ynew, memo, counters = work.K, work.end, work.memo, work.counters
     Om = par.Omega
     ct = math.cos(Om * t)  # the phase at t, carried along by rotations
@@ -324,7 +327,7 @@ def contact(Y, t, t_stop, h, at_onset, work, cst):
     if not adaptive:
         h = fixed_step
     elif first and memo[0] > 0.0:
-        h = (0.5 / (memo[0] * max(cd_act, 1e-6) ** 1.5)) ** 0.4
+        h = (0.5 / (memo[0] * max(cd_act, 1e-6) ** p)) ** (1.0 / p1)
     v_onset = max(cd_act, 1e-6)
     for _ in range(10_000_000):
         s_step = min(h, par.h_max)
@@ -335,12 +338,12 @@ def contact(Y, t, t_stop, h, at_onset, work, cst):
             cdd = _curvature(K, ct, st, wall_left, cst)
             tau = _first_root(c_act, cd_act, cdd)
             v_rel = max(abs(cd_act + cdd * tau), 1e-6)
-            s_rel = (0.5 / (memo[1] * v_rel**1.5)) ** 0.4 if memo[1] > 0.0 else s_step
+            s_rel = (0.5 / (memo[1] * v_rel**p)) ** (1.0 / p1) if memo[1] > 0.0 else s_step
             if tau <= 1.2 * s_rel and tau <= 1.25 * s_step and tau < t_stop - t:
                 s, err, found = locate_release(Y, flight.Phase(t, ct, st), tau, min(2.0 * s_step, t_stop - t),
                                                RELEASE, wall_left, work, cst)
                 if found:
-                    memo[1] = max(err, 1e-3) / (v_rel**1.5 * s**2.5)
+                    memo[1] = max(err, 1e-3) / (v_rel**p * s**p1)
                     if err <= 1.0:
                         for i in range(Y.size):
                             Y[i] = Ynew[i]
@@ -348,7 +351,7 @@ def contact(Y, t, t_stop, h, at_onset, work, cst):
                         return t + s, h, True, OK, extra
                     # too long: a regular step that leaves a release step of acceptable length
                     counters[COUNT.rejected_steps] += 1
-                    h = max(s - s * 0.9 * err ** -0.4, 0.05 * s)
+                    h = max(s - s * 0.9 * err ** (-1.0 / p1), 0.05 * s)
                     continue
             elif tau < s_step + s_rel and tau < t_stop - t:
                 # approach so that the release step left over is s_rel (never longer than the step control allows)
@@ -361,13 +364,13 @@ def contact(Y, t, t_stop, h, at_onset, work, cst):
         if adaptive and err > 1.0:
             counters[COUNT.rejected_steps] += 1
             if first:
-                memo[0] = err / (v_onset**1.5 * s_step**2.5)
-                h = s_step * max(0.1, 0.9 * err ** -0.4)
+                memo[0] = err / (v_onset**p * s_step**p1)
+                h = s_step * max(0.1, 0.9 * err ** (-1.0 / p1))
             else:
                 h = s_step * max(0.2, 0.9 * err ** -0.2)
             continue
         if adaptive and first:
-            memo[0] = max(err, 1e-3) / (v_onset**1.5 * s_step**2.5)
+            memo[0] = max(err, 1e-3) / (v_onset**p * s_step**p1)
         ct1, st1 = flight.rotate(ct, st, Om * s_step)
         ncl, ncld, ncr, ncrd = flight.closing_at(Ynew, ct1, st1, cst)
         if ncl <= 0.0 and ncr <= 0.0:

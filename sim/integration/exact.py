@@ -79,6 +79,7 @@ from sim.common.errors import SimulationDiverged, SimulationInputError
 from sim.integration.flight import (COUNT, IMPACT, LEDGER, NONFINITE, OK, OVERLAP, STALLED, STALLED_SEARCH, Constants, Output,
                         mode_records, run_record, state_layout)
 from sim.integration.jit import kernel
+from sim.model.contact_law import duration_factor, onset_exponent
 from sim.model.system import SystemArrays, check_run_step
 
 #: Free-flight grid steps per excitation period (certification cells; no effect on accuracy).
@@ -427,12 +428,14 @@ def _record_contact(p, t0, t1, at_onset, h, record, run):
 
 @kernel
 def _initial_contact_step(Y, t, cst):
-    """First Dormand-Prince step of a contact, tied to the Hertz contact time t_c = 2.9432 delta_max / v0
-    (rigid wall, Eq. 4)."""
+    """First Dormand-Prince step of a contact, tied to the contact time of one impact on a rigid wall under the law
+    k delta^p (`sim.model.contact_law.Law`: exponent p, duration factor c_t): delta_max = ((p + 1) m v0^2 / (2 k))^(1/(p+1))
+    from the energy, t_c = c_t delta_max / v0 (Hertz, Eq. 4: p = 1.5, c_t = 2.9432)."""
     cl, cld, cr, crd = flight.closing(Y, t, cst)
     v = max(cld, crd, 1e-6)
-    delta_max = (5.0 * cst.par.m_a * v * v / (4.0 * cst.par.k_H)) ** 0.4
-    return min(0.02 * 2.9432 * delta_max / v, cst.par.h_max)
+    p1 = onset_exponent(cst.law) + 1.0  # compile-time constants per law
+    delta_max = (p1 * cst.par.m_a * v * v / (2.0 * cst.par.k_H)) ** (1.0 / p1)
+    return min(0.02 * duration_factor(cst.law) * delta_max / v, cst.par.h_max)
 
 
 @kernel(inline="always")

@@ -1,7 +1,14 @@
-"""Integrators of the coupled system by name (Sect. 3.2), imported lazily, and their warm-up.
+"""The integrators of the coupled system (Sect. 3.2): one record each (`Integrator`: its kernels' module, imported
+lazily, and its capabilities), and their warm-up.
 
 Every entry follows the contract of `sim.model.system`:
 ``run_step(y, n_periods, Omega, a_base, sys, record=None) -> (amplitudes, impacts)``.
+
+A record says what its integrator can do, so that no caller asks by name: whether it takes dry friction (Appendix C),
+a step scale (``dt_scale``, a multiple of the paper's dt = 2 pi/(15 omega_9)), which contact laws it runs (None: every
+registered law, `sim.model.contact_law.LAWS`) and how long its kernels take to compile. `Integrator.check` refuses a
+system it cannot run with one line; the commands' options and help are built from the records. Adding an integrator
+is writing its module and one `INTEGRATORS` row.
 
 The kernels are numba functions cached on disk (``cache=True``, in ``__pycache__`` beside the sources). The
 first run on a machine compiles them, which takes minutes; `warm_up` does it before a command's progress bar
@@ -18,6 +25,7 @@ import subprocess
 import sys as _sys
 import threading
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable, Iterator, TextIO
 
@@ -28,37 +36,80 @@ from sim.model.system import Impactor, ModalModel, SystemArrays, system_arrays
 
 RunStep = Callable[[np.ndarray, int, float, float, SystemArrays, "np.ndarray | None"], tuple[np.ndarray, np.ndarray]]
 
-#: name -> (module, function). "ode3" is the paper's reference; "exact" is the fast free-flight integrator.
-REGISTRY: dict[str, tuple[str, str]] = {
-    "ode3": ("sim.integration.ode3", "run_step"),
-    "exact": ("sim.integration.exact", "run_step"),
-}
-#: integrators that accept ``dt_scale`` (a multiple of the paper's dt = 2 pi/(15 omega_9))
-_ACCEPTS_DT_SCALE = {"ode3"}
+
+@dataclass(frozen=True)
+class Integrator:
+    """One integrator: name (the --integrator value), module (its kernels, with ``run_step``), summary (one line of the
+    help); friction: it takes dry friction (Appendix C); dt_scale: it takes a step scale; compile_minutes: how long
+    compiling its kernels takes with a cold cache (`warm_up`'s notice); laws: the contact laws it runs (None: all)."""
+
+    name: str
+    module: str
+    summary: str
+    friction: bool = False
+    dt_scale: bool = False
+    compile_minutes: float = 2.0
+    laws: tuple[str, ...] | None = None
+
+    def run_step(self, *, dt_scale: float | None = None) -> RunStep:
+        """Its `run_step`, with ``dt_scale`` bound if given (one line if it takes none)."""
+        run_step = importlib.import_module(self.module).run_step
+        if dt_scale is None or dt_scale == 1.0:
+            return run_step
+        if not self.dt_scale:
+            scaled = ", ".join(i.name for i in INTEGRATORS.values() if i.dt_scale)
+            raise SimulationInputError(f"dt_scale applies only to {scaled}, not to {self.name!r}")
+        return functools.partial(run_step, dt_scale=float(dt_scale))
+
+    def supports(self, law: str) -> bool:
+        """Whether it runs the contact law `law` (a name of `sim.model.contact_law.LAWS`)."""
+        return self.laws is None or law in self.laws
+
+    def check(self, impactor: Impactor) -> None:
+        """One line (SimulationInputError) if this integrator cannot run `impactor`: its contact law, dry friction."""
+        law = impactor.contact_law.name
+        if not self.supports(law):
+            able = " or ".join(i.name for i in INTEGRATORS.values() if i.supports(law))
+            raise SimulationInputError(f"the contact law {law!r} is not in the {self.name} integrator; choose {able} "
+                                       "(--integrator, or [excitation] integrator in a study file)")
+        if impactor.friction > 0 and not self.friction:
+            able = " or ".join(i.name for i in INTEGRATORS.values() if i.friction)
+            raise SimulationInputError(f"dry friction (mu = {impactor.friction:g}, Appendix C) is in the {able} "
+                                       f"integrator only; choose it (--integrator {able.split(' or ')[0]}, or "
+                                       f"[excitation] integrator = \"{able.split(' or ')[0]}\" in a study file)")
+
+
+#: "ode3" is the paper's reference; "exact" is the fast free-flight integrator (the default).
+INTEGRATORS: dict[str, Integrator] = {i.name: i for i in (
+    Integrator("ode3", "sim.integration.ode3", "the paper's fixed step", friction=True, dt_scale=True,
+               compile_minutes=1),
+    Integrator("exact", "sim.integration.exact", "closed-form free flight, located contacts", compile_minutes=2),
+)}
+DEFAULT_INTEGRATOR = "exact"
+
+
+def integrator_named(name: str) -> Integrator:
+    """The record of the integrator `name`; one line naming the choices if there is none."""
+    try:
+        return INTEGRATORS[name]
+    except KeyError:
+        raise SimulationInputError(f"unknown integrator {name!r}; available: {', '.join(available())}") from None
 
 
 def available() -> list[str]:
     """Names of the registered integrators."""
-    return list(REGISTRY)
+    return list(INTEGRATORS)
 
 
 def get_integrator(name: str, *, dt_scale: float | None = None) -> RunStep:
-    """The `run_step` function registered under `name`, with ``dt_scale`` bound if given (ode3 only)."""
-    if name not in REGISTRY:
-        raise SimulationInputError(f"unknown integrator {name!r}; available: {', '.join(available())}")
-    module_name, attribute = REGISTRY[name]
-    run_step = getattr(importlib.import_module(module_name), attribute)
-    if dt_scale is None or dt_scale == 1.0:
-        return run_step
-    if name not in _ACCEPTS_DT_SCALE:
-        raise SimulationInputError(f"dt_scale applies only to {', '.join(sorted(_ACCEPTS_DT_SCALE))}, not to {name!r}")
-    return functools.partial(run_step, dt_scale=float(dt_scale))
+    """The `run_step` function of the integrator `name`, with ``dt_scale`` bound if given (`Integrator.run_step`)."""
+    return integrator_named(name).run_step(dt_scale=dt_scale)
 
 
-#: how long compiling the kernels of one integrator takes with a cold cache (`warm_up`), measured on the 2-core
-#: development machine while other work shared the cores (load average 6-8): "exact" 101 s in a fresh install
-#: (up to 390 s under heavier load), "ode3" 32 s
-COMPILE_MINUTES = {"exact": 2, "ode3": 1}
+#: how long compiling the kernels of one integrator takes with a cold cache (`warm_up`; `Integrator.compile_minutes`),
+#: measured on the 2-core development machine while other work shared the cores (load average 6-8): "exact" 101 s
+#: in a fresh install (up to 390 s under heavier load), "ode3" 32 s
+COMPILE_MINUTES = {name: record.compile_minutes for name, record in INTEGRATORS.items()}
 #: seconds after which `warm_up` says that it is compiling: loading the cached kernels of "exact" takes 1-3 s
 #: (2.5-3 s measured with the machine's 2 cores shared by four engineers), compiling them minutes
 NOTICE_AFTER_S = 5.0

@@ -22,7 +22,12 @@ Both walls use the same law; the sign conventions of sim/model/system.py apply (
 delta_r < 0 in contact: the right wall's indentation is -delta_r).
 
 Adding a law (the one place to edit): write its force, stiffness, potential, dissipation (if any) and single-impact
-reference below and `register` a `Law`; every integrator compiles it on first use. How a law reaches the kernels:
+reference below and `register` a `Law`; every integrator compiles it on first use. A law with a constant of its own
+(a linear spring's stiffness in N/m instead of k_H) declares it as a parameter row (`Law.constant`, a
+`sim.model.parameters.UncertainParameter`): `register` adds the row to `PARAMETERS`, which gives it its option, study
+key, JSON key and checks, and the kernels receive its value as the law's k. A law that does not grow like Hertz's
+delta^1.5 at the onset declares its exponent (`Law.exponent`): the exact integrator's contact step predictors
+(`sim.integration.dopri5.contact`, `sim.integration.exact._initial_contact_step`) are built on it. How a law reaches the kernels:
 a `Law` is typed by numba as `LawType` (its name and a hash of its kernels' sources), so every kernel that is handed
 one (in `SystemArrays.law`, `sim.integration.flight.Constants.law`) is compiled, and cached on disk, once per law,
 and `wall_force`, `wall_stiffness`, `wall_dissipation` and `uses_rate` resolve to that law's kernels at compile
@@ -48,7 +53,8 @@ from numba.core.extending import NativeValue, models, overload, register_model, 
 from numpy.typing import ArrayLike
 
 from sim.common.errors import SimulationInputError
-from sim.model.parameters import DEFAULT_R_CONT  # noqa: F401 (the paper's value, re-exported)
+from sim.model.parameters import (DEFAULT_R_CONT, PARAMETERS,  # noqa: F401 (the paper's value, re-exported)
+                                  UncertainParameter, register_parameter)
 
 
 class ImpactReference(NamedTuple):
@@ -81,6 +87,13 @@ class Law:
         equals when c = 0 (compiled instead then, bit for bit); collocation: the exact integrator may take its
         contacts by `sim.integration.collocation` (which assumes Hertz's force and impact times), else all by
         Dormand-Prince.
+    constant: the row (`sim.model.parameters.UncertainParameter`) of the law's own stiffness constant k, registered
+        with the law; None: k is k_H (N/m^1.5).
+    exponent: p of the force's growth k delta^p from an onset (1.5 for Hertz, 1 for a linear spring): the Dormand-Prince
+        contact's step predictors assume an onset step's error ~ v^p s^(p+1) and an impact's largest indentation
+        ((p + 1) m v^2 / (2 k))^(1 / (p + 1)); duration_factor: t_c v0 / delta_max of one impact on a rigid wall
+        (None: 2 sqrt(pi) Gamma(1 + 1/(p+1)) / Gamma(1/2 + 1/(p+1)), the closed form for k delta^p; Hertz states the
+        rounded 2.9432 of Johnson, Sect. 11.4).
     """
 
     name: str
@@ -93,10 +106,16 @@ class Law:
     takes_r_cont: bool = False
     elastic: str | None = None
     collocation: bool = False
+    constant: UncertainParameter | None = None
+    exponent: float = 1.5
+    duration_factor: float | None = None
     key: str = field(default="", init=False)
 
     def __post_init__(self) -> None:
-        digest = hashlib.sha256(self.name.encode())
+        if self.duration_factor is None:
+            q = 1.0 / (self.exponent + 1.0)
+            object.__setattr__(self, "duration_factor", 2.0 * math.sqrt(math.pi) * math.gamma(1.0 + q) / math.gamma(0.5 + q))
+        digest = hashlib.sha256(f"{self.name} {self.exponent!r} {self.duration_factor!r}".encode())
         for kernel in (self.force, self.stiffness, self.dissipation):
             if kernel is not None:
                 function = getattr(kernel, "py_func", kernel)
@@ -134,7 +153,9 @@ LAWS: dict[str, Law] = {}
 
 
 def register(law: Law) -> Law:
-    """Add (or replace) a law in `LAWS`; returns it."""
+    """Add (or replace) a law in `LAWS`, and its own constant's row in `sim.model.parameters.PARAMETERS`; returns it."""
+    if law.constant is not None:
+        register_parameter(law.constant)
     LAWS[law.name] = law
     return law
 
@@ -166,6 +187,16 @@ def wall_dissipation(law: Law, delta: float, rate: float, k: float, c: float) ->
 def uses_rate(law: Law) -> bool:
     """True if the law's force depends on the approach rate (a compile-time constant in kernels)."""
     return law.dissipation is not None
+
+
+def onset_exponent(law: Law) -> float:
+    """p of the law's growth k delta^p from an onset (`Law.exponent`; a compile-time constant in kernels)."""
+    return law.exponent
+
+
+def duration_factor(law: Law) -> float:
+    """t_c v0 / delta_max of one impact on a rigid wall (`Law.duration_factor`; a compile-time constant in kernels)."""
+    return law.duration_factor
 
 
 def _law_of(typ) -> Law:
@@ -210,6 +241,18 @@ def _wall_dissipation(law, delta, rate, k, c):
 def _uses_rate(law):
     if isinstance(law, LawType):
         return _calling(None, "law", "", "True" if _law_of(law).dissipation is not None else "False")
+
+
+@overload(onset_exponent, inline="always")
+def _onset_exponent(law):
+    if isinstance(law, LawType):
+        return _calling(None, "law", "", repr(float(_law_of(law).exponent)))
+
+
+@overload(duration_factor, inline="always")
+def _duration_factor(law):
+    if isinstance(law, LawType):
+        return _calling(None, "law", "", repr(float(_law_of(law).duration_factor)))
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -266,10 +309,11 @@ def damped_hertz_reference(m: float, v0: float, k: float, c: float) -> ImpactRef
 
 
 HERTZ = register(Law("hertz", "Eq. 4, elastic", hertz_force, hertz_stiffness, hertz_potential, hertz_reference,
-                     collocation=True))
+                     collocation=True, duration_factor=HERTZ_CONTACT_TIME))
 HERTZ_DAMPED = register(Law("hertz-damped", "Eq. 10, Hertz with damping in approach; needs the model's beam mass",
                             damped_hertz_force_kernel, hertz_stiffness, hertz_potential, damped_hertz_reference,
-                            dissipation=damped_hertz_dissipation, takes_r_cont=True, elastic="hertz"))
+                            dissipation=damped_hertz_dissipation, takes_r_cont=True, elastic="hertz",
+                            duration_factor=HERTZ_CONTACT_TIME))
 #: The law of a run that names none (Eq. 4), and the law that an r_cont,diss without a law name implies (Eq. 10).
 DEFAULT_LAW = "hertz"
 DEFAULT_DAMPED_LAW = "hertz-damped"
@@ -324,8 +368,10 @@ class ContactLaw:
     def __post_init__(self) -> None:
         law = law_named(self.name)
         r = self.r_cont
-        if isinstance(r, bool) or not isinstance(r, (int, float)) or not math.isfinite(r) or not 0.0 < r <= 1.0:
-            raise SimulationInputError(f"r_cont must lie in (0, 1] (1 = elastic, e.g. 0.99), got {r!r}")
+        row = PARAMETERS["r_cont"]
+        if isinstance(r, bool) or not isinstance(r, (int, float)):
+            raise SimulationInputError(f"r_cont must be a number; r_cont {row.bounds.text()} ({row.hint}), got {r!r}")
+        row.check(r)
         if not law.takes_r_cont and r != 1.0:
             damped = " or ".join(repr(name) for name, other in LAWS.items() if other.takes_r_cont)
             raise SimulationInputError(f"r_cont = {r!r} needs the contact law {damped}; {self.name!r} takes no r_cont "

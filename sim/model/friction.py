@@ -24,9 +24,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from sim.common.errors import SimulationInputError
-from sim.model.parameters import K_T_PAPER, MU_PAPER, SPHERE_MASS  # noqa: F401 (re-exported)
-
-GRAVITY = 9.81  # m/s^2
+from sim.model.parameters import GRAVITY, K_T_PAPER, MU_PAPER, SPHERE_MASS  # noqa: F401 (re-exported)
 
 
 @dataclass(frozen=True)

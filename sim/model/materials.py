@@ -1,5 +1,7 @@
-"""Sphere materials for the design of an IES (`ies design`): density, Young's modulus and Poisson's ratio, the
-sphere's mass from its radius and its Hertz constant against the host's steel wall (seed paper Eq. 8).
+"""The materials of the seed paper (Table 1) and Eq. 8, defined once for every stage: the host's steel, the sphere
+materials of `ies design` (density, Young's modulus, Poisson's ratio), the sphere's mass from its radius, and the
+Hertz constant k_H = (4/3) sqrt(R) E* of a sphere on a flat wall with the contact modulus E* of Eq. 8's bracket
+(`contact_modulus_of`, `hertz_constant_of`; `bem_contact.materials` and `bem_contact.calibration` use them too).
 
 Values are handbook values at room temperature (ASM Handbook vol. 2 and MatWeb for the alloys named): brass is the
 free-cutting brass CuZn39Pb3 (CW614N / C38500) of turned balls, with the seed paper's E = 102 GPa (Table 1; handbooks
@@ -29,13 +31,15 @@ class SphereMaterial:
     what: str
 
 
+#: Table 1: the host's steel (the rig and its cavity walls) and the sphere's brass, E in Pa and nu (-)
+HOST_E, HOST_NU = 207e9, 0.30
+BRASS_E, BRASS_NU = 102e9, 0.30
+
 MATERIALS: dict[str, SphereMaterial] = {m.name: m for m in (
-    SphereMaterial("brass", 8470.0, 102e9, 0.30, "free-cutting brass CuZn39Pb3 (the seed paper's sphere, Table 1)"),
-    SphereMaterial("steel", 7810.0, 207e9, 0.30, "bearing steel AISI 52100 (E as the paper's host, Table 1)"),
+    SphereMaterial("brass", 8470.0, BRASS_E, BRASS_NU, "free-cutting brass CuZn39Pb3 (the seed paper's sphere, Table 1)"),
+    SphereMaterial("steel", 7810.0, HOST_E, HOST_NU, "bearing steel AISI 52100 (E as the paper's host, Table 1)"),
     SphereMaterial("tungsten", 18000.0, 360e9, 0.29, "tungsten heavy alloy W-Ni-Fe, 95 % W"),
 )}
-#: the host's wall: the rig's steel (Table 1)
-HOST_E, HOST_NU = 207e9, 0.30
 
 
 def material(name: str) -> SphereMaterial:
@@ -57,11 +61,21 @@ def sphere_mass(radius: ArrayLike, mat: SphereMaterial) -> np.ndarray | float:
     return ball_mass(radius, mat.density)
 
 
+def contact_modulus_of(E_a: float, nu_a: float, E_b: float, nu_b: float) -> float:
+    """E* = [(1 - nu_a^2)/E_a + (1 - nu_b^2)/E_b]^-1 in Pa of two bodies in contact (the bracket of Eq. 8; E in Pa)."""
+    return 1.0 / ((1.0 - nu_a**2) / E_a + (1.0 - nu_b**2) / E_b)
+
+
+def hertz_constant_of(radius: float, E_star: float) -> float:
+    """Eq. 8: k_H = (4/3) sqrt(R) E* in N/m^1.5 of a sphere of radius R (m) on a flat wall, E* in Pa."""
+    return 4.0 / 3.0 * math.sqrt(radius) * E_star
+
+
 def contact_modulus(mat: SphereMaterial, host_E: float = HOST_E, host_nu: float = HOST_NU) -> float:
-    """E* = [(1 - nu_s^2)/E_s + (1 - nu_h^2)/E_h]^-1 in Pa, sphere on the host's wall (the bracket of Eq. 8)."""
-    return 1.0 / ((1.0 - mat.nu**2) / mat.E + (1.0 - host_nu**2) / host_E)
+    """E* (Pa) of a sphere of `mat` on the host's wall (the bracket of Eq. 8)."""
+    return contact_modulus_of(mat.E, mat.nu, host_E, host_nu)
 
 
 def hertz_constant(radius: float, mat: SphereMaterial) -> float:
     """k_H of a sphere of `radius` (m) on the host's flat steel wall, Eq. 8: (4/3) sqrt(R) E*, in N/m^1.5."""
-    return 4.0 / 3.0 * math.sqrt(radius) * contact_modulus(mat)
+    return hertz_constant_of(radius, contact_modulus(mat))

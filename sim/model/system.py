@@ -39,14 +39,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from sim.model.contact_law import HERTZ, ContactLaw, Law, contact_law_of
 from sim.common.errors import SimulationInputError
 from sim.model.parameters import (CLEARANCE_NOMINAL, D1_NOMINAL, K_H_NOMINAL, K_T_PAPER,  # noqa: F401 (re-exported)
-                                 SPHERE_MASS, SystemSettings)
+                                  PARAMETERS, SPHERE_MASS, SystemSettings)
 
 
 
@@ -120,8 +120,8 @@ class ModalModel:
         return 0.5 * float(self.phi_wall_left[0] + self.phi_wall_right[0])
 
     def with_damping(self, D1: float) -> "ModalModel":
-        """Copy with the damping ratio of mode 1 replaced (the uncertain D of Table 2)."""
-        check_open_unit(D1, "D")
+        """Copy with the damping ratio of mode 1 replaced (the uncertain D of Table 2, checked by its row)."""
+        D1 = PARAMETERS["D"].check(D1)
         d = self.damping_ratios.copy()
         d[0] = D1
         return replace(self, damping_ratios=d)
@@ -130,7 +130,9 @@ class ModalModel:
 @dataclass(frozen=True)
 class Impactor:
     """The sphere and its contacts (Eqs. 3-6): mass m_a (kg), clearance g (m), k_H (N/m^1.5), and the normal
-    contact law at both walls (Eq. 4 by default, or the damped law of Eq. 10)."""
+    contact law at both walls (Eq. 4 by default, or the damped law of Eq. 10); inputs: (name, value) of the
+    parameters it was built from (`SystemSettings.inputs`; a contact law's own constant is read from there).
+    Every value is checked against its row of `sim.model.parameters.PARAMETERS` (one line each)."""
 
     mass: float = SPHERE_MASS
     clearance: float = CLEARANCE_NOMINAL
@@ -138,15 +140,26 @@ class Impactor:
     contact_law: ContactLaw = ContactLaw()
     friction: float = 0.0  # Coulomb coefficient mu of the floor contact (Appendix C); 0: no friction
     k_t: float = K_T_PAPER  # N/m, tangential stiffness of the floor contact (Appendix C: 22 kN/mm)
+    inputs: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
-        for name, label in (("mass", "sphere mass"), ("clearance", "clearance g"), ("k_H", "k_H"), ("k_t", "k_t (N/m)")):
-            value = float(getattr(self, name))
-            if not np.isfinite(value) or value <= 0:
-                raise SimulationInputError(f"{label} must be a positive number, got {value!r}")
-        mu = float(self.friction)
-        if not np.isfinite(mu) or mu < 0:
-            raise SimulationInputError(f"the friction coefficient mu must be >= 0 (0: no friction, e.g. 0.07), got {mu!r}")
+        for row in PARAMETERS.values():
+            if row.feeds.field in _IMPACTOR_FIELDS and not row.feeds.scale:
+                row.check(getattr(self, row.feeds.field))
+
+    def input(self, name: str) -> float:
+        """The value of the parameter `name` this sphere was built with (its row's nominal value if none was given)."""
+        return dict(self.inputs).get(name, PARAMETERS[name].nominal)
+
+    @property
+    def stiffness(self) -> float:
+        """The contact law's stiffness constant k (`sim.model.contact_law.Law.constant`): k_H (N/m^1.5) for the
+        Hertz laws, the value of the law's own parameter otherwise."""
+        constant = self.contact_law.law.constant
+        return self.k_H if constant is None else self.input(constant.name)
+
+
+_IMPACTOR_FIELDS = ("mass", "clearance", "k_H", "friction", "k_t")
 
 
 @dataclass(frozen=True)
@@ -212,7 +225,7 @@ def damping_factor(model: ModalModel, impactor: Impactor) -> float:
     if not law.dissipative:
         return 0.0
     m_red = law.reduced_mass(model.beam_mass, impactor.mass, model.source)
-    return 2.0 * law.xi * math.sqrt(impactor.k_H * m_red)
+    return 2.0 * law.xi * math.sqrt(impactor.stiffness * m_red)
 
 
 def system_arrays(model: ModalModel, impactor: Impactor) -> SystemArrays:
@@ -222,7 +235,7 @@ def system_arrays(model: ModalModel, impactor: Impactor) -> SystemArrays:
     return SystemArrays(
         omega=as_f8(model.omega), D=as_f8(model.damping_ratios), phi_l=as_f8(model.phi_wall_left),
         phi_r=as_f8(model.phi_wall_right), phi_tip=as_f8(model.phi_tip), gamma=as_f8(model.participation),
-        m_a=float(impactor.mass), k_H=float(impactor.k_H), g=float(impactor.clearance),
+        m_a=float(impactor.mass), k_H=float(impactor.stiffness), g=float(impactor.clearance),
         c_damp=damping_factor(model, impactor), phi_f=phi_f, k_t=k_t, slip_force=slip_force, slider=slider,
         law=impactor.contact_law.law,
     )
@@ -246,27 +259,34 @@ def build_impactor(settings: SystemSettings) -> Impactor:
     Every value is checked here, one line each (`Impactor`, `ContactLaw`)."""
     law = contact_law_of(settings.contact_law, settings.r_cont)
     return Impactor(mass=settings.mass, clearance=settings.clearance, k_H=settings.k_H, contact_law=law,
-                    friction=settings.friction, k_t=settings.k_t)
+                    friction=settings.friction, k_t=settings.k_t, inputs=settings.inputs)
 
 
-def build_system(model: ModalModel, settings: SystemSettings, *,
-                 integrator: str | None = None) -> tuple[ModalModel, Impactor]:
+def settings_of(model: ModalModel, impactor: Impactor) -> SystemSettings:
+    """The `SystemSettings` a built system stands for (the inverse of `build_system`): what the rows of `PARAMETERS`
+    report about it (`UncertainParameter.reported`, the JSON of `ies sweep`)."""
+    law = impactor.contact_law
+    return SystemSettings(D1=float(model.damping_ratios[0]), mass=impactor.mass, clearance=impactor.clearance,
+                          k_H=impactor.k_H, contact_law=law.name, r_cont=law.r_cont, friction=impactor.friction,
+                          k_t=impactor.k_t, inputs=impactor.inputs)
+
+
+def build_system(model: ModalModel, settings: SystemSettings, *, integrator: Any = None) -> tuple[ModalModel, Impactor]:
     """The one impactor builder of the workbench, used by `ies sweep/overview/trace` (`sim.cli`) and by studies
     (`uq.problem.models.IESModel`): (the model with D_1 = settings.D1 when given, the impactor of `build_impactor`).
 
     The checks that need the model and the integrator live here, once, so that a bad combination fails before any
     work with one line: the damped law (Eq. 10) needs the model's beam mass, dry friction (Appendix C) the model's
-    floor values and the ode3 integrator (`integrator`: the protocol's; None skips that check).
+    floor values; `integrator`, the protocol's record (`sim.integration.integrators.Integrator`; None skips the
+    check), says whether it can run this impactor (its law, friction).
     """
     if settings.D1 is not None:
         model = model.with_damping(settings.D1)
     impactor = build_impactor(settings)
+    if integrator is not None:
+        integrator.check(impactor)
     if impactor.contact_law.dissipative or impactor.friction > 0:
         system_arrays(model, impactor)  # beam mass (Eq. 10) and phi_floor (friction): one line if missing
-    if impactor.friction > 0 and integrator is not None and integrator != "ode3":
-        raise SimulationInputError(f"dry friction (mu = {impactor.friction:g}, Appendix C) is in the ode3 integrator "
-                                   "only; choose it (--integrator ode3, or [excitation] integrator = \"ode3\" in a "
-                                   "study file)")
     return model, impactor
 
 

@@ -24,7 +24,7 @@ The predictor
 predicted, on a grid of own levels with the full stepped-sine simulator, and bisects each reference's switch
 bracket (last SMR level, first APR level] down to `resolution` levels. A level counts as APR when at least half of
 its repetitions reach their resonant level almost periodically (the majority rule of
-`sim.hosts.variants.landmarks`). The switch is the first one from below (`ReferenceCurve.bracket`): far above it the
+`sim.stepped_sine.landmarks.landmarks`). The switch is the first one from below (`ReferenceCurve.bracket`): far above it the
 response can turn strongly modulated again for a few levels (seen at 17-18 a_base*(g) on the cantilever of the
 design benchmarks), which `landmarks`' rule "APR from there on" would take for the switch. `SimilarityLaw` then predicts, for any (kappa, D_1):
 
@@ -305,8 +305,8 @@ def simulate_levels(model, m_a: float, realise: Callable[[int], tuple[float, flo
     """An `evaluate` for `reference_curves` by direct stepped-sine sweeps (`sim.stepped_sine.protocol.sweep`): reference
     i is simulated as the design `realise(i)` = (g in m, k_H in N/m^1.5, D_1) with sphere mass m_a (kg) on `model`, its
     levels own levels (a_base*(g) of its own clearance); the value is the sweep's resonant `output` ("mean" or "max",
-    / a_noabs*), the APR share that of its repetition samples (`sim.hosts.variants.landmarks`)."""
-    from sim.hosts.variants import landmarks
+    / a_noabs*), the APR share that of its repetition samples (`sim.stepped_sine.landmarks.landmarks`)."""
+    from sim.stepped_sine.landmarks import landmarks
     from sim.model.system import Impactor, Nominal
     from sim.stepped_sine.protocol import sweep
 

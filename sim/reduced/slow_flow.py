@@ -78,7 +78,7 @@ Validity against the full simulator, measured (first table: an earlier run of 1 
 r measured from its own runs; second: tests/benchmarks/test_slow_flow_switch.py, 2 repetitions): stepped sine as
 the fidelity studies (eta 0.96:1.0:21 up, 3 s + 5 s, exact integrator, seed 2024), levels 2-9 step 0.5 in units of
 each design's own a_base* (own g), r = the simulator's Eq. D.1 value at the wall; switch = (last SMR level, first
-APR level] of `sim.hosts.variants.landmarks`; "agrees" = within one grid step.
+APR level] of `sim.stepped_sine.landmarks.landmarks`; "agrees" = within one grid step.
 
   design       g (mm)  m_a (g)  r (Eq. D.1)  simulated switch  slow flow (9)  agrees   APR level at 7.5 sim / (9)
   rig          0.580   17.7     0.857        5.5 -> 6.0        4.00           no       0.364 / 0.410

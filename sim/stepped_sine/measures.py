@@ -148,7 +148,7 @@ def significant_impacts(impacts: np.ndarray, theta: float = SIGNIFICANT_IMPULSE_
     if not complete.any():
         return complete
     periods = impacts["period"][complete]  # in onset order: non-decreasing
-    starts = np.flatnonzero(np.r_[True, np.diff(periods) != 0])
+    starts = np.flatnonzero(np.concatenate(([True], np.diff(periods) != 0)))
     largest = np.maximum.reduceat(impulse[complete], starts)  # each period's largest impulse
     reference = float(np.median(largest[largest > 0])) if np.any(largest > 0) else 0.0
     return complete & (np.nan_to_num(impulse) >= theta * reference) & (reference > 0)
@@ -181,13 +181,13 @@ def scattering_measures(ledger: Ledger, theta: float = SIGNIFICANT_IMPULSE_FRACT
     records = ledger.impacts
     if records.size == 0 or ledger.dropped:  # ode3 keeps no impact records; an incomplete log is not used
         return ScatteringMeasures(**energy)
-    significant = significant_impacts(records, theta)
-    chosen = records[significant]
-    last = chosen[chosen["period"] >= n_periods - RESTITUTION_PERIODS]
+    chosen = np.flatnonzero(significant_impacts(records, theta))  # indices, not a copy of the records
+    last = records[chosen[records["period"][chosen] >= n_periods - RESTITUTION_PERIODS]]
     r_tip = modal_restitution(last, ledger.fundamental("tip"), ledger.Omega)
     r_wall = np.where(last["wall"] == 0, modal_restitution(last, ledger.fundamental("left"), ledger.Omega),
                       modal_restitution(last, ledger.fundamental("right"), ledger.Omega))
-    after = chosen["higher_release"] / (chosen["fundamental_release"] + chosen["higher_release"])
+    higher = records["higher_release"][chosen]
+    after = higher / (records["fundamental_release"][chosen] + higher)
     median = lambda a: float(np.median(a)) if a.size else math.nan  # noqa: E731
     return ScatteringMeasures(significant_impacts_per_period=chosen.size / n_periods, restitution=median(r_tip),
                               restitution_wall=median(r_wall),

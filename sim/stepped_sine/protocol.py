@@ -58,6 +58,7 @@ import numpy as np
 
 from sim.common.errors import SimulationInputError
 from sim.integration.energy import Ledger
+from sim.integration.integrators import DEFAULT_INTEGRATOR
 from sim.stepped_sine.measures import APR, LINEAR, REGIME_CV_THRESHOLD, SCATTERING_MEASURES, classify_regime, point_measures
 from sim.model.system import (CLEARANCE_NOMINAL, SPHERE_MASS, Impactor, ModalModel, Nominal, SystemArrays,
                         a_base_star, a_noabs_star, system_arrays)
@@ -104,7 +105,7 @@ class SteppedSine:
     hold: float = 5.0
     perturbation: float = 5e-4
     repetition: str = "leg"
-    integrator: str = "exact"  # exact free flight (sim.integration.exact); "ode3" is the paper's fixed-step scheme
+    integrator: str = DEFAULT_INTEGRATOR  # a name of `sim.integration.integrators.INTEGRATORS` (exact free flight)
     dt_scale: float = 1.0
     start: str = "base-velocity"
     perturb: str = "start"

@@ -11,7 +11,7 @@ cantilever (modal restitution r about 0.70) the paper's sphere does not switch u
 
 Simulated: stepped sine as the fidelity studies (eta 0.96:1.0:21 up, 3 s wait, 5 s hold, base-velocity start,
 exact integrator, seed 2024), 2 repetitions per level, own levels a_base/a_base*(g) 2.0-9.0 in steps of 0.5 at the
-design's clearance g; switch = (last SMR level, first APR level] of `sim.hosts.variants.landmarks`; SMR level = the
+design's clearance g; switch = (last SMR level, first APR level] of `sim.stepped_sine.landmarks.landmarks`; SMR level = the
 resonant mean / a_noabs* averaged over the SMR levels from 2 up.
 Predicted: the similarity law from two references at the same host, sphere and protocol but g/2 and 2 g (kappa =
 k_H g^1/2 a factor 2 apart), each on own levels 1.5-12 (geometric, 1.2 apart) with its switch bisected to 0.25:
@@ -30,7 +30,7 @@ import numpy as np
 import pytest
 
 from sim.hosts.rig import seed_rig_model
-from sim.hosts.variants import landmarks
+from sim.stepped_sine.landmarks import landmarks
 from sim.model.system import CLEARANCE_NOMINAL, K_H_NOMINAL, SPHERE_MASS, Impactor, Nominal
 from sim.reduced.similarity import kappa, own_levels, reference_curves, simulate_levels
 from sim.reduced.slow_flow import SlowFlowModel, host_mode, switch_level

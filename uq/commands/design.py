@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Any
 
 from sim.common.options import positive_int
+from sim.model.parameters import PARAMETERS
 from uq.commands.study import add_run_arguments, engine, print_files
 
 DESIGN_HELP = ("choose the clearance and the sphere (radius, material) for a host structure: the worst case of the "
@@ -21,7 +22,10 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--excitation", metavar="RANGE",
                         help="operating base amplitudes START:STOP[:COUNT] with units (e.g. 0.66um:6.6um:10) or base "
                              "accelerations (0.5m/s2:2m/s2); required")
-    parser.add_argument("--clearance", metavar="RANGE", help="clearances to consider (default 0.3mm:1.2mm:10)")
+    flags = sorted(PARAMETERS["g"].option.flags, key=lambda flag: flag != "--clearance")  # the clearance's names
+    parser.add_argument(*flags, dest="clearance", metavar="RANGE",
+                        help=f"clearances to consider (default 0.3mm:1.2mm:10); also {', '.join(flags[1:])} (the "
+                             "same quantity as in ies sweep)")
     parser.add_argument("--radius", metavar="RANGE", help="sphere radii (default the paper's 7.92mm)")
     parser.add_argument("--material", metavar="LIST", help="sphere materials, comma separated: brass, steel, tungsten "
                                                            "(default brass)")
@@ -35,10 +39,12 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--margin", metavar="FRACTION",
                         help="the margin a design's switch to the almost periodic response must keep above the top of "
                              "--excitation at every corner of the box, as a fraction in (0, 1] (default 0.2: 20 %%)")
-    parser.add_argument("--damping", metavar="LOW:HIGH", help="interval of D_1 (default Table 2: 0.00075:0.0009)")
+    D, g, k_H = (PARAMETERS[name].spread for name in ("D", "g", "k_H"))  # Table 2's intervals (the one vocabulary)
+    parser.add_argument("--damping", metavar="LOW:HIGH", help=f"interval of D_1 (default Table 2: {D.low:g}:{D.high:g})")
     parser.add_argument("--clearance-tolerance", metavar="LOW:HIGH",
-                        help="tolerance added to each clearance (default Table 2: 0:0.032mm)")
-    parser.add_argument("--k-H-factor", metavar="LOW:HIGH", help="factor on Eq. 8's k_H (default Table 2: 1:1.518)")
+                        help=f"tolerance added to each clearance (default Table 2: {g.low * 1e3:g}:{g.high * 1e3:g}mm)")
+    parser.add_argument("--k-H-factor", metavar="LOW:HIGH",
+                        help=f"factor on Eq. 8's k_H (default Table 2: {k_H.low:g}:{k_H.high:.4g})")
     parser.add_argument("--calibration", metavar="FILE",
                         help="`ies calibrate --json` output: its k_H / k_H* becomes the upper end of the k_H factor "
                              "(the crater's stiffening, as `ies reproduce` uses it)")

@@ -51,12 +51,9 @@ class Corner:
         return f"D_1 {self.D:g}, g + {self.tolerance * 1e3:.3g} mm, k_H x{self.k_H_factor:.3g}"
 
 
-def box(problem: DesignProblem) -> tuple[list[Corner], Corner]:
-    """The box's distinct corners (D, tolerance, k_H factor ends) and its centre."""
-    corners = list(dict.fromkeys(Corner(D, t, f) for D in problem.D for t in problem.clearance_tolerance
-                                 for f in problem.k_H_factor))
-    centre = Corner(0.5 * sum(problem.D), 0.5 * sum(problem.clearance_tolerance), 0.5 * sum(problem.k_H_factor))
-    return corners, centre
+def corner_of(point: Mapping[str, float], sphere: Sphere) -> Corner:
+    """A box point's task parameters (`DesignProblem.corners`: D, g, k_H in SI) as a Corner of `sphere`."""
+    return Corner(float(point["D"]), float(point["g"]) - sphere.clearance, float(point["k_H"]) / sphere.k_H)
 
 
 @dataclass(frozen=True)
@@ -107,7 +104,6 @@ class Predictor:
         self.laws: dict[tuple[float, str], SphereLaw] = {}
         self._a_star = lambda g: a_base_star(rig, Nominal(clearance=g))  # a_base*(g) (m), Sect. 5.3 with g* -> g
         self._a_star_nominal = a_base_star(rig)
-        self.corners, self.centre = box(problem)
 
     @property
     def runs(self) -> int:
@@ -196,14 +192,14 @@ class Predictor:
         scale = np.array([a_noabs_star(self.rig, x) for x in a])  # objective per a_noabs* -> SI
         per_level = np.full(a.size, -np.inf)
         switches = []
-        for c in [*self.corners, self.centre]:
-            g = sphere.clearance + c.tolerance
-            k = kappa(c.k_H_factor * sphere.k_H, g)
+        for point in p.corners(sphere):  # the box's corners, then its centre (built from the parameter rows)
+            g, D = float(point["g"]), float(point["D"])
+            k = kappa(float(point["k_H"]), g)
             own = a / self._a_star(g)
-            values = np.array([law.value(k, c.D, x) for x in own]) * scale
+            values = np.array([law.value(k, D, x) for x in own]) * scale
             per_level = np.maximum(per_level, values)
-            s = law.switch(k, c.D)
-            switches.append((s.level * self._a_star(g), s.kind, c, k))
+            s = law.switch(k, D)
+            switches.append((s.level * self._a_star(g), s.kind, corner_of(point, sphere), k))
         corner_switches = switches[:-1]
         a_s, kind, worst_corner, k_w = min(corner_switches, key=lambda x: x[0])
         below, above = law.jump(k_w, worst_corner.D)

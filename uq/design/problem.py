@@ -12,17 +12,18 @@ from typing import Any
 
 import numpy as np
 
+from sim.model.parameters import PARAMETERS, UncertainParameter, boxed_parameters
 from uq.errors import StudyError
 
-#: Table 2's intervals as the default uncertainty box: D_1, the clearance's tolerance above its nominal value
-#: (0.58 -> 0.612 mm) and the factor on Eq. 8's k_H (282e3 -> 428e3 N/mm^1.5)
-D_INTERVAL = (0.00075, 0.00090)
-
-
-CLEARANCE_TOLERANCE = (0.0, 0.032e-3)
-
-
-K_H_FACTOR = (1.0, 428.0 / 282.0)
+#: Table 2's intervals as the default uncertainty box, each the spread of its row of the one vocabulary
+#: (`sim.model.parameters.Spread`): D_1, the clearance's tolerance above its nominal value (0.58 -> 0.612 mm) and the
+#: factor on Eq. 8's k_H (282e3 -> 428e3 N/mm^1.5)
+D_INTERVAL = (PARAMETERS["D"].spread.low, PARAMETERS["D"].spread.high)
+CLEARANCE_TOLERANCE = (PARAMETERS["g"].spread.low, PARAMETERS["g"].spread.high)
+K_H_FACTOR = (PARAMETERS["k_H"].spread.low, PARAMETERS["k_H"].spread.high)
+#: the rows whose box the design's options set (the row -> the `DesignProblem` field holding its spread's ends);
+#: every other row with a spread enters the box with its own
+BOX_OPTIONS = {"D": "D", "g": "clearance_tolerance", "k_H": "k_H_factor"}
 
 
 #: the built-in rig's block across the cavity and its walls (Sect. 2: 28 mm, 17 mm cavity in the paper's design)
@@ -85,6 +86,11 @@ class Sphere:
     def describe(self) -> dict[str, Any]:
         return {"clearance_m": self.clearance, "radius_m": self.radius, "material": self.material,
                 "mass_kg": self.mass, "k_H_N_per_m1p5": self.k_H, "cavity_m": self.cavity()}
+
+    def value(self, row: UncertainParameter) -> float:
+        """This design's nominal value of a parameter row: its clearance (g), k_H (Eq. 8), mass (m_a), or the row's
+        nominal value."""
+        return {"g": self.clearance, "k_H": self.k_H, "m_a": self.mass}.get(row.name, row.nominal)
 
 
 @dataclass(frozen=True)
@@ -184,18 +190,44 @@ class DesignProblem:
         """Every design of the grid, material by material, radius by radius, clearance by clearance."""
         return [Sphere(g, R, m) for m in self.materials for R in self.radii for g in self.clearances]
 
+    def spreads(self) -> list[tuple[UncertainParameter, Any]]:
+        """The uncertainty box: each row with a `Spread` (`sim.model.parameters.boxed_parameters`) with its spread,
+        the ends set by this problem's options for D, g and k_H (`BOX_OPTIONS`)."""
+        boxed = []
+        for row in boxed_parameters():
+            spread = row.spread
+            if row.name in BOX_OPTIONS:
+                spread = dataclasses.replace(spread, low=getattr(self, BOX_OPTIONS[row.name])[0],
+                                             high=getattr(self, BOX_OPTIONS[row.name])[1])
+            boxed.append((row, spread))
+        return boxed
+
+    def corners(self, sphere: Sphere) -> list[dict[str, float]]:
+        """The uncertainty box of one design as task parameters (SI; the rows with a spread, then m_a): its corners
+        (each once), then the nominal point (the box's centre) for the monotonicity check."""
+        import itertools
+
+        boxed = self.spreads()
+        points = []
+        for ends in itertools.product(*[(spread.low, spread.high) for _, spread in boxed]):
+            point = {row.name: spread.at(sphere.value(row), end) for (row, spread), end in zip(boxed, ends)}
+            points.append({**point, "m_a": sphere.mass})
+        nominal = {**{row.name: spread.centre(sphere.value(row)) for row, spread in boxed}, "m_a": sphere.mass}
+        unique = {tuple(sorted(p.items())): p for p in points}
+        return [*unique.values(), nominal]
+
 
 _EXAMPLES = {"--excitation": "0.66um:6.6um:10", "--clearance": "0.3mm:1.2mm:10", "--radius": "5mm:8mm:4"}
 
 
 def host_model(problem: DesignProblem) -> Any:
-    """The host's modal model (`sim.model.system.ModalModel`): the built-in rig or the problem's modal file."""
+    """The host's modal model (`sim.model.system.ModalModel`): the built-in rig or the problem's model file, through the
+    one host resolver (`sim.hosts.sources.resolve_host`: a modal-model file or a file kind another source reads)."""
     from sim.common.errors import SimulationInputError
-    from sim.hosts.modal_file import load_modal_model
-    from sim.hosts.rig import seed_rig_model
+    from sim.hosts.sources import resolve_host
 
     try:
-        return seed_rig_model() if problem.modal_file is None else load_modal_model(problem.modal_file)
+        return resolve_host({"model": problem.modal_file}).model
     except SimulationInputError as exc:
         raise StudyError(f"--model: {exc}") from None
 
@@ -237,15 +269,15 @@ def micrometres(a: float) -> str:
 
 
 def _quantities() -> dict[str, Any]:
-    from sim.common.units import Quantity
+    """The quantities of the design's ranges: the clearance and the radius of the one vocabulary (`sim.common.units`,
+    the clearance's row of `PARAMETERS`), and the excitation as a base amplitude or acceleration."""
+    from sim.common.units import LENGTH_UNITS, RADIUS, Quantity
 
-    length = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6}
-    return {"excitation": Quantity("base amplitude a_base", "m", {**length, "nm": 1e-9}, (1e-10, 1e-2), "2um"),
+    return {"excitation": Quantity("base amplitude a_base", "m", {**LENGTH_UNITS, "nm": 1e-9}, (1e-10, 1e-2), "2um"),
             "acceleration": Quantity("base acceleration", "m/s2", {"m/s2": 1.0, "m/s^2": 1.0}, (1e-4, 1e4), "1m/s2"),
-            "clearance": Quantity("clearance g", "m", length, (1e-6, 1e-2), "0.58mm"),
-            "radius": Quantity("sphere radius R", "m", length, (0.5e-3, 0.1), "7.92mm"),
-            "block_width": Quantity("block width", "m", length, (1e-3, 1.0), "28mm"),
-            "min_wall": Quantity("wall thickness", "m", length, (1e-5, 0.5), "5.5mm")}
+            "clearance": PARAMETERS["g"].quantity, "radius": RADIUS,
+            "block_width": Quantity("block width", "m", LENGTH_UNITS, (1e-3, 1.0), "28mm"),
+            "min_wall": Quantity("wall thickness", "m", LENGTH_UNITS, (1e-5, 0.5), "5.5mm")}
 
 
 #: a number alone, without a unit (`2e-3`, `0.5`): refused in a range, on the command line as in a study file

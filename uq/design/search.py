@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from uq.design.objectives import Objective, objective_named
-from uq.design.prediction import DesignPrediction, Predictor, box
+from uq.design.prediction import DesignPrediction, Predictor
 from uq.design.problem import (
     SECONDS_PER_RUN,
     DesignProblem,
@@ -82,7 +82,7 @@ def first_runs(problem: DesignProblem) -> tuple[int, int]:
 
     fitting = [s for s in problem.grid() if problem.fits(s)]
     designs = min(problem.candidates, len(fitting)) + (problem.baseline is not None)
-    points = len(set(problem.D)) * len(set(problem.clearance_tolerance)) * len(set(problem.k_H_factor)) + 1
+    points = len(problem.corners(fitting[0] if fitting else problem.grid()[0]))
     per_design = points * (len(problem.excitation) + 1) * problem.repetitions
     spheres = min(problem.candidates, len({(s.radius, s.material) for s in fitting}))
     levels = 1 + math.ceil(math.log(LEVEL_CEILING / LEVEL_FLOOR) / math.log(LEVEL_RATIO))
@@ -166,10 +166,9 @@ def best_of(problem: DesignProblem, verified: Sequence[Verified]) -> list[Verifi
 
 def corners(problem: DesignProblem, sphere: Sphere) -> list[dict[str, float]]:
     """The uncertainty box of one design as task parameters (D, g, k_H, m_a in SI): its distinct corners, then the
-    centre (D's midpoint, the clearance and k_H of the design) for the monotonicity check."""
-    points, centre = box(problem)
-    return [{"D": c.D, "g": sphere.clearance + c.tolerance, "k_H": c.k_H_factor * sphere.k_H, "m_a": sphere.mass}
-            for c in [*points, centre]]
+    centre (D's midpoint, the clearance and k_H of the design) for the monotonicity check; built from the parameter
+    rows (`DesignProblem.corners`)."""
+    return problem.corners(sphere)
 
 
 def verification_model(problem: DesignProblem) -> Any:

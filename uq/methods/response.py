@@ -105,7 +105,7 @@ class Response(Method):
     def analyse(self, study: Study, model: Any, plan: Plan, runs: Runs) -> Analysis:
         """The frequency response at every level (sweeps.csv), the resonant levels (overview.csv), the overview and
         landmarks in study.json."""
-        from sim.hosts.variants import landmarks
+        from sim.stepped_sine.landmarks import landmarks
         from sim.stepped_sine.tables import OVERVIEW_COLUMNS, SWEEP_COLUMNS, overview_data, overview_rows, sweep_rows
 
         point = plan.points[0]
@@ -151,7 +151,7 @@ def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: 
     import csv
     import dataclasses
 
-    from sim.plots.figures import plot_motion
+    from sim.plots.figures import plot_motion, plot_trace
     from uq.outputs.figures import series_label
     from sim.analysis.trace import record_trace, write_trace
 
@@ -175,7 +175,7 @@ def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: 
         out.mkdir(parents=True, exist_ok=True)
         settings = {"integrator": visit.integrator, "seed": study.seed, "protocol": dataclasses.asdict(visit),
                     "series": sub, "study": study.name}
-        _, paths = write_trace(out, trace, settings, out / "trace.png")
+        _, paths = write_trace(out, trace, settings, out / "trace.png", draw=plot_trace)
         title = (f"{series_label(sub)}: $a_\\mathrm{{base}}/a_\\mathrm{{base}}^*$ = {level:g}, $\\eta$ = {trace.eta_actual:.4f} "
                  "(cf. Fig. C.1b), "
                  f"{trace.amplitudes.size} periods")

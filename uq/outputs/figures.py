@@ -184,14 +184,10 @@ def _tip_mm_per_level(meta: dict) -> float | None:
     study = meta.get("study", {})
     if study.get("model") != "ies":
         return None
+    from sim.hosts.sources import resolve_host
+
     try:
-        if study.get("modal_model"):
-            from sim.hosts.modal_file import load_modal_model
-
-            return tip_mm_per_level(load_modal_model(study["modal_model"]))
-        from sim.hosts.rig import seed_rig_model
-
-        return tip_mm_per_level(seed_rig_model())
+        return tip_mm_per_level(resolve_host({"model": study.get("modal_model") or None}).model)
     except (OSError, ValueError):  # a moved or changed modal file: the figure is drawn without the factor
         return None
 

@@ -78,7 +78,7 @@ def response_figures(folder: str | Path, options: "PlotOptions | None" = None) -
 def response_table(folder: Path, summary: Mapping, name: str) -> None:
     """The resonant levels per excitation level and the optimum (Fig. 6, Sect. 5.3); for a series study the
     resonant mean and the dissipation shares of each value (Fig. 11, C.1)."""
-    from sim.hosts.variants import switch_line
+    from sim.stepped_sine.landmarks import switch_line
     from sim.stepped_sine.tables import optimum_line, overview_text, series_text
     from uq.outputs.figures import series_overviews
 

@@ -184,28 +184,30 @@ class IESModel:
 
     def check_physics(self, params: Mapping[str, float]) -> None:
         """The model and protocol can simulate a point with these optional parameters (`optional_parameters`): the
-        checks of `sim.model.system.build_system` (Eq. 10 needs the model's beam mass, friction its phi_floor and the
-        ode3 integrator), one line otherwise."""
+        checks of `sim.model.system.build_system` (Eq. 10 needs the model's beam mass, friction its phi_floor) and of
+        the protocol's integrator (`sim.integration.integrators.Integrator.check`: its laws, friction), one line
+        otherwise."""
         from sim.common.errors import SimulationInputError
+        from sim.integration.integrators import integrator_named
+        from sim.model.contact_law import law_named
         from sim.model.system import build_system
 
-        point = {"g": 1e-3, "k_H": 1e9, **params}
-        from sim.model.contact_law import law_named
+        from sim.model.parameters import table2_parameters
 
+        point = {**{row.name: row.nominal for row in table2_parameters()}, **params}
         if not law_named(self._law_name()).takes_r_cont and point.get("friction", 0.0) == 0.0:
             return  # only Eq. 10 (the beam mass) and friction (the floor values) ask more of the model
         try:
-            build_system(self._rig(), self._settings(point), integrator=self._stepped_sine().integrator)
+            build_system(self._rig(), self._settings(point), integrator=integrator_named(self._stepped_sine().integrator))
         except SimulationInputError as exc:
             raise StudyError(f"[study] {exc}") from None
 
     def _rig(self) -> "ModalModel":
         from sim.common.errors import SimulationInputError
-        from sim.hosts.modal_file import load_modal_model
         from sim.hosts.variants import with_higher_mode_damping
 
         try:
-            rig = _rig_model(self.n_modes) if self.modal_file is None else load_modal_model(self.modal_file)
+            rig = _rig_model(self.n_modes) if self.modal_file is None else _file_model(self.modal_file)
         except SimulationInputError as exc:
             raise StudyError(f"[study] modal_model: {exc}") from None
         if "higher_mode_damping" in self.variant:
@@ -356,10 +358,19 @@ def mean_over_repetitions(outputs: tuple[str, ...], records: list[Mapping[str, A
 
 
 @functools.lru_cache(maxsize=4)
-def _rig_model(n_modes: int):
-    from sim.hosts.rig import seed_rig_model
+def _rig_model(n_modes: int) -> "ModalModel":
+    """The built-in rig with n_modes modes, through the one host resolver (`sim.hosts.sources.resolve_host`)."""
+    from sim.hosts.sources import resolve_host
 
-    return seed_rig_model(n_modes=n_modes)
+    return resolve_host({"n_modes": n_modes}).model
+
+
+def _file_model(path: str) -> "ModalModel":
+    """The host of a study's modal_model file, through the one host resolver: a modal-model file or a file kind a row
+    of `sim.hosts.sources.HOST_SOURCES` reads."""
+    from sim.hosts.sources import resolve_host
+
+    return resolve_host({"model": path}).model
 
 
 @dataclass(frozen=True)

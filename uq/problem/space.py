@@ -20,24 +20,14 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from sim.common.errors import SimulationInputError
-from sim.common.units import implausible, parse_quantity
-from sim.model.parameters import K_H_NOMINAL, N_PER_MM15, PARAMETERS, UncertainParameter, table2_parameters  # noqa: F401
+from sim.model.parameters import (K_H_BEST_ESTIMATE_FACTOR, K_H_NOMINAL, N_PER_MM15, PARAMETERS,  # noqa: F401
+                                  UncertainParameter, column_name, table2_parameters)
 from uq.errors import StudyError
 
-# Table 2 of the seed paper (SI units) is the table2 rows of `sim.model.parameters.PARAMETERS`, the one table of the
-# parameters; k_H in N/m^1.5: 1 N/mm^1.5 = 1e3^1.5 N/m^1.5.
+# Table 2 of the seed paper (SI units) is the table2 rows of `sim.model.parameters.PARAMETERS`, the one vocabulary of
+# the paper's quantities (names, units, nominal values, intervals, bounds, plausible ranges, CSV columns).
 K_H_STAR = K_H_NOMINAL  # Eq. 8, nominal sphere on a flat wall (282e3 N/mm^1.5)
-K_H_BEST_ESTIMATE_FACTOR = 1.25  # Sect. 4.1
 K_H_BEST_ESTIMATE = K_H_BEST_ESTIMATE_FACTOR * K_H_STAR
-
-
-def column_name(name: str, unit: str) -> str:
-    """A CSV column for a quantity and its unit: ``g`` in ``m`` -> ``g_m``, ``k_H`` in ``N/m^1.5`` ->
-    ``k_H_N_per_m1p5``, a dimensionless quantity (unit "-", "1" or "") keeps its name."""
-    if unit in ("", "-", "1"):
-        return name
-    token = unit.replace("/", "_per_").replace("^", "").replace(".", "p").replace(" ", "_")
-    return f"{name}_{token}"
 
 
 @dataclass(frozen=True)
@@ -213,7 +203,7 @@ def resolve_k_H(value: object, *, base_dir: Path | None = None) -> float:
                 path = base_dir / path
             return calibrated_k_H(path)
         try:
-            return parse_quantity(value, PARAMETERS["k_H"].quantity)
+            return PARAMETERS["k_H"].parse(value)
         except SimulationInputError:
             pass
     raise StudyError(f"cannot read k_H = {value!r}: give N/m^1.5, a value with its unit like \"282e3 N/mm^1.5\", "
@@ -221,16 +211,21 @@ def resolve_k_H(value: object, *, base_dir: Path | None = None) -> float:
 
 
 def resolve_value(name: str, value: object, *, base_dir: Path | None = None) -> object:
-    """A parameter value of a study file in SI units: k_H through `resolve_k_H`, the clearance g as a number in m
-    or a string with its unit ("0.58 mm", `sim.common.units`); other parameters unchanged (checked by `Parameter`)."""
-    if name == "k_H":
-        return resolve_k_H(value, base_dir=base_dir)
+    """A parameter value of a study file in SI units: k_H through `resolve_k_H`, a row's value with its unit ("0.58
+    mm", `sim.model.parameters.UncertainParameter.parse`); a number of a row checked against the row's physical
+    bounds, as on the command line (`UncertainParameter.problem`); other values unchanged (checked by `Parameter`)."""
     row = PARAMETERS.get(name)
-    if row is not None and row.quantity is not None and isinstance(value, str):
+    if name == "k_H":
+        value = resolve_k_H(value, base_dir=base_dir)
+    elif row is not None and row.quantity is not None and isinstance(value, str):
         try:
-            return parse_quantity(value, row.quantity)
+            value = row.parse(value)
         except SimulationInputError as exc:
             raise StudyError(str(exc)) from None
+    if row is not None and isinstance(value, (int, float)) and not isinstance(value, bool):
+        problem = row.problem(value)
+        if problem is not None:
+            raise StudyError(f"[parameters.{row.study_key}] {problem}")
     return value
 
 
@@ -238,7 +233,7 @@ def plausibility_warning(name: str, value: float) -> str | None:
     """`sim.common.units.implausible` for the parameters of `PARAMETERS` with a unit parser (a clearance above 10 mm,
     a k_H below 1e6 N/m^1.5, ...)."""
     row = PARAMETERS.get(name)
-    return None if row is None or row.quantity is None else implausible(float(value), row.quantity)
+    return None if row is None else row.implausible(value)
 
 
 def calibrated_k_H(source: str | Path | Mapping) -> float:

@@ -1,13 +1,20 @@
-"""The contact-law seam (issue 27, item 3): a law is defined once in `sim.model.contact_law` and every integrator
-compiles it. The toy entry, registered here and nowhere else, is a linear spring with clearance, f = k delta for
-delta > 0 (k in N/m). It is run end to end through a short stepped-sine point (a wait and a hold of one period
-each at 0.99 omega_1, the sphere launched at 0.3 m/s: the rattling is chaotic, and over four periods the exact
-integrator's 1e-11 per step already grow to 5e-7) by both integrators and checked against scipy's DOP853 with events
-(`sim.integration.references.reference_run`, which evaluates the law's force in Python), against its own
-single-impact reference (a half sine: restitution 1, duration pi sqrt(m / k)), and by the energy ledger's balance
-with the law's potential k delta^2 / 2."""
+"""The contact-law seam: a law is defined once in `sim.model.contact_law` and every integrator compiles it. The toy
+entry, defined here and registered by one line (`register`) inside the tests only, is a linear spring with
+clearance and a constant of its own, f = k_lin delta for delta > 0 (k_lin in N/m, a row of
+`sim.model.parameters.PARAMETERS` that the law carries: its option --k-lin, study key, JSON key and checks come with it;
+its onset exponent 1 is what the exact integrator's step predictors are told). It is run end to end through a short
+stepped-sine point (a wait and a hold of one period each at 0.99 omega_1, the sphere launched at 0.3 m/s: the
+rattling is chaotic, and over four periods the exact integrator's 1e-11 per step already grow to 5e-7) by both
+integrators and checked against scipy's DOP853 with events (`sim.integration.references.reference_run`, which
+evaluates the law's force in Python), against its own single-impact reference (a half sine: restitution 1, duration
+pi sqrt(m / k)), by the energy ledger's balance with the law's potential k delta^2 / 2, and through the real
+commands: `ies sweep --contact-law linear-spring --k-lin ...` and an interval study that varies k_lin.
+
+Files a law with a constant of its own touches: the file that defines it (here this test) and the registry line.
+"""
 from __future__ import annotations
 
+import json
 import math
 
 import numba
@@ -15,12 +22,15 @@ import numpy as np
 import pytest
 
 from sim.common.errors import SimulationInputError
+from sim.common.units import Quantity
 from sim.integration import exact, ode3
 from sim.integration.energy import Ledger
 from sim.integration.references import cantilever_like_model, reference_run
 from sim.model import contact_law
-from sim.model.contact_law import LAWS, ContactLaw, ImpactReference, Law, contact_law_of
+from sim.model.contact_law import LAWS, ContactLaw, ImpactReference, Law, contact_law_of, register
+from sim.model.parameters import PARAMETERS, CliOption, Feed, UncertainParameter
 from sim.model.system import Impactor, ModalModel, a_base_star, system_arrays
+from tests.support import interval_runs
 
 K_SPRING = 4e6  # N/m: a contact of ~0.3 ms on the sphere, a few steps of ode3 at its paper step
 
@@ -47,20 +57,35 @@ def spring_reference(m, v0, k, c):
     return ImpactReference(1.0, math.pi * math.sqrt(m / k))
 
 
+#: the spring's own constant: a parameter row (units, bounds, plausible range, option, study key) that the law carries
+K_LIN = UncertainParameter(
+    "k_lin", "N/m", "stiffness k_lin of the linear spring", K_SPRING, (K_SPRING, K_SPRING), Feed(), "k_lin",
+    quantity=Quantity("spring stiffness k_lin", "N/m", {"N/m": 1.0, "N/mm": 1e3, "kN/mm": 1e6}, (1e3, 1e10), "4kN/mm"),
+    option=CliOption("--k-lin", "K", "stiffness of the linear-spring law in N/m, or with a unit: 4kN/mm"))
+
 SPRING = Law("linear-spring", "a linear spring with clearance (test entry)", spring_force, spring_stiffness,
-             spring_potential, spring_reference)
+             spring_potential, spring_reference, constant=K_LIN, exponent=1.0)
 
 
 @pytest.fixture
-def spring(monkeypatch):
-    """The toy law registered for one test (and removed after it)."""
-    monkeypatch.setitem(LAWS, SPRING.name, SPRING)
-    return SPRING
+def spring():
+    """The toy law registered for one test by its one registry line, and removed after it (with its constant's row)."""
+    saved = dict(LAWS), dict(PARAMETERS)
+    register(SPRING)  # the registry line: the law and its constant's row of PARAMETERS
+    yield SPRING
+    for registry, before in zip((LAWS, PARAMETERS), saved):
+        registry.clear()
+        registry.update(before)
 
 
-def three_mode_system(law_name: str = "linear-spring"):
+def spring_impactor(k: float = K_SPRING) -> Impactor:
+    """The sphere with the toy law and its own constant k (N/m)."""
+    return Impactor(contact_law=ContactLaw("linear-spring"), inputs=(("k_lin", k),))
+
+
+def three_mode_system():
     model = cantilever_like_model(n_modes=3)
-    return model, system_arrays(model, Impactor(k_H=K_SPRING, contact_law=ContactLaw(law_name)))
+    return model, system_arrays(model, spring_impactor())
 
 
 #: the sphere's speed at the start (m/s): the beam rings up over seconds at resonance, the sphere rattles at once
@@ -140,7 +165,7 @@ def test_the_toy_law_meets_its_single_impact_reference(spring):
     model = ModalModel(frequencies_hz=np.array([1e-3]), damping_ratios=np.array([1e-6]), phi_wall_left=np.array([phi]),
                        phi_wall_right=np.array([phi]), phi_tip=np.array([phi]), participation=np.array([0.0]),
                        source="immovable wall")
-    impactor = Impactor(k_H=K_SPRING, contact_law=ContactLaw("linear-spring"))
+    impactor = spring_impactor()
     sys = system_arrays(model, impactor)
     v0 = 0.2
     y = np.zeros(4)
@@ -165,3 +190,40 @@ def test_the_registered_laws_give_their_own_references():
     assert contact_law.HERTZ_DAMPED.reference(m, v0, k, 0.0).restitution == 1.0
     assert contact_law_of(None, 0.9).law is contact_law.HERTZ_DAMPED
     assert contact_law_of("hertz-damped", 1.0).law is contact_law.HERTZ  # r_cont = 1: the elastic law, bit for bit
+
+
+def test_the_law_gives_its_constant_to_the_kernels_and_its_predictor_its_exponent(spring):
+    """The spring's k is the kernels' k (`SystemArrays.k_H`), not Hertz's k_H; the law's exponent and its contact time
+    (pi sqrt(m / k) = pi delta_max / v0 for p = 1, the closed form Law derives) are the predictors' inputs."""
+    model = cantilever_like_model(n_modes=3)
+    sys = system_arrays(model, spring_impactor(2.5e6))
+    assert sys.k_H == 2.5e6 and sys.law is SPRING
+    assert SPRING.exponent == 1.0 and SPRING.duration_factor == pytest.approx(math.pi, rel=1e-14)
+    assert contact_law.HERTZ.duration_factor == 2.9432  # Johnson's rounded value, stated by the Hertz law
+    assert system_arrays(model, Impactor()).k_H == Impactor().k_H  # the Hertz laws keep k_H
+
+
+def test_the_toy_law_and_its_constant_through_ies_sweep(spring, model_file, capsys):
+    """`ies sweep` takes the law and its constant's option (with a unit), reports the constant in its JSON, and
+    refuses an impossible value with the row's one line."""
+    from uq.cli import main
+
+    argv = ["sweep", "--level", "7.4", "--eta", "0.99", "--wait", "0.02", "--hold", "0.05", "--reps", "1",
+            "--model", model_file, "--contact-law", "linear-spring", "--json"]
+    assert main([*argv, "--k-lin", "2kN/mm"]) == 0
+    soft = json.loads(capsys.readouterr().out)
+    assert soft["impactor"]["contact_law"] == "linear-spring" and soft["impactor"]["k_lin_N_per_m"] == 2e6
+    assert main([*argv, "--k-lin", "8e6"]) == 0
+    stiff = json.loads(capsys.readouterr().out)
+    assert stiff["impactor"]["k_lin_N_per_m"] == 8e6
+    assert soft["mean"] != stiff["mean"]  # the constant reaches the kernels: another spring, another response
+    assert main([*argv, "--k-lin", "-1"]) == 2
+    assert "argument --k-lin: k_lin must be a positive number, got -1.0" in capsys.readouterr().err
+
+
+def test_a_study_varies_the_laws_constant(spring, model_file, tmp_path):
+    """An interval study lists the constant under its study key and runs it end to end (`ies interval`)."""
+    _, runs = interval_runs(tmp_path, f"contact_law = 'linear-spring'\nmodal_model = '{model_file}'\n"
+                                      "[parameters.k_lin]\nmin = '2kN/mm'\nmax = '8kN/mm'\n")
+    assert {float(r["k_lin_N_per_m"]) for r in runs} == {2e6, K_SPRING, 8e6}  # its ends and its nominal value
+    assert len({r["mean"] for r in runs}) > 1

@@ -37,3 +37,17 @@ def test_eq8_scales_with_the_root_of_the_radius_and_mass_with_its_cube():
 def test_an_unknown_material_names_the_known_ones():
     with pytest.raises(SimulationInputError, match="unknown sphere material 'gold'; choose one of brass, steel, tungsten"):
         material("gold")
+
+
+def test_table2s_k_H_is_eq8_of_table1_rounded_and_every_stage_computes_eq8_alike():
+    """k_H* = 282e3 N/mm^1.5 of Table 2 is Eq. 8 with Table 1's brass on steel (281.76e3) rounded to three digits;
+    bem_contact's Eq. 8 is sim's, bit for bit (one definition)."""
+    from bem_contact.materials import BRASS, STEEL, k_H_star
+
+    from sim.model.parameters import N_PER_MM15, SPHERE_RADIUS
+
+    k = hertz_constant(SPHERE_RADIUS, MATERIALS["brass"])
+    assert k / N_PER_MM15 == pytest.approx(281.755e3, rel=1e-5)
+    assert round(k / N_PER_MM15, -3) == K_H_NOMINAL / N_PER_MM15
+    assert k_H_star(SPHERE_RADIUS, BRASS, STEEL) == k
+

@@ -398,9 +398,13 @@ def test_a_calibration_sets_the_upper_end_of_the_k_H_factor(tmp_path, capsys):
 
 def test_the_box_is_its_distinct_corners_and_its_centre():
     problem = dp.DesignProblem(excitation=(2e-6,), clearances=(0.5e-3,), radii=(7.92e-3,))
-    corners, centre = dq.box(problem)
-    assert len(corners) == 8 and len(set(corners)) == 8
-    assert centre == dq.Corner(0.5 * sum(problem.D), 0.5 * sum(problem.clearance_tolerance),
-                               0.5 * sum(problem.k_H_factor))
-    points = ds.corners(problem, dp.Sphere(0.5e-3, 7.92e-3, "brass"))
-    assert len(points) == 9 and points[-1]["g"] == pytest.approx(0.5e-3 + 0.016e-3)
+    sphere = dp.Sphere(0.5e-3, 7.92e-3, "brass")
+    points = ds.corners(problem, sphere)
+    corners = {dq.corner_of(p, sphere) for p in points[:-1]}
+    assert len(points) == 9 and len(corners) == 8
+    ends = [(D, t, f) for D in problem.D for t in problem.clearance_tolerance for f in problem.k_H_factor]
+    assert all(min(abs(c.D - D) + abs(c.tolerance - t) + abs(c.k_H_factor - f) for D, t, f in ends) < 1e-12
+               for c in corners)
+    centre = dq.corner_of(points[-1], sphere)
+    assert centre.D == pytest.approx(0.5 * sum(problem.D)) and centre.k_H_factor == pytest.approx(
+        0.5 * sum(problem.k_H_factor)) and points[-1]["g"] == pytest.approx(0.5e-3 + 0.016e-3)
