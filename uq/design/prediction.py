@@ -53,7 +53,8 @@ class Corner:
 
 def corner_of(point: Mapping[str, float], sphere: Sphere) -> Corner:
     """A box point's task parameters (`DesignProblem.corners`: D, g, k_H in SI) as a Corner of `sphere`."""
-    return Corner(float(point["D"]), float(point["g"]) - sphere.clearance, float(point["k_H"]) / sphere.k_H)
+    tolerance = round(float(point["g"]) - sphere.clearance, 12)  # to the picometre: no -1e-19 m from the subtraction
+    return Corner(float(point["D"]), tolerance + 0.0, float(point["k_H"]) / sphere.k_H)
 
 
 @dataclass(frozen=True)
