@@ -2,11 +2,12 @@
 instead of a dozen numpy temporaries. Arrays are 2-D float64, C-contiguous, of one shape."""
 from __future__ import annotations
 
-import numba
 import numpy as np
 
+from sim.common.kernel_cache import cached_njit
 
-@numba.njit(cache=True)
+
+@cached_njit
 def contact_mean(h: np.ndarray, u: np.ndarray, p: np.ndarray) -> float:
     """Mean of h + u over the loaded elements (the approach read off the solution, load control)."""
     total = 0.0
@@ -19,7 +20,7 @@ def contact_mean(h: np.ndarray, u: np.ndarray, p: np.ndarray) -> float:
     return total / count if count else 0.0
 
 
-@numba.njit(cache=True)
+@cached_njit
 def gap_and_residual(h: np.ndarray, u: np.ndarray, p: np.ndarray, delta: float, kii: float, g: np.ndarray):
     """g = h + u - delta (written into g); returns (max |min(p kii, g)|, sum of g^2 over the contact)."""
     worst = 0.0
@@ -36,7 +37,7 @@ def gap_and_residual(h: np.ndarray, u: np.ndarray, p: np.ndarray, delta: float, 
     return worst, G
 
 
-@numba.njit(cache=True)
+@cached_njit
 def conjugate_direction(g: np.ndarray, p: np.ndarray, t: np.ndarray, beta: float) -> None:
     """t = g + beta t on the contact, 0 elsewhere (in place; beta = 0 restarts)."""
     for i in range(g.shape[0]):
@@ -44,7 +45,7 @@ def conjugate_direction(g: np.ndarray, p: np.ndarray, t: np.ndarray, beta: float
             t[i, j] = g[i, j] + beta * t[i, j] if p[i, j] > 0.0 else 0.0
 
 
-@numba.njit(cache=True)
+@cached_njit
 def step_sums(Kt: np.ndarray, t: np.ndarray, g: np.ndarray, p: np.ndarray):
     """Sums over the contact: (Kt.t, g.t, sum t, sum Kt, count)."""
     rt = 0.0
@@ -63,7 +64,7 @@ def step_sums(Kt: np.ndarray, t: np.ndarray, g: np.ndarray, p: np.ndarray):
     return rt, gt, st, sk, count
 
 
-@numba.njit(cache=True)
+@cached_njit
 def update_pressure(p: np.ndarray, t: np.ndarray, g: np.ndarray, tau: float, tau_overlap: float):
     """p <- max(p - tau t, 0); elements that stay unloaded but penetrate (g < 0) get -tau_overlap g.
 
@@ -85,7 +86,7 @@ def update_pressure(p: np.ndarray, t: np.ndarray, g: np.ndarray, tau: float, tau
     return clipped, overlap, total
 
 
-@numba.njit(cache=True)
+@cached_njit
 def linear_update(u: np.ndarray, Kt: np.ndarray, tau: float, scale: float) -> None:
     """u <- scale (u - tau Kt), the exact displacement after a step without clipping."""
     for i in range(u.shape[0]):

@@ -9,14 +9,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 import scipy.ndimage as ndi
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from sim.common.kernel_cache import cached_njit
 
-@numba.njit(cache=True)
+
+@cached_njit
 def _rasterize(x, y, z, faces, x0, y0, dx, nx, ny, out, hits):  # pragma: no cover - numba
     for f in range(faces.shape[0]):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]

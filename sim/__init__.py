@@ -5,9 +5,10 @@ Pipeline: rig geometry / modal file -> sim.hosts.rig / sim.hosts.modal_file -> m
 per-period amplitudes) -> uq. sim stands alone: it imports no other stage, which is why `sim.common.files`, the
 one way every stage writes a file, lives here, with what every stage's command line shares: option types
 (`sim.common.options`, quantities with units from `sim.common.units`) and the redrawing of result folders (`sim.plots.redraw`). Its
-commands, `sim.cli.COMMANDS`: `ies modes`, `ies sweep`, `ies overview`, `ies trace` (`sim.cli`), `ies orbits`
-(`sim.orbits.cli`: periodic orbits, their stability and bifurcations) and `ies impacts`, `ies modal-fit`
-(`sim.analysis.cli`); independent references for tests in `sim.integration.references`.
+commands, `sim.cli.COMMANDS`: `ies modes`, `ies sweep`, `ies overview`, `ies trace`, `ies cache` (the compiled
+kernels' per-user cache, `sim.common.kernel_cache`; `sim.cli`), `ies orbits` (`sim.orbits.cli`: periodic orbits,
+their stability and bifurcations) and `ies impacts`, `ies modal-fit` (`sim.analysis.cli`); independent references for
+tests in `sim.integration.references`.
 
 Public names, each imported from its module on first use, so that `import sim.common.errors` (done by the `ies`
 front door) stays light (importing all of them takes 0.6-0.8 s more):

@@ -8,6 +8,7 @@
 * `ies trace`: time histories of one stepped-sine point, like Figs. 4 and 9a (Sects. 5.1, 5.5; `sim.analysis.trace`).
 * `ies orbits`: the periodic orbits with their stability and bifurcations (`sim.orbits`).
 * `ies impacts`, `ies modal-fit`: the analyses of measured or simulated signals (`sim.analysis.cli`).
+* `ies cache`: where the compiled kernels are cached, how big the cache is, and emptying it (`sim.common.kernel_cache`).
 
 `add_commands(subparsers)` (at the end) registers them with the front door (`uq.cli`), which only dispatches. Heavy
 imports (numpy, numba) stay inside the functions, so that `ies --help` stays fast. Every bad value ends in
@@ -557,6 +558,70 @@ def orbits_command(args: argparse.Namespace) -> int:
     return run(args, build_system, output_folder, system_data)
 
 
+# ---- ies cache -------------------------------------------------------------------------------------------------
+
+CACHE_HELP = "where the compiled kernels are cached and how big the cache is; --clear empties it"
+
+
+def add_cache_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of `ies cache`."""
+    parser.add_argument("--clear", action="store_true",
+                        help="delete every cached kernel (the next run compiles the kernels again)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+
+
+def _megabytes(size: int) -> str:
+    return f"{size / 1e6:.1f} MB"
+
+
+def _ago(seconds: float) -> str:
+    for unit, length in (("d", 86400.0), ("h", 3600.0), ("min", 60.0)):
+        if seconds >= length:
+            return f"{seconds / length:.0f} {unit} ago"
+    return "just now"
+
+
+def cache_command(args: argparse.Namespace) -> int:
+    """`ies cache`: the kernel cache's folder (`sim.common.kernel_cache`: per user, keyed by the code, never in the
+    installed package), one line per code version with its size, and `--clear` to empty it."""
+    from sim.common import kernel_cache
+    from sim.common.files import dumps
+    from sim.integration import jit
+
+    root, chosen_by = kernel_cache.cache_root()
+    current = f"{jit.CACHE_GROUP}-{jit.fingerprint()[:16]}"
+    if args.clear:
+        removed, freed = kernel_cache.clear(root)
+        left = kernel_cache.version_folders(root)
+        data = {"folder": root, "removed_folders": removed, "freed_bytes": freed, "left_folders": [e.path for e in left]}
+        if args.json:
+            print(dumps(data))
+            return 0
+        print(f"kernel cache {root}: removed {removed} code version(s), {_megabytes(freed)}; the next run compiles the "
+              "kernels again" + (f"; {len(left)} folder(s) in use or holding other files were left" if left else ""))
+        return 0
+    folders = kernel_cache.version_folders(root)
+    now = time.time()
+    data = {"folder": root, "chosen_by": chosen_by, "total_bytes": sum(e.size for e in folders),
+            "versions": [{"folder": e.path.name, "group": e.group, "bytes": e.size, "files": e.files,
+                          "last_used": e.last_used, "current": e.path.name == current} for e in folders]}
+    if args.json:
+        print(dumps(data))
+        return 0
+    moved = "" if chosen_by == kernel_cache.SETTING else f"; {kernel_cache.SETTING}=DIR moves it"
+    print(f"kernel cache: {root} ({chosen_by}{moved})")
+    labels = {"sim": "simulator", "bem_contact": "contact solver", "scans": "scan resampling"}
+    for entry in folders:
+        what = labels.get(entry.group, entry.group) + (
+            {True: " (this version)", False: " (another version)"}[entry.path.name == current] if entry.group == "sim" else "")
+        print(f"  {entry.path.name:<30} {_megabytes(entry.size):>9} {entry.files:>5} files  {what}, last used "
+              f"{_ago(now - entry.last_used)}")
+    if not folders:
+        print("  empty: the next run compiles the kernels (once per version of the code)")
+    print(f"total {_megabytes(data['total_bytes'])} in {len(folders)} folder(s); `ies cache --clear` empties it")
+    return 0
+
+
 # ---- registration with the front door -------------------------------------------------------------------------
 
 COMMANDS = (("modes", MODES_HELP, add_modes_arguments, modes_command),
@@ -565,12 +630,13 @@ COMMANDS = (("modes", MODES_HELP, add_modes_arguments, modes_command),
             ("trace", TRACE_HELP, add_trace_arguments, trace_command),
             ("orbits", ORBITS_HELP, add_orbits_arguments, orbits_command),
             ("impacts", signal_cli.IMPACTS_HELP, signal_cli.add_impacts_arguments, signal_cli.impacts_command),
-            ("modal-fit", signal_cli.MODAL_FIT_HELP, signal_cli.add_modal_fit_arguments, signal_cli.modal_fit_command))
+            ("modal-fit", signal_cli.MODAL_FIT_HELP, signal_cli.add_modal_fit_arguments, signal_cli.modal_fit_command),
+            ("cache", CACHE_HELP, add_cache_arguments, cache_command))
 
 
 def add_commands(subparsers: Any) -> None:
-    """Register `modes`, `sweep`, `overview`, `trace`, `orbits`, `impacts` and `modal-fit` (COMMANDS) on the front door's
-    subparsers (argparse)."""
+    """Register `modes`, `sweep`, `overview`, `trace`, `orbits`, `impacts`, `modal-fit` and `cache` (COMMANDS) on the
+    front door's subparsers (argparse)."""
     for name, help_text, add_arguments, run in COMMANDS:
         parser = subparsers.add_parser(name, help=help_text, description=help_text)
         add_arguments(parser)

@@ -9,17 +9,30 @@ if os.environ.get("CI"):
     settings.load_profile("ci")
 
 
+@pytest.hookimpl(tryfirst=True)
 def pytest_sessionstart(session) -> None:
     """Compile (or load) the integrators' kernels once, quietly, before the tests: a cold numba cache would otherwise
     put the first run's "compiling ..." notice on the stderr of whichever command test comes first, and the tests
     that check a command's one-line messages would depend on their order. The notice itself is tested in
-    tests/sim/integration/test_warm_up.py."""
+    tests/sim/integration/test_warm_up.py. With pytest-xdist (`-n`) this runs first in the controller, before xdist
+    starts the workers (in its own, later, session start: tryfirst here), so each worker only loads the kernels from the
+    cache (seconds) instead of both compiling them at once."""
     import io
 
     from sim.integration.integrators import available, warm_up_all
     from sim.model.contact_law import LAWS
 
     warm_up_all([(name, law) for name in available() for law in LAWS], stream=io.StringIO())
+
+
+def pytest_xdist_auto_num_workers(config) -> int | None:
+    """`-n auto` (pyproject's addopts) means one worker per core, except for a run that selects the benchmarks
+    (`-m benchmark`): those time themselves and need the cores to themselves, so they run in one process."""
+    import re
+
+    if re.search(r"(?<!not )\bbenchmark\b", config.option.markexpr or ""):
+        return 0
+    return None
 
 
 @pytest.fixture

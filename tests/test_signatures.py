@@ -15,7 +15,7 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGES = ("scans", "bem_contact", "sim", "uq", "tests")
 MAX_POSITIONAL = 8
-KERNEL_DECORATORS = {"kernel", "njit", "jit"}
+KERNEL_DECORATORS = {"kernel", "njit", "jit", "cached_njit"}
 
 
 def _decorator_name(node: ast.expr) -> str:

@@ -10,9 +10,11 @@ registered law, `sim.model.contact_law.LAWS`) and how long its kernels take to c
 system it cannot run with one line; the commands' options and help are built from the records. Adding an integrator
 is writing its module and one `INTEGRATORS` row.
 
-The kernels are numba functions cached on disk (``cache=True``, in ``__pycache__`` beside the sources). The
-first run on a machine compiles them, which takes minutes; `warm_up` does it before a command's progress bar
-starts (so that the bar's rate and ETA measure simulation only) and says so while it happens.
+The kernels are numba functions cached on disk (`sim.integration.jit`: in the per-user kernel cache, one folder per
+version of their sources). The first run of a version of the code on a machine compiles them, which takes a minute
+or more; `warm_up` does it before a command's progress bar starts (so that the bar's rate and ETA measure simulation
+only) and says so while it happens, with an estimate of how long: a small test compilation (`compile_probe_s`, about
+a second) measures this machine's speed and present load, and the reference times of COMPILE_S_QUIET scale with it.
 """
 from __future__ import annotations
 
@@ -40,15 +42,16 @@ RunStep = Callable[[np.ndarray, int, float, float, SystemArrays, "np.ndarray | N
 @dataclass(frozen=True)
 class Integrator:
     """One integrator: name (the --integrator value), module (its kernels, with ``run_step``), summary (one line of the
-    help); friction: it takes dry friction (Appendix C); dt_scale: it takes a step scale; compile_minutes: how long
-    compiling its kernels takes with a cold cache (`warm_up`'s notice); laws: the contact laws it runs (None: all)."""
+    help); friction: it takes dry friction (Appendix C); dt_scale: it takes a step scale; compile_s_quiet: how long
+    compiling its kernels for one law takes with a cold cache on a quiet 2-core machine, s (what `warm_up`'s estimate
+    scales); laws: the contact laws it runs (None: all)."""
 
     name: str
     module: str
     summary: str
     friction: bool = False
     dt_scale: bool = False
-    compile_minutes: float = 2.0
+    compile_s_quiet: float = 80.0
     laws: tuple[str, ...] | None = None
 
     def run_step(self, *, dt_scale: float | None = None) -> RunStep:
@@ -82,8 +85,8 @@ class Integrator:
 #: "ode3" is the paper's reference; "exact" is the fast free-flight integrator (the default).
 INTEGRATORS: dict[str, Integrator] = {i.name: i for i in (
     Integrator("ode3", "sim.integration.ode3", "the paper's fixed step", friction=True, dt_scale=True,
-               compile_minutes=1),
-    Integrator("exact", "sim.integration.exact", "closed-form free flight, located contacts", compile_minutes=2),
+               compile_s_quiet=25.0),
+    Integrator("exact", "sim.integration.exact", "closed-form free flight, located contacts", compile_s_quiet=80.0),
 )}
 DEFAULT_INTEGRATOR = "exact"
 
@@ -106,13 +109,70 @@ def get_integrator(name: str, *, dt_scale: float | None = None) -> RunStep:
     return integrator_named(name).run_step(dt_scale=dt_scale)
 
 
-#: how long compiling the kernels of one integrator takes with a cold cache (`warm_up`; `Integrator.compile_minutes`),
-#: measured on the 2-core development machine while other work shared the cores (load average 6-8): "exact" 101 s
-#: in a fresh install (up to 390 s under heavier load), "ode3" 32 s
-COMPILE_MINUTES = {name: record.compile_minutes for name, record in INTEGRATORS.items()}
-#: seconds after which `warm_up` says that it is compiling: loading the cached kernels of "exact" takes 1-3 s
-#: (2.5-3 s measured with the machine's 2 cores shared by four engineers), compiling them minutes
+#: seconds a cold compilation of one integrator's kernels with one contact law takes on a quiet 2-core machine, in
+#: one process (`Integrator.compile_s_quiet`), and the share each further law adds (its own specialisations of the
+#: entry kernels), measured by tests/benchmarks/test_cold_compile.py together with PROBE_S_QUIET
+COMPILE_S_QUIET = {name: record.compile_s_quiet for name, record in INTEGRATORS.items()}
+FURTHER_LAW_SHARE = 0.5
+#: seconds `compile_probe_s` takes on the same quiet machine
+PROBE_S_QUIET = 0.75
+#: seconds after which `warm_up` says that it is compiling where it did not expect to (kernels it thought cached);
+#: loading the cached kernels of "exact" takes 1-3 s
 NOTICE_AFTER_S = 5.0
+
+
+def _probe_kernel(y: np.ndarray, omega: np.ndarray, zeta: np.ndarray, force: np.ndarray, h: float, n: int) -> float:
+    """A damped modal system with a Hertz-like wall, a few third-order Runge-Kutta steps: loops, array arithmetic and
+    branches like the integrators', for `compile_probe_s` to compile."""
+    m = omega.size
+    k1, k2, k3, stage_y = np.empty_like(y), np.empty_like(y), np.empty_like(y), np.empty_like(y)
+    peak = 0.0
+    for step in range(n):
+        for stage in range(3):
+            source = y if stage == 0 else stage_y
+            out = k1 if stage == 0 else (k2 if stage == 1 else k3)
+            for j in range(m):
+                q, v = source[j], source[m + j]
+                out[j] = v
+                out[m + j] = (force[j] * np.cos(step * h) - 2.0 * zeta[j] * omega[j] * v - omega[j] ** 2 * q
+                              - 1e3 * max(q - 1.0, 0.0) ** 1.5)
+            weight, slope = (0.5, k1) if stage == 0 else (0.75, k2)
+            for i in range(y.size):
+                stage_y[i] = y[i] + weight * h * slope[i]
+        for i in range(y.size):
+            y[i] += h * (2.0 * k1[i] + 3.0 * k2[i] + 4.0 * k3[i]) / 9.0
+        peak = max(peak, abs(y[0]))
+    return peak
+
+
+def compile_probe_s() -> float:
+    """Seconds this machine takes, now, to compile `_probe_kernel` afresh (never cached): its speed and load."""
+    import numba
+
+    started = time.perf_counter()
+    numba.njit(_probe_kernel)(np.zeros(4), np.ones(2), np.full(2, 0.01), np.ones(2), 1e-3, 2)
+    return time.perf_counter() - started
+
+
+def compile_estimate_s(laws: dict[str, list[str]], *, probe_s: float | None = None, cores: int | None = None) -> float:
+    """Estimated seconds to compile the kernels of the integrators `laws` names, each for its list of contact laws,
+    from COMPILE_S_QUIET scaled by this machine's speed against the quiet reference (`compile_probe_s` /
+    PROBE_S_QUIET). Integrators compile in parallel, one process each, while there are cores for them."""
+    scale = (compile_probe_s() if probe_s is None else probe_s) / PROBE_S_QUIET
+    each = [COMPILE_S_QUIET.get(name, max(COMPILE_S_QUIET.values())) * (1.0 + FURTHER_LAW_SHARE * (len(names) - 1))
+            for name, names in laws.items()]
+    cores = cores or os.cpu_count() or 1
+    return scale * max(max(each), sum(each) / min(cores, len(each)))
+
+
+def cached(name: str, law: str = "hertz") -> bool:
+    """Whether the kernel cache holds the integrator `name`'s kernels for the present sources (`sim.integration.jit`;
+    the laws share its files, so a law compiled for the first time is found out only by `warm_up`'s timer)."""
+    from sim.integration import jit
+
+    folder = jit.cache_folder()
+    stem = INTEGRATORS[name].module.rsplit(".", 1)[-1]
+    return folder is not None and any(folder.glob(f"{stem}.*.nbi"))
 
 
 def _run_tiny_system(run_step: RunStep, *, law: str = "hertz") -> None:
@@ -139,38 +199,55 @@ def _run_tiny_system(run_step: RunStep, *, law: str = "hertz") -> None:
             run_step(y, 3, 2.0 * np.pi * 100.0, 1e-5, sys, None, ledger=ledger)
 
 
+def _notice(what: str, estimate_s: float) -> str:
+    return (f"compiling {what} (once per version of the code on this machine; about {_duration(estimate_s)} here, "
+            "estimated from a test compilation) ...\n")
+
+
+def _duration(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 300 else f"{seconds / 60:.0f} min"
+
+
 @contextlib.contextmanager
-def _announced(what: str, minutes: float, stream: TextIO) -> Iterator[None]:
-    """Say, once NOTICE_AFTER_S have passed, that `what` is being compiled (about `minutes` min), and when done how
-    long it took; silent when it is quick (the kernels came from the cache)."""
-    def say_so() -> None:
-        stream.write(f"compiling {what} (first run only, about {minutes:g} min) ...\n")
+def _announced(what: str, laws: dict[str, list[str]], stream: TextIO) -> Iterator[None]:
+    """Say that `what` is being compiled and about how long it takes (`compile_estimate_s`): at once when the cache
+    lacks the kernels, else once NOTICE_AFTER_S have passed; when done, how long it took. Silent when it is quick (the
+    kernels came from the cache)."""
+    def say_so(estimate_s: float) -> None:
+        stream.write(_notice(what, estimate_s))
         stream.flush()
 
-    notice = threading.Timer(NOTICE_AFTER_S, say_so)
+    cold = not all(cached(name) for name in laws)
+    if cold:
+        say_so(compile_estimate_s(laws))
+    # unexpected (e.g. a law compiled for the first time): no test compilation while numba holds its lock; the quiet
+    # reference scaled by the load
+    load = os.getloadavg()[0] / (os.cpu_count() or 1) if hasattr(os, "getloadavg") else 1.0
+    notice = threading.Timer(NOTICE_AFTER_S, say_so, args=(compile_estimate_s(laws, probe_s=PROBE_S_QUIET * max(1.0, load)),))
     started = time.perf_counter()
-    notice.start()
+    if not cold:
+        notice.start()
     try:
         yield
     finally:
         notice.cancel()
     elapsed = time.perf_counter() - started
-    if elapsed > NOTICE_AFTER_S:
-        stream.write(f"kernels compiled in {elapsed:.0f} s; later runs load them from the cache\n")
+    if cold or elapsed > NOTICE_AFTER_S:
+        stream.write(f"kernels compiled in {elapsed:.0f} s; later runs load them from the cache (ies cache)\n")
 
 
 def warm_up(name: str, *, law: str = "hertz", stream: TextIO | None = None) -> float:
     """Compile (or load from numba's on-disk cache) the kernels of the integrator `name` in this process by one
     short run of a tiny system, before any timed or progress-reported work. When that takes longer than
-    NOTICE_AFTER_S (a cold cache), one line ``compiling ... kernels (first run only, about N min) ...`` goes to
-    `stream` (stderr) while it happens, and one line with the time when it is done. Returns the seconds spent
+    NOTICE_AFTER_S (a cold cache), one line ``compiling ... (once per version of the code on this machine; about N s
+    here ...) ...`` goes to `stream` (stderr) while it happens, and one line with the time when it is done. Returns the seconds spent
     (0 when this process has warmed the integrator with this law before). law: the run's contact law (its name in
     `sim.model.contact_law.LAWS`; the kernels are compiled per law)."""
     if (name, law) in _WARM:
         return 0.0
     run_step = get_integrator(name)
     started = time.perf_counter()
-    with _announced(f"the {name} integrator's kernels", COMPILE_MINUTES.get(name, 2), stream or _sys.stderr):
+    with _announced(f"the {name} integrator's kernels", {name: [law]}, stream or _sys.stderr):
         _run_tiny_system(run_step, law=law)
     _WARM.add((name, law))
     return time.perf_counter() - started
@@ -193,7 +270,7 @@ def warm_up_all(pairs: Iterable[tuple[str, str]], *, stream: TextIO | None = Non
     laws: dict[str, list[str]] = {}
     for name, law in pending:
         laws.setdefault(name, []).append(law)
-    with _announced(f"the kernels of {', '.join(laws)}", max(COMPILE_MINUTES.get(n, 2) for n in laws), stream):
+    with _announced(f"the kernels of {', '.join(laws)}", laws, stream):
         if len(laws) > 1 and (os.cpu_count() or 1) > 1:
             for name in laws:
                 get_integrator(name)  # imports the kernels: a stale cache is discarded here, once (`sim.integration.jit`)

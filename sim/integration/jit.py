@@ -1,19 +1,19 @@
 """The numba kernels of `sim` and their on-disk cache.
 
-numba caches a compiled function in a cache folder (sim/__pycache__ in the source tree) and keys it on its
-own source file alone (modification time and size). The integrators' kernels call and inline kernels of
-other files: the period loop of `sim.integration.exact` embeds `sim.integration.collocation`, `sim.integration.dopri5` and `sim.integration.flight`. After an
-edit of a callee file, numba would still load the caller's machine code with the old callee compiled in.
+numba keys a cached kernel on its own source file alone. The integrators' kernels call and inline kernels of
+other files: the period loop of `sim.integration.exact` embeds `sim.integration.collocation`,
+`sim.integration.dopri5` and `sim.integration.flight`, and every integrator inlines the contact laws. After an edit
+of a callee file numba would still load the caller's machine code with the old callee compiled in.
 
-`kernel` is ``numba.njit(cache=True)`` with one addition: when it compiles the first kernel of a process it
-compares a fingerprint of the sources of all KERNEL_MODULES (SHA-256 of their contents) with the one stored
-in numba's cache folder for them (`Dispatcher.stats.cache_path`) and, if they differ, deletes the cached
-kernels of these modules before anything is loaded; numba then compiles them afresh and the new fingerprint
-is stored. So any edit of any kernel file invalidates every kernel that could embed it.
+`kernel` is ``numba.njit`` with its cache in the workbench's kernel cache (`sim.common.kernel_cache`: a per-user
+folder, never the installed package) under the group ``sim`` and a fingerprint of the sources of all
+KERNEL_MODULES and FINGERPRINT_FILES (SHA-256 of their contents): any edit of any kernel file gives every kernel
+that could embed it a new folder, and the same sources find their machine code again wherever they are installed
+(a reinstall compiles nothing).
 
 Why this design and not kernels that never call another file's kernels: the state layout, the free-flight
 transitions and the closing functions are written once (`sim.integration.flight`) and shared by the exact integrator,
-its two contact methods and, with the energy bookkeeping and the new contact laws to come, by more kernels.
+its two contact methods and, with the energy bookkeeping and the contact laws, by more kernels.
 One fingerprint over a handful of files costs a fraction of a millisecond per process.
 
 Reference counts. numba counts the references to every array a kernel is handed or slices (an atomic
@@ -35,47 +35,41 @@ it with reference counts (correct, some percent slower in the exact integrator) 
 
 The contact laws (`sim.model.contact_law`) are compiled inlined into the kernels, per law: their file is part of
 the fingerprint (`FINGERPRINT_FILES`).
-
-Where the cache folder cannot be written to (a read-only install: numba then uses its user cache folder;
-NUMBA_CACHE_DIR if set), nothing is deleted and numba itself decides (an install brings new files with new
-modification times, which numba's own key already catches). A process that was started before an edit and
-compiles a kernel after it still writes machine code for the sources it imported; restart such processes.
 """
 from __future__ import annotations
 
-import hashlib
-import os
+import functools
 import sys
 from pathlib import Path
 from typing import Callable
 
 import numba
 
+from sim.common.kernel_cache import cache_in_folder, sources_hash, version_folder
+
 #: Modules of `sim` (file stems) whose numba kernels are compiled with `kernel`; they may embed each other.
 KERNEL_MODULES = ("jit", "flight", "dopri5", "collocation", "exact", "ode3")
-#: Name of the file in the cache folder that holds the fingerprint the cached kernels were compiled from.
-FINGERPRINT_FILE = "sim-kernels.sha256"
+#: the group of these kernels in the kernel cache (`sim.common.kernel_cache`)
+CACHE_GROUP = "sim"
 
 _SOURCE_DIR = Path(__file__).resolve().parent
 #: Sources inlined into the kernels without kernels (cached files) of their own: the contact laws.
 FINGERPRINT_FILES = (_SOURCE_DIR.parent / "model" / "contact_law.py",)
-_checked_folders: set[str] = set()
 #: The message `kernel` writes (once) when numba refuses the `_nrt` option.
 NRT_FALLBACK_NOTICE = ("numba {version} does not take the option _nrt: the kernels of sim are compiled with "
                        "reference counts (correct, somewhat slower)\n")
 _fallback_said = False
 
 
+@functools.lru_cache(maxsize=None)
 def fingerprint() -> str:
     """SHA-256 (hex) of the names and contents of the source files of KERNEL_MODULES and FINGERPRINT_FILES."""
-    digest = hashlib.sha256()
-    for stem in KERNEL_MODULES:
-        digest.update(stem.encode() + b"\0")
-        digest.update((_SOURCE_DIR / f"{stem}.py").read_bytes())
-    for path in FINGERPRINT_FILES:
-        digest.update(path.name.encode() + b"\0")
-        digest.update(path.read_bytes())
-    return digest.hexdigest()
+    return sources_hash([*(_SOURCE_DIR / f"{stem}.py" for stem in KERNEL_MODULES), *FINGERPRINT_FILES])
+
+
+def cache_folder() -> Path | None:
+    """The folder of these sources' kernels in the kernel cache (None where no folder can be written)."""
+    return version_folder(CACHE_GROUP, fingerprint())
 
 
 def nrt_option_supported() -> bool:
@@ -87,39 +81,10 @@ def nrt_option_supported() -> bool:
     return hasattr(CPUTargetOptions, "_nrt")
 
 
-def discard_stale_kernels(cache_folder: str | os.PathLike) -> bool:
-    """Delete the cached kernels of KERNEL_MODULES in `cache_folder` if they were compiled from other sources.
-
-    Returns True if the folder's fingerprint did not match (kernels deleted, new fingerprint written). A folder
-    that cannot be read or written is left alone (numba cannot cache there either).
-    """
-    folder = Path(cache_folder)
-    stamp = folder / FINGERPRINT_FILE
-    current = fingerprint()
-    try:
-        if stamp.read_text() == current:
-            return False
-    except OSError:
-        pass  # no fingerprint yet: whatever is cached there is of unknown origin
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        for stem in KERNEL_MODULES:
-            for path in [*folder.glob(f"{stem}.*.nbi"), *folder.glob(f"{stem}.*.nbc")]:
-                path.unlink(missing_ok=True)
-        partial = folder / f"{FINGERPRINT_FILE}.{os.getpid()}.tmp"
-        partial.write_text(current)
-        os.replace(partial, stamp)  # atomic: concurrent processes read either fingerprint, never half of one
-    except OSError:
-        return False
-    return True
-
-
 def kernel(function: Callable | None = None, *, refcounts: bool | None = None, **options) -> Callable:
-    """``numba.njit(cache=True, **options)`` whose cache is discarded when any kernel source changed.
+    """``numba.njit(**options)`` cached in the kernel cache's folder of the current kernel sources (`cache_folder`).
 
-    Use as ``@kernel`` or ``@kernel(inline="always", fastmath=...)``. The check runs once per process and
-    cache folder, before the first kernel of that folder is compiled or loaded (numba loads lazily, at the
-    first call, so checking at decoration time is early enough).
+    Use as ``@kernel`` or ``@kernel(inline="always", fastmath=...)``.
 
     refcounts: False compiles the kernel, and every kernel it calls that does not say otherwise, without
     numba's reference counts (see the module docstring: such kernels may not allocate, copy slices or hand
@@ -136,11 +101,6 @@ def kernel(function: Callable | None = None, *, refcounts: bool | None = None, *
             sys.stderr.write(NRT_FALLBACK_NOTICE.format(version=numba.__version__))
 
     def decorate(py_function: Callable) -> Callable:
-        dispatcher = numba.njit(cache=True, **options)(py_function)
-        folder = dispatcher.stats.cache_path
-        if folder not in _checked_folders:
-            _checked_folders.add(folder)
-            discard_stale_kernels(folder)
-        return dispatcher
+        return cache_in_folder(numba.njit(**options)(py_function), CACHE_GROUP, fingerprint())
 
     return decorate if function is None else decorate(function)

@@ -48,13 +48,15 @@ REGIME_SHADING = {"APR": {"facecolor": "0.9", "label": "APR levels (almost perio
                              "label": "linear levels (no impacts)"}}
 
 
-def shade_regimes(ax: Any, levels: Sequence[float], regimes: Sequence[str]) -> None:
+def shade_regimes(ax: Any, levels: Sequence[float], regimes: Sequence[str]) -> dict[str, list[tuple[float, float]]]:
     """Shade the excitation levels of each regime (REGIME_SHADING) behind the data of a level plot: a level's
-    span reaches half way to its neighbours (half the nearest spacing beyond the first and last level)."""
+    span reaches half way to its neighbours (half the nearest spacing beyond the first and last level). Returns the
+    spans (from, to) of each regime, shaded or not."""
     import numpy as np
 
+    spans: dict[str, list[tuple[float, float]]] = {}
     if not len(levels):
-        return
+        return spans
     order = np.argsort(np.asarray(levels, dtype=float))
     x = np.asarray(levels, dtype=float)[order]
     kinds = [str(regimes[i]) for i in order]
@@ -66,13 +68,16 @@ def shade_regimes(ax: Any, levels: Sequence[float], regimes: Sequence[str]) -> N
         j = i
         while j + 1 < x.size and kinds[j + 1] == kinds[i]:
             j += 1
+        spans.setdefault(kinds[i], []).append((float(edges[i]), float(edges[j + 1])))
         style = REGIME_SHADING.get(kinds[i])
         if style is not None:
             style = dict(style)
             label = style.pop("label")
-            ax.axvspan(edges[i], edges[j + 1], lw=0, zorder=0, label=None if kinds[i] in labelled else label, **style)
+            ax.axvspan(edges[i], edges[j + 1], lw=0, zorder=0, label=None if kinds[i] in labelled else label,
+                       gid=f"regime:{kinds[i]}", **style)
             labelled.add(kinds[i])
         i = j + 1
+    return spans
 
 
 def tip_mm_per_level(model: Any) -> float:
@@ -166,36 +171,51 @@ def draw_overview(ax: Any, data: Mapping[str, Any], title: str, *, paper_optimum
 
     levels = np.asarray(data["levels"], dtype=float)
     shade_regimes(ax, levels, data["regime"])
-    for name, style, color in (("max", "s--", "C3"), ("mean", "o-", "C0")):
+    tops = []
+    step = float(np.min(np.diff(np.unique(levels)))) if np.unique(levels).size > 1 else 1.0
+    for side, (name, style, color) in zip((-1, 1), (("max", "s--", "C3"), ("mean", "o-", "C0"))):
         value = np.asarray(data[f"resonant_{name}"], dtype=float)
         spread = [value - np.asarray(data[f"resonant_{name}_lo"], dtype=float),
                   np.asarray(data[f"resonant_{name}_hi"], dtype=float) - value]
-        ax.errorbar(levels, value, yerr=spread, fmt=style, color=color, ms=4, capsize=2, lw=1.2,
+        # max and mean a little apart (an eighth of the closest levels' spacing): the bars of an SMR level overlap
+        ax.errorbar(levels + side * step / 8, value, yerr=spread, fmt=style, color=color, ms=4, capsize=2, lw=1.2,
                     label=f"resonant {name} (bars: range of the runs)")
+        tops.append(np.fmax(value, np.asarray(data[f"resonant_{name}_hi"], dtype=float)))
+    top_of_data = np.nanmax(tops, axis=0)
+    y_top = 1.3 * max([float(np.nanmax(top_of_data)),
+                       *((PAPER_APR_LEVEL[1], 1 / PAPER_REDUCTION_MAX) if paper_optimum else ())])
+
+    def marker_line(x: float, **style: Any) -> None:
+        """A vertical line at level x from above the data there (never through its error bars) to the top."""
+        near = np.abs(levels - x) < 0.5 * step
+        start = 1.08 * float(np.nanmax(top_of_data[near])) if near.any() else 0.0
+        ax.plot([x, x], [start, y_top], **style)
+
     best = int(np.argmin(data["resonant_mean"]))
-    ax.axvline(levels[best], color="C2", lw=1.2, ls=":",
-               label=f"optimum of this model at {levels[best]:g}: mean reduced "
-                     f"{_reduction(data['resonant_mean'][best])}, max {_reduction(data['resonant_max'][best])}")
+    marker_line(levels[best], color="C2", lw=1.2, ls=":",
+                label=f"optimum of this model at {levels[best]:g}: mean reduced "
+                      f"{_reduction(data['resonant_mean'][best])}, max {_reduction(data['resonant_max'][best])}")
     if paper_optimum:
-        draw_paper_landmarks(ax)
+        draw_paper_landmarks(ax, marker_line)
+    ax.set_ylim(0, y_top)
     ax.set_xlabel(LEVEL_LABEL)
     ax.set_ylabel(f"resonant level {RESPONSE_LABEL}")
-    ax.set_ylim(bottom=0)
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
 
 
-def draw_paper_landmarks(ax: Any) -> None:
+def draw_paper_landmarks(ax: Any, vertical_line: Any = None) -> None:
     """The paper's Fig. 6 landmarks on `ax`: its optimum (a_base/a_base* ~ 6.7, a vertical line, with its mean and
-    max levels as stars, Sect. 5.3) and its almost periodic level at 7.4 (a grey box, Appendix B)."""
+    max levels as stars, Sect. 5.3) and its almost periodic level at 7.4 (a grey box, Appendix B). vertical_line(x,
+    **style): how to draw the optimum's line (default: across the axes)."""
     from matplotlib.patches import Rectangle
 
-    ax.axvline(PAPER_OPTIMUM_LEVEL, color="k", lw=1, ls="-.", alpha=0.6,
-               label=f"paper's optimum at {PAPER_OPTIMUM_LEVEL:g} (stars): mean reduced {PAPER_REDUCTION_MEAN:g}-fold, "
-                     f"max {PAPER_REDUCTION_MAX:g}-fold")
+    (vertical_line or ax.axvline)(PAPER_OPTIMUM_LEVEL, color="k", lw=1, ls="-.", alpha=0.6,
+                                  label=f"paper's optimum at {PAPER_OPTIMUM_LEVEL:g} (stars): mean reduced "
+                                        f"{PAPER_REDUCTION_MEAN:g}-fold, max {PAPER_REDUCTION_MAX:g}-fold")
     ax.plot([PAPER_OPTIMUM_LEVEL] * 2, [1 / PAPER_REDUCTION_MEAN, 1 / PAPER_REDUCTION_MAX], "k*", ms=8)
     ax.add_patch(Rectangle((7.2, PAPER_APR_LEVEL[0]), 0.4, PAPER_APR_LEVEL[1] - PAPER_APR_LEVEL[0],
-                           facecolor="0.6", alpha=0.5, hatch="xx",
+                           facecolor="0.6", alpha=0.5, hatch="////",
                            label=f"paper's almost periodic level at 7.4 ({PAPER_APR_LEVEL[0]:g}-"
                                  f"{PAPER_APR_LEVEL[1]:g}, App. B)"))
 
@@ -221,21 +241,37 @@ def plot_series(series: Sequence[tuple[str, Mapping[str, Any]]], path: str | os.
     landmarks (draw_paper_landmarks; `ies compare`); mm_per_level: the factor to the tip amplitude (`tip_note`)."""
     import numpy as np
 
-    with plot_to(path, figsize=(9.5, 4.4)) as (fig, ax):
+    with plot_to(path, figsize=(11.0, 4.4)) as (fig, ax):  # wide: the series side by side at each level
+        every = np.unique(np.concatenate([np.asarray(data["levels"], dtype=float) for _, data in series]))
+        span = float(every[-1] - every[0]) if every.size > 1 else 1.0
+        closest = float(np.min(np.diff(every))) if every.size > 1 else 1.0
+        tops: list[tuple[float, float]] = []
         for i, (label, data) in enumerate(series):
             levels = np.asarray(data["levels"], dtype=float)
             value = np.asarray(data["resonant_mean"], dtype=float)
             spread = [value - np.asarray(data["resonant_mean_lo"], dtype=float),
                       np.asarray(data["resonant_mean_hi"], dtype=float) - value]
-            # markers and line styles tell apart curves of one colour (and in grayscale)
+            # markers and line styles tell apart curves of one colour (and in grayscale); each series a little
+            # beside the others (1 % of the level range apart, the group within 90 % of the closest levels' spacing),
+            # so that no error bar hides another's
             fmt = "osD^v<>ph*"[i % 10] + ("-", "--", ":", "-.")[i % 4]
-            ax.errorbar(levels, value, yerr=spread, fmt=fmt, ms=4, mfc="none" if i % 2 else None, capsize=2, lw=1.2,
+            x = levels + (i - (len(series) - 1) / 2) * min(0.01 * span, 0.9 * closest / len(series))
+            ax.errorbar(x, value, yerr=spread, fmt=fmt, ms=4, mfc="none" if i % 2 else None, capsize=2, lw=1.2,
                         label=label)
+            tops += [(float(at), float(top)) for at, top in zip(x, np.nan_to_num(np.fmax(value, value + spread[1])))]
+        y_top = 1.3 * max([top for _, top in tops] + ([PAPER_APR_LEVEL[1], 1 / PAPER_REDUCTION_MAX]
+                                                      if paper_landmarks else []), default=1.0)
+
+        def above_the_data(x: float, **style: Any) -> None:
+            """A vertical line at level x from above the error bars near it to the top (never through a bar)."""
+            start = 1.08 * max((top for at, top in tops if abs(at - x) < 0.06 * span), default=0.0)
+            ax.plot([x, x], [start, y_top], **style)
+
         if paper_line is not None:
-            ax.axvline(paper_line[0], color="k", lw=1, ls="-.", alpha=0.6, label=paper_line[1])
+            above_the_data(paper_line[0], color="k", lw=1, ls="-.", alpha=0.6, label=paper_line[1])
         if paper_landmarks:
-            draw_paper_landmarks(ax)
-            ax.set_ylim(bottom=0)
+            draw_paper_landmarks(ax, above_the_data)
+        ax.set_ylim(0, y_top)
         ax.set_xlabel(LEVEL_LABEL)
         ax.set_ylabel(f"resonant mean {RESPONSE_LABEL}")
         ax.set_title(title, fontsize=9)
@@ -270,8 +306,7 @@ def plot_scattering(overview: Mapping[str, Any], runs: Sequence[Mapping[str, Any
         keep = np.array([regime == "APR" for regime in overview["regime"]])
     step = float(np.min(np.diff(np.unique(levels)))) if np.unique(levels).size > 1 else 1.0
     with plot_to(path, figsize=(9.0, 4.4)) as (fig, ax):
-        if measure == "impacts":
-            shade_regimes(ax, levels, overview["regime"])
+        spans = shade_regimes(ax, levels, overview["regime"]) if measure == "impacts" else {}
         for k, (key, label, style, color, face) in enumerate(curves):
             value = np.asarray(overview[key], dtype=float)[keep]
             # figD3: the two estimates side by side at each level, so that neither hides the other's bar
@@ -289,8 +324,10 @@ def plot_scattering(overview: Mapping[str, Any], runs: Sequence[Mapping[str, Any
         if measure == "restitution":
             ax.axhline(0.8, color="k", lw=1, ls="-.", alpha=0.6, label="paper: $r$ ~ 0.8 (Fig. D.3)")
             ax.axhline(1.0, color="k", lw=0.8, alpha=0.3, label="$r$ = 1: elastic")
-        else:
-            ax.axhline(2.0, color="k", lw=1, ls="-.", alpha=0.6, label="paper: 2 per period in APR (Fig. D.2)")
+        else:  # the paper's statement is about the almost periodic levels: drawn over those only
+            for k, (start, stop) in enumerate(spans.get("APR", [])):
+                ax.plot([start, stop], [2.0, 2.0], color="k", lw=1, ls="-.", alpha=0.6,
+                        label="paper: 2 per period in APR (Fig. D.2)" if k == 0 else None)
         ax.set_xlabel(LEVEL_LABEL)
         ax.set_ylabel(ylabel)
         ax.set_ylim(bottom=0)

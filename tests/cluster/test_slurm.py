@@ -13,6 +13,9 @@ import pytest
 
 from uq.cli import main
 
+# one test SLURM per module (its fixture): under pytest-xdist all of the module's tests go to one worker
+pytestmark = pytest.mark.xdist_group("slurm")
+
 STUDY = """
 [study]
 name = "tiny-sobol"

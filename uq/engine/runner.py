@@ -12,11 +12,13 @@ same study gives identical numbers serially, with `--jobs N` and on Dask.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import logging
 import math
 import os
+import signal
 import sys
 import time
 from contextlib import contextmanager
@@ -277,6 +279,34 @@ def _run_and_store(model: Callable, pending: list[tuple[str, Task]], seed: int, 
                          "and rerun the same command with --resume") from None
 
 
+def _start_workers_deaf_to_ctrl_c() -> None:
+    """Have loky (joblib's local processes) start its workers with SIGINT blocked, as loky starts its own resource
+    tracker: the signal mask survives fork and exec, so a Ctrl-C in the terminal reaches only this process, which
+    stops the pool (its workers end by SIGTERM) and prints one line (`uq.cli`). Without it every worker that is still
+    importing when Ctrl-C comes prints its own traceback (13 of them, 220 lines, with --jobs 99 on 2 cores).
+    Installed once per process around loky's one call that starts a worker (`fork_exec`, right at the spawn: the
+    standard library's resource tracker unblocks SIGINT on its way there); where it or `pthread_sigmask` is missing,
+    nothing changes."""
+    try:
+        from joblib.externals.loky.backend import fork_exec as module
+    except ImportError:
+        return
+    spawn = getattr(module, "fork_exec", None)
+    if spawn is None or getattr(spawn, "sigint_blocked", False) or not hasattr(signal, "pthread_sigmask"):
+        return
+
+    @functools.wraps(spawn)
+    def spawn_deaf(*args: Any, **kwargs: Any) -> Any:
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            return spawn(*args, **kwargs)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, previous)  # a Ctrl-C meanwhile is delivered here, now
+
+    spawn_deaf.sigint_blocked = True
+    module.fork_exec = spawn_deaf
+
+
 def _dispatch(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int,
               client: Any) -> Iterable[tuple[str, Task, dict]]:
     """(key, task, result) of every pending task as it finishes: in this process (jobs 1, no client), in `jobs`
@@ -312,6 +342,7 @@ def _dispatch(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs:
         return
     from joblib import Parallel, delayed
 
+    _start_workers_deaf_to_ctrl_c()
     calls = (delayed(_run_one)(model, key, task, seed) for key, task in pending)
     for key, result in Parallel(n_jobs=jobs, return_as="generator_unordered", batch_size=1)(calls):
         yield key, by_key[key], result

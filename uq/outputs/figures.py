@@ -23,7 +23,7 @@ import json
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -137,10 +137,13 @@ def _errorbar(ax: Any, x: np.ndarray, y: np.ndarray, se: np.ndarray, fmt: str, *
 
 
 def _band_with_noise(ax: Any, band: dict, color: str, alpha: float, label: str, *, hatch: str | None = None,
-                     discrete: bool = False, offset: float = 0.0, width: float = 0.0) -> None:
+                     discrete: bool = False, offset: float = 0.0, width: float = 0.0,
+                     curves: Sequence[tuple[np.ndarray, np.ndarray]] = ()) -> None:
     """The band (shaded, or hatched and unfilled with `hatch` so that a band beneath stays visible) and the
     standard errors of its edges (bars at both edges). discrete: one box per level (width in level units, shifted
-    by offset), no band drawn between levels."""
+    by offset), no band drawn between levels. curves: (levels, values) of the curves drawn with their own error bars
+    at the same levels: where an edge is one of them (a corner or the nominal at a bound) its bar is theirs, not drawn
+    twice."""
     x = band["level"] + offset
     fill = {"facecolor": "none", "edgecolor": color, "hatch": hatch, "lw": 0.8} if hatch else \
         {"color": color, "alpha": alpha, "lw": 0}
@@ -150,7 +153,12 @@ def _band_with_noise(ax: Any, band: dict, color: str, alpha: float, label: str, 
         ax.fill_between(x, band["lower"], band["upper"], label=label, **fill)
     at = x - 0.3 * width if discrete else x  # a box's edge errors off its centre, where the nominal point sits
     for edge in ("lower", "upper"):
-        ax.errorbar(at, band[edge], yerr=np.nan_to_num(band[f"{edge}_se"], nan=0.0), fmt="none",
+        own = np.ones(band["level"].size, dtype=bool)
+        for levels, values in curves:
+            at_level = dict(zip(np.round(levels, 9), values))
+            own &= ~np.array([np.isclose(at_level.get(round(lv, 9), np.nan), v, rtol=1e-12, atol=0.0)
+                              for lv, v in zip(band["level"], band[edge])])
+        ax.errorbar(at[own], band[edge][own], yerr=np.nan_to_num(band[f"{edge}_se"][own], nan=0.0), fmt="none",
                     ecolor=color, elinewidth=0.8, capsize=2, alpha=0.9)
 
 
@@ -234,17 +242,23 @@ def interval_figures(folder: str | Path, options: PlotOptions | None = None, *, 
             if not discrete:
                 shade_regimes(ax, list(regimes), list(regimes.values()))
             width = 0.3 * _level_step(band["level"])
-            _band_with_noise(ax, band, "C0", 0.2, "band (± SE of its edges)", discrete=discrete, width=width)
-            # the nominal first and thin, so that a corner at the nominal value stays visible above it
-            _errorbar(ax, *nominal, "--" if not discrete else "D", color="k", lw=1.0, ms=3, zorder=2,
-                      label=parameter_text(pname, params[pname]["nominal"], star=True) + " (nominal)"
-                      if pname in params else "nominal")
             corners = sorted({r["point"] for r in points if r["design"] == d and r["role"] == "corner"},
                              key=_corner_value)
-            for label, marker, style, color in ((corners[0], "v", ":", "C0"), (corners[-1], "^", "-", "C3")):
-                text = parameter_text(pname, _corner_value(label))
-                _errorbar(ax, *_curve(points, d, label, output), marker + ("" if discrete else style), color=color,
-                          mfc="none", ms=6, zorder=3, label=text)
+            value = params.get(pname, {}).get("nominal")
+            # a corner at the nominal value is the nominal curve: drawn and listed once, as the nominal at that end
+            ends = [(label, marker, style, color, end) for (label, marker, style, color, end) in
+                    ((corners[0], "v", ":", "C0", "lower"), (corners[-1], "^", "-", "C3", "upper"))
+                    if value is None or not np.isclose(_corner_value(label), value, rtol=1e-6)]
+            at_end = [end for end in ("lower", "upper") if end not in {e[-1] for e in ends}]
+            curves = [_curve(points, d, label, output) for label, *_ in ends]
+            _band_with_noise(ax, band, "C0", 0.2, "band (± SE of its edges)", discrete=discrete, width=width,
+                             curves=[(c[0], c[1]) for c in [nominal, *curves]])
+            _errorbar(ax, *nominal, "--" if not discrete else "D", color="k", lw=1.4 if at_end else 1.0, ms=3, zorder=4,
+                      label=(parameter_text(pname, value, star=True) + " (nominal"
+                             + "".join(f", {end} end" for end in at_end) + ")") if pname in params else "nominal")
+            for (label, marker, style, color, _), curve in zip(ends, curves):
+                _errorbar(ax, *curve, marker + ("" if discrete else style), color=color, mfc="none", ms=6, zorder=3,
+                          label=parameter_text(pname, _corner_value(label)))
             _marks(ax, band)
             ax.set_title(parameter_title(pname, params.get(pname, {})), fontsize=9)
             ax.set_xlabel(LEVEL_LABEL)
@@ -328,6 +342,11 @@ def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list
     meta = _study(folder) if (folder / "study.json").is_file() else {}
     n = meta.get("study", {}).get("sobol", {}).get("n")
     outputs = list(dict.fromkeys(r["output"] for r in rows))
+    # the surrogate's verdict (surrogate.csv): a level whose response is NOT SMOOTH has unreliable indices, drawn as
+    # outlines only (and said so in the legend), never like the valid ones
+    rough = {(r["output"], float(r["level"])) for r in (_rows(folder / "surrogate.csv")
+                                                        if (folder / "surrogate.csv").is_file() else [])
+             if r.get("smooth") == "0"}
     fig, axes = plt.subplots(1, len(outputs), figsize=(5.5 * len(outputs) + 3.0, 4.0), squeeze=False,
                              layout="constrained")
     lo, hi = _SOBOL_RANGE
@@ -345,9 +364,15 @@ def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list
                 errs = np.array([float(r[f"{idx}_conf"]) for r in pr])
                 at = x + (2 * k + m - len(names)) * width + width / 2
                 # the whiskers end at the axis edge where they would run on (marked there by a triangle)
-                shown = [np.clip(np.minimum(errs, vals - lo), 0, None), np.clip(np.minimum(errs, hi - vals), 0, None)]
-                ax.bar(at, vals, width, yerr=shown, hatch=hatch, color=f"C{k}", alpha=0.8 if m == 0 else 0.45,
-                       edgecolor=f"C{k}", label=f"{idx} {pname}", capsize=2)
+                shown = np.array([np.clip(np.minimum(errs, vals - lo), 0, None),
+                                  np.clip(np.minimum(errs, hi - vals), 0, None)])
+                valid = np.array([(o, lv) not in rough for lv in levels])
+                ax.bar(at[valid], vals[valid], width, yerr=shown[:, valid], hatch=hatch, color=f"C{k}",
+                       alpha=0.8 if m == 0 else 0.45, edgecolor=f"C{k}", label=f"{idx} {pname}", capsize=2)
+                if (~valid).any():  # no whiskers: a confidence interval of an unreliable index would mislead
+                    ax.bar(at[~valid], vals[~valid], width, fill=False, hatch="xx", edgecolor="0.5", lw=0.8,
+                           label="NOT SMOOTH: index unreliable\n(use Saltelli's sampling there)"
+                           if k == m == 0 else None)
                 for edge, marker, out_of in ((hi, "^", vals + errs > hi), (lo, "v", vals - errs < lo)):
                     if out_of.any():
                         beyond = True

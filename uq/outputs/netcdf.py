@@ -19,6 +19,7 @@ compression, which scipy's NetCDF-3 writer lacks. The file is written under a te
 """
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -219,11 +220,25 @@ def finish(ds: Any, study: Any, model: Any, folder: Path, extra: Mapping[str, An
 
 
 def open_results(folder: str | Path) -> Any:
-    """The Dataset of folder/results.nc, read into memory (the file is closed); a one-line StudyError when the
-    folder has none (see `uq.outputs.results.open_study`)."""
+    """The Dataset of folder/results.nc (or of the .nc file `folder` names), read into memory (the file is closed).
+    One-line StudyErrors: a path that does not exist, a folder without results.nc, a file that cannot be read (damaged
+    or cut short: rewritten by rerunning the study with --resume, which recomputes nothing). See
+    `uq.outputs.results.open_study`."""
     import xarray as xr
 
-    path = Path(folder) / "results.nc"
+    folder = Path(folder)
+    if not folder.exists():
+        raise StudyError(f"{folder} does not exist; give the output folder (--out) of ies interval, sobol, response "
+                         "or design, or a figure folder of ies reproduce")
+    path = folder if folder.is_file() else folder / "results.nc"
     if not path.is_file():
-        raise StudyError(f"{folder} holds no results.nc; give the output folder of ies interval, sobol or response")
-    return xr.load_dataset(path, engine=ENGINE)
+        raise StudyError(f"{folder} holds no results.nc; give the output folder of ies interval, sobol, response or "
+                         "design, or a figure folder of ies reproduce")
+    try:
+        return xr.load_dataset(path, engine=ENGINE)
+    except (OSError, ValueError, KeyError, RuntimeError) as exc:
+        detail = re.search(r"\(([^()]*)\)\s*$", str(exc))
+        reason = detail.group(1) if detail else (str(exc).splitlines() or [type(exc).__name__])[0]
+        raise StudyError(f"{path} cannot be read ({reason}: damaged or cut short); rerun the study's command with "
+                         f"--resume and --out {path.parent} to write it again from the stored runs, or redraw the "
+                         f"figures from the CSV tables with ies plot {path.parent}") from None

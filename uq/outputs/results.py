@@ -263,7 +263,8 @@ def open_study(folder: str | Path) -> xarray.Dataset:
         >>> ds["mean_ST"].sel(level=6.7).to_series()            # doctest: +SKIP
         >>> ds["mean"].mean("repetition").plot.scatter(x="g")   # doctest: +SKIP
 
-    A folder without results.nc (not a study's output) is a one-line `StudyError`.
+    A path that does not exist, a folder without results.nc (not a study's output) and a results.nc that cannot be
+    read (damaged or cut short) are each a one-line `StudyError` saying what to do.
     """
     from uq.outputs.netcdf import open_results
 

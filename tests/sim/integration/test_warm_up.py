@@ -1,6 +1,7 @@
 """sim.integration.integrators.warm_up: the kernels are compiled before a progress bar starts, and a slow (first) compilation
 says so while it happens."""
 import io
+import re
 import time
 
 import numpy as np
@@ -15,6 +16,7 @@ def fresh(monkeypatch):
 
 
 def test_a_slow_warm_up_says_that_it_compiles_while_it_happens(monkeypatch):
+    """Kernels the cache seemed to hold but that compile all the same: the notice comes after NOTICE_AFTER_S."""
     said_during = []
     stream = io.StringIO()
 
@@ -23,17 +25,53 @@ def test_a_slow_warm_up_says_that_it_compiles_while_it_happens(monkeypatch):
         said_during.append(stream.getvalue())
 
     monkeypatch.setattr(integrators, "NOTICE_AFTER_S", 0.1)
+    monkeypatch.setattr(integrators, "cached", lambda name, law="hertz": True)
     monkeypatch.setattr(integrators, "_run_tiny_system", lambda run_step, law: slow_compile(run_step))
     assert integrators.warm_up("exact", stream=stream) >= 0.5
-    assert said_during == ["compiling the exact integrator's kernels (first run only, about "
-                           f"{integrators.COMPILE_MINUTES['exact']} min) ...\n"]
+    (notice,) = said_during
+    assert re.fullmatch(r"compiling the exact integrator's kernels \(once per version of the code on this machine; "
+                        r"about \d+ (s|min) here, estimated from a test compilation\) \.\.\.\n", notice)
     assert stream.getvalue().splitlines()[-1].startswith("kernels compiled in ")
     assert integrators.warm_up("exact", stream=stream) == 0.0  # once per process
+
+
+def test_a_cold_cache_says_so_at_once_with_a_measured_estimate(monkeypatch):
+    """Kernels missing from the cache: the line comes before the compilation, its estimate from a test compilation
+    on this machine (twice as slow as the quiet reference: twice the reference time)."""
+    stream = io.StringIO()
+    said_before = []
+    monkeypatch.setattr(integrators, "cached", lambda name, law="hertz": False)
+    monkeypatch.setattr(integrators, "compile_probe_s", lambda: 2.0 * integrators.PROBE_S_QUIET)
+    monkeypatch.setattr(integrators, "_run_tiny_system", lambda run_step, law: said_before.append(stream.getvalue()))
+    integrators.warm_up("ode3", stream=stream)
+    expected = 2.0 * integrators.COMPILE_S_QUIET["ode3"]
+    assert said_before == [integrators._notice("the ode3 integrator's kernels", expected)]
+    assert f"about {expected:.0f} s here" in said_before[0]
+    assert stream.getvalue().splitlines()[-1].startswith("kernels compiled in ")
+
+
+def test_the_estimate_adds_laws_and_shares_the_cores():
+    reference = integrators.COMPILE_S_QUIET
+    one = integrators.compile_estimate_s({"exact": ["hertz"]}, probe_s=integrators.PROBE_S_QUIET)
+    assert one == pytest.approx(reference["exact"])
+    two_laws = integrators.compile_estimate_s({"exact": ["hertz", "hertz-damped"]}, probe_s=integrators.PROBE_S_QUIET)
+    assert two_laws == pytest.approx(reference["exact"] * (1 + integrators.FURTHER_LAW_SHARE))
+    both = {"exact": ["hertz"], "ode3": ["hertz"]}
+    assert integrators.compile_estimate_s(both, probe_s=integrators.PROBE_S_QUIET, cores=2) == pytest.approx(
+        reference["exact"])  # in parallel
+    assert integrators.compile_estimate_s(both, probe_s=integrators.PROBE_S_QUIET, cores=1) == pytest.approx(
+        reference["exact"] + reference["ode3"])
+
+
+def test_the_probe_compiles_afresh_each_time():
+    """The test compilation must not come from any cache, or it would measure nothing."""
+    assert integrators.compile_probe_s() > 0.02 and integrators.compile_probe_s() > 0.02
 
 
 def test_a_quick_warm_up_is_silent(monkeypatch):
     stream = io.StringIO()
     calls = []
+    monkeypatch.setattr(integrators, "cached", lambda name, law="hertz": True)
     monkeypatch.setattr(integrators, "_run_tiny_system", lambda run_step, law: calls.append(run_step))
     integrators.warm_up("ode3", stream=stream)
     assert stream.getvalue() == "" and len(calls) == 1

@@ -11,6 +11,12 @@ pi sqrt(m / k)), by the energy ledger's balance with the law's potential k delta
 commands: `ies sweep --contact-law linear-spring --k-lin ...` and an interval study that varies k_lin.
 
 Files a law with a constant of its own touches: the file that defines it (here this test) and the registry line.
+
+Compiling a new law into the integrators takes minutes (numba cannot cache kernels specialised on a law defined at
+run time), so the tests that run it (the stepped-sine point, the single impact, `ies sweep` and the interval study) are
+in the `long` set (`pytest -m long tests/sim/model/test_contact_law_seam.py`); the default run keeps stand-ins that
+compile nothing: the registered toy law through `system_arrays` in the DOP853 reference against its single-impact
+reference, its constant in the kernels' arrays, and the command line's refusal of an impossible constant.
 """
 from __future__ import annotations
 
@@ -126,6 +132,33 @@ def test_an_unknown_law_is_one_line():
         ContactLaw("linear-spring")
 
 
+def immovable_wall(law_name: str = "linear-spring"):
+    """A sphere against a wall that does not move (a 1e6 kg 'beam'), the impactor with the law `law_name`."""
+    m_wall = 1e6
+    phi = 1.0 / math.sqrt(m_wall)
+    model = ModalModel(frequencies_hz=np.array([1e-3]), damping_ratios=np.array([1e-6]), phi_wall_left=np.array([phi]),
+                       phi_wall_right=np.array([phi]), phi_tip=np.array([phi]), participation=np.array([0.0]),
+                       source="immovable wall")
+    impactor = spring_impactor() if law_name == "linear-spring" else Impactor(contact_law=ContactLaw(law_name))
+    return model, impactor, system_arrays(model, impactor)
+
+
+def test_the_toy_law_reaches_the_reference_and_meets_its_single_impact(spring):
+    """The default run's stand-in for the compiled tests below: the registered toy law, carried by `system_arrays`
+    like any law, drives the DOP853 reference (its force evaluated in Python): one impact on the immovable wall lasts
+    half a period of the spring and rebounds with restitution 1, as the law's own reference says."""
+    model, impactor, sys = immovable_wall()
+    assert sys.law.force is spring_force
+    v0 = 0.2
+    y0 = np.array([0.0, 0.0, -sys.g + 1e-4 * v0, -v0])
+    _, onsets, releases, rebounds = reference_run(y0, 1e-3, 2 * math.pi * 1000.0, 0.0, sys, rtol=1e-12)
+    expected = SPRING.reference(impactor.mass, v0, K_SPRING, 0.0)
+    assert onsets.size == 1 and releases.size == 1
+    assert releases[0] - onsets[0] == pytest.approx(expected.duration, rel=1e-6)
+    assert abs(rebounds[0]) / v0 == pytest.approx(expected.restitution, rel=1e-6)
+
+
+@pytest.mark.long  # compiles the toy law into the integrator: minutes (see the module docstring)
 @pytest.mark.parametrize("integrator", ["exact", "ode3"])
 def test_the_toy_law_runs_a_stepped_sine_point_like_scipy(spring, integrator):
     model, sys = three_mode_system()
@@ -157,16 +190,11 @@ def test_the_toy_law_runs_a_stepped_sine_point_like_scipy(spring, integrator):
     assert abs(ledger.balance_error) < (1e-7 if integrator == "exact" else 1e-3)
 
 
+@pytest.mark.long  # compiles the toy law into the exact integrator: minutes (see the module docstring)
 def test_the_toy_law_meets_its_single_impact_reference(spring):
     """One impact on a wall that does not move (a 1e6 kg 'beam'): the exact integrator's impact log against the
     law's reference (half a period of the spring, restitution 1)."""
-    m_wall = 1e6
-    phi = 1.0 / math.sqrt(m_wall)
-    model = ModalModel(frequencies_hz=np.array([1e-3]), damping_ratios=np.array([1e-6]), phi_wall_left=np.array([phi]),
-                       phi_wall_right=np.array([phi]), phi_tip=np.array([phi]), participation=np.array([0.0]),
-                       source="immovable wall")
-    impactor = spring_impactor()
-    sys = system_arrays(model, impactor)
+    model, impactor, sys = immovable_wall()
     v0 = 0.2
     y = np.zeros(4)
     y[2] = -sys.g + 1e-4 * v0
@@ -203,6 +231,16 @@ def test_the_law_gives_its_constant_to_the_kernels_and_its_predictor_its_exponen
     assert system_arrays(model, Impactor()).k_H == Impactor().k_H  # the Hertz laws keep k_H
 
 
+def test_an_impossible_constant_is_refused_before_anything_runs(spring, capsys):
+    """The stand-in of the next test in the default run: the constant's option refuses a negative value with the
+    row's one line, before any kernel is compiled."""
+    from uq.cli import main
+
+    assert main(["sweep", "--level", "7.4", "--eta", "0.99", "--contact-law", "linear-spring", "--k-lin", "-1"]) == 2
+    assert "argument --k-lin: k_lin must be a positive number, got -1.0" in capsys.readouterr().err
+
+
+@pytest.mark.long  # compiles the toy law into the exact integrator: minutes (see the module docstring)
 def test_the_toy_law_and_its_constant_through_ies_sweep(spring, model_file, capsys):
     """`ies sweep` takes the law and its constant's option (with a unit), reports the constant in its JSON, and
     refuses an impossible value with the row's one line."""
@@ -221,6 +259,7 @@ def test_the_toy_law_and_its_constant_through_ies_sweep(spring, model_file, caps
     assert "argument --k-lin: k_lin must be a positive number, got -1.0" in capsys.readouterr().err
 
 
+@pytest.mark.long  # compiles the toy law into the exact integrator: minutes (see the module docstring)
 def test_a_study_varies_the_laws_constant(spring, model_file, tmp_path):
     """An interval study lists the constant under its study key and runs it end to end (`ies interval`)."""
     _, runs = interval_runs(tmp_path, f"contact_law = 'linear-spring'\nmodal_model = '{model_file}'\n"

@@ -153,3 +153,58 @@ def test_a_dead_worker_does_not_recompute_finished_tasks(tmp_path):
     calls = log.read_text().split()
     assert sorted(finished) == sorted(k for k, _ in pending)
     assert all(calls.count(key[1:]) == 1 for key in finished[:10]), calls  # finished before the kill: run once
+
+
+def _children(pid: int, marker: str) -> list[int]:
+    """Processes whose parent is `pid` and whose command line contains `marker` (Linux /proc)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                ppid = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
+                if ppid == pid and marker in (entry / "cmdline").read_bytes().decode(errors="replace"):
+                    found.append(int(entry.name))
+            except (OSError, IndexError, ValueError):
+                continue
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="finds the workers through /proc")
+def test_ctrl_c_while_the_workers_start_is_one_line(tmp_path):
+    """Ctrl-C (SIGINT to the terminal's process group) while `--jobs 99` workers are still starting: no worker prints
+    a traceback, the command says one line and exits 130."""
+    study = tiny_study(tmp_path)
+    proc = subprocess.Popen([sys.executable, "-m", "uq", "interval", str(study), "--out", str(tmp_path / "out"),
+                             "--jobs", "99", "--no-figures"], cwd=ROOT, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.time() + 300
+    while time.time() < deadline and proc.poll() is None and len(_children(proc.pid, "loky")) < 3:
+        time.sleep(0.02)
+    assert proc.poll() is None, f"the study ended before its workers started: {proc.stderr.read()}"
+    time.sleep(0.3)  # the workers are importing numpy, numba, the simulator
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err[-3000:]
+    assert proc.returncode == 130
+    assert err.strip().splitlines()[-1] == "ies interval: interrupted; finished results were kept (rerun with --resume)"
+
+
+def test_ctrl_c_during_a_dask_study_is_one_line(tmp_path):
+    """The same on a Dask cluster (here a LocalCluster of worker processes): the client's Ctrl-C cancels its tasks and
+    says one line; no traceback from the client or Dask's logging."""
+    distributed = pytest.importorskip("distributed")
+    study = tiny_study(tmp_path, wait=0.5)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        proc = subprocess.Popen([sys.executable, "-m", "uq", "interval", str(study), "--out", str(tmp_path / "out"),
+                                 "--scheduler", cluster.scheduler_address, "--no-figures"], cwd=ROOT,
+                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
+        tasks = tmp_path / "out" / "tasks"
+        deadline = time.time() + 300
+        while time.time() < deadline and proc.poll() is None and len(list(tasks.glob("*.json"))) < 2:
+            time.sleep(0.02)
+        assert proc.poll() is None, f"the study ended before the interruption: {proc.stderr.read()}"
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=120)
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err[-3000:]
+    assert proc.returncode == 130
+    assert err.strip().splitlines()[-1] == "ies interval: interrupted; finished results were kept (rerun with --resume)"

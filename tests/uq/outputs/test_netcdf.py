@@ -156,5 +156,27 @@ def test_response_study(tmp_path):
 
 
 def test_open_study_of_a_folder_without_results(tmp_path):
-    with pytest.raises(StudyError, match="holds no results.nc"):
+    with pytest.raises(StudyError, match="holds no results.nc; give the output folder of ies interval, sobol, response "
+                                         "or design"):
         open_study(tmp_path)
+    with pytest.raises(StudyError, match=f"^{tmp_path / 'nowhere'} does not exist; give the output folder"):
+        open_study(tmp_path / "nowhere")
+
+
+@pytest.mark.parametrize("damage", ["garbage", "truncated"])
+def test_open_study_of_a_damaged_results_file_is_one_line(tmp_path, damage):
+    """A results.nc that h5py cannot open (not HDF5 at all, or cut short as by a full disk) is one line that says how to
+    get it back, not h5py's raw OSError."""
+    import xarray as xr
+
+    path = tmp_path / "results.nc"
+    xr.Dataset({"mean": ("level", np.arange(200.0))}).to_netcdf(path, engine="h5netcdf")
+    whole = path.read_bytes()
+    path.write_bytes(b"not a NetCDF file" * 10 if damage == "garbage" else whole[: len(whole) // 2])
+    with pytest.raises(StudyError) as caught:
+        open_study(tmp_path)
+    line = str(caught.value)
+    assert "\n" not in line and line.startswith(f"{path} cannot be read (")
+    assert "damaged or cut short" in line and "--resume" in line and f"ies plot {tmp_path}" in line
+    path.write_bytes(whole)  # the file itself may be named too
+    assert open_study(path)["mean"].values.tolist() == list(np.arange(200.0))

@@ -60,3 +60,15 @@ def test_a_study_file_may_only_list_figures_of_the_table(tmp_path, capsys) -> No
     study.write_text("[study]\nkind = 'response'\n[excitation]\nlevels = [2.0]\n[response]\nfigures = ['figToy']\n")
     assert main(["response", str(study), "--out", str(tmp_path / "o")]) == 2
     assert "[response] figures must be a list from fig5, fig6, figD2, figD3, fig11, figC1" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("quick", [True, False])
+def test_each_figure_folder_holds_only_its_own_figure(quick):
+    """`ies reproduce all` writes each figure into its own folder: a response study of the table draws only its own
+    row's figure (Fig. 6's study once also drew a second, different fig5.png into fig6/)."""
+    from uq.methods import load_study
+
+    for name in figures_of_all():
+        study = load_study(PAPER_FIGURES[name].study_file(quick))
+        if study.kind == "response":
+            assert list(study.settings["figures"]) == [name], (name, study.settings)
