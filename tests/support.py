@@ -39,14 +39,15 @@ def interval_runs(tmp_path: Path, head: str, name: str = "study") -> tuple[Path,
 
 
 def tiny_design(tmp_path: Path, model: str | Path) -> dict:
-    """Run `ies design` on a tiny design study (3 um, clearances 0.5 and 0.6 mm, the paper's radius, one candidate,
-    one repetition, a two-frequency stepped sine) with the host `model` (a file); returns its design.json."""
+    """Run `ies design` on a tiny design study (1.5 um: below the switch by more than the margin; clearances 0.5 and
+    0.6 mm, the paper's radius, one candidate, one repetition, a two-frequency stepped sine) with the host `model` (a
+    file); returns its design.json."""
     import json
 
     from uq.cli import main
 
     study = tmp_path / "design.toml"
-    study.write_text(f"[study]\nkind = 'design'\noutput = '{tmp_path / 'design-out'}'\n[design]\nexcitation = '3um'\n"
+    study.write_text(f"[study]\nkind = 'design'\noutput = '{tmp_path / 'design-out'}'\n[design]\nexcitation = '1.5um'\n"
                      f"clearance = '0.5mm:0.6mm:2'\nradius = '7.92mm'\ncandidates = 1\nreps = 1\nmodel = '{model}'\n"
                      "[excitation]\neta = { start = 0.98, stop = 0.99, n = 2 }\nwait = 0.02\nhold = 0.05\n")
     assert main(["design", str(study), "--jobs", "1", "--quiet", "--no-figures"]) == 0

@@ -537,21 +537,39 @@ def draw_scan_calibrate(tmp: Path) -> None:
     sim.common.files.save_figure(fig, tmp / "scan-calibrate.png")
 
 
-def draw_design(tmp: Path) -> None:
-    """ies design's map and curves from a real screening of a small grid and fabricated verifications."""
-    from uq.design import problem as dp, results as dr, search as ds
-    from uq.design.figures import plot_design_curves, plot_design_map
+def _design_result(tmp: Path, radii: tuple, materials: tuple) -> Any:
+    """A design result from a real screening of a small grid, fabricated predictions (the cliff of the switch near
+    0.45 mm) and fabricated verifications of three designs and the baseline."""
+    from uq.design import prediction as dq, problem as dp, results as dr, search as ds
 
     problem = dp.DesignProblem(excitation=tuple(np.linspace(1e-6, 6e-6, 6)), clearances=(0.3e-3, 0.45e-3, 0.6e-3),
-                              radii=(6e-3, 7.92e-3), materials=("brass", "tungsten"),
-                              baseline=dp.Sphere(0.58e-3, 7.92e-3, "brass"))
+                               radii=radii, materials=materials, baseline=dp.Sphere(0.58e-3, 7.92e-3, "brass"))
     screened = ds.screen_designs(problem, dp.host_mode(dp.host_model(problem)))
+    corner = dq.Corner(0.00075, 0.0, 1.0)
+    predictions = {d: dq.DesignPrediction(d, np.linspace(0.1, 0.4, 6) * 1e-3 * d.clearance / 0.45e-3,
+                                          7.2e-6 * (d.clearance / 0.45e-3) ** 1.2, "found", corner,
+                                          8e-6 * d.clearance / 0.45e-3, "found", (0.2e-3, 0.8e-3))
+                   for d in [*problem.grid(), problem.baseline]}
     level = np.linspace(0.1, 1.0, 6) * 1e-3
-    verified = [dr.Verified(s, k * level, 1.3 * k * level, 1.1 * k * level, np.linspace(0, 1, 6), np.zeros(6, bool), 6)
-                for k, s in zip((1.0, 1.5, 2.0), ds.candidates(problem, screened)[:3])]
-    result = dr.DesignResult(problem, screened, verified, tmp, np.arange(1.0, 7.0), 3.0 * level, [])
-    plot_design_map(result, tmp / "design-map.png")
-    plot_design_curves(result, tmp / "design-curves.png")
+    chosen = [d for d in problem.grid() if d.clearance >= 0.45e-3 and problem.fits(d)][:3] + [problem.baseline]
+    verified = [dr.Verified(d, k * level, 1.3 * k * level, 1.1 * k * level, np.zeros(6), np.zeros(6, bool), 63,
+                            point_apr=np.zeros((9, 7)), margin_high=1.3 * k * 1.2e-3,
+                            excitation=(*problem.excitation, 7.2e-6), prediction=predictions[d])
+                for k, d in zip((1.0, 1.5, 2.0, 2.5), chosen)]
+    return dr.DesignResult(problem, screened, verified, tmp, np.arange(1.0, 7.0), 3.0 * level, [],
+                           predictions=predictions, rounds=[[v.sphere for v in verified]], stop="stand-in",
+                           omega_1=2 * np.pi * 117.4)
+
+
+def draw_design(tmp: Path) -> None:
+    """ies design's map (clearance x radius per material), its one-radius form (worst case against clearance) and the
+    curves."""
+    from uq.design.figures import plot_design_curves, plot_design_map
+
+    both = _design_result(tmp, (6e-3, 7.92e-3), ("brass", "tungsten"))
+    plot_design_map(both, tmp / "design-map.png")
+    plot_design_curves(both, tmp / "design-curves.png")
+    plot_design_map(_design_result(tmp, (7.92e-3,), ("brass",)), tmp / "design-map-one-radius.png")
 
 
 def draw_orbits(tmp: Path) -> None:

@@ -74,10 +74,11 @@ matter at that eps); a direct solve_ivp simulation settles on the exact orbit to
 fixed r (k_H does not enter; the similarity law then makes the response depend on g only through a_base/g),
 first-order averaging in eps and D, no friction, no gravity along x.
 
-Validity against the full simulator (check (c), tests/benchmarks/test_slow_flow_switch.py, one run): stepped
-sine as the fidelity studies (eta 0.96:1.0:21 up, 3 s + 5 s, exact integrator, seed 2024, 1 repetition), levels
-2-9 step 0.5 in units of each design's own a_base* (own g), r = the simulator's Eq. D.1 value at the wall;
-switch = (last SMR level, first APR level] of `sim.stepped_sine.landmarks.landmarks`; "agrees" = within one grid step.
+Validity against the full simulator, measured (first table: an earlier run of 1 repetition per level and a design's
+r measured from its own runs; second: tests/benchmarks/test_slow_flow_switch.py, 2 repetitions): stepped sine as
+the fidelity studies (eta 0.96:1.0:21 up, 3 s + 5 s, exact integrator, seed 2024), levels 2-9 step 0.5 in units of
+each design's own a_base* (own g), r = the simulator's Eq. D.1 value at the wall; switch = (last SMR level, first
+APR level] of `sim.stepped_sine.landmarks.landmarks`; "agrees" = within one grid step.
 
   design       g (mm)  m_a (g)  r (Eq. D.1)  simulated switch  slow flow (9)  agrees   APR level at 7.5 sim / (9)
   rig          0.580   17.7     0.857        5.5 -> 6.0        4.00           no       0.364 / 0.410
@@ -88,15 +89,26 @@ switch = (last SMR level, first APR level] of `sim.stepped_sine.landmarks.landma
   mode 1 only  0.580   17.7     0.851        6.5 -> 7.0        4.15           no       0.326 / 0.395
   (the last row is a diagnostic: the rig's mode 1 alone with the damped contact law, r_cont = 0.86)
 
+  host, design          r      simulated switch  slow flow (9)  fold / switch
+  rig                   0.845  5.0 -> 5.5        4.29           0.82
+  rig m_a/2             0.901  2.0 -> 2.5        1.73           0.77
+  rig 2 m_a             0.784  none up to 9      12.87          (both beyond 9)
+  rig 2 g*              0.838  5.5 -> 6.0        4.47           0.78
+  cantilever m_a/2      0.831  4.5 -> 5.0        3.63           0.76
+  3D solid rig          0.843  5.5 -> 6.0        4.32           0.75
+
 The fold (9) comes out at 0.67-0.82 times the middle of the simulated switch interval on every design that
-switches (0.6-2.0 levels low; with mode 1 alone 2.6 levels low, so the higher modes are not the cause): the
+switches (0.6-2.6 levels low; with mode 1 alone 2.6 levels low, so the higher modes are not the cause): the
 fold is where the two-impact orbit starts to exist, a lower bound of the switch, and the stepped sine stays
-strongly modulated above it (the slow flow's boundary of the relaxation cycle is not modelled here); it follows the simulator's trends (clearance: weak; lighter sphere: much earlier; heavier: later) and
-the almost periodic level within 5-13 %. The simulated switches correspond to the fold at an r 0.02-0.09
-below the measured one (rig: 0.78-0.80). With the paper's r = 0.8 the fold of the rig lies at 5.43 (4.00 at
-the simulator's 0.857): lowering r by that much moves the switch up by 1.4 levels, the size of the gap
-between the paper's 6.7 and the simulator's 5.3-5.5; scaled by the same ratio (1.36) the simulator's switch
-would move to 7.2-7.5. So the lower r of the experiment can account for the paper's later switch.
+strongly modulated above it (the slow flow's boundary of the relaxation cycle is not modelled here); it follows
+the simulator's trends (clearance: weak; lighter sphere: much earlier; heavier: later) and the almost periodic level
+within 5-13 %. The switch that `ies design` uses is therefore not this fold but the similarity law of the full model
+(`sim.reduced.similarity`), which agrees with the simulated switch on every design above; the slow flow screens.
+The simulated switches correspond to the fold at an r 0.02-0.09 below the measured one (rig: 0.78-0.80). With the
+paper's r = 0.8 the fold of the rig lies at 5.43 (4.00 at the simulator's 0.857): lowering r by that much moves the
+switch up by 1.4 levels, the size of the gap between the paper's 6.7 and the simulator's 5.3-5.5; scaled by the
+same ratio (1.36) the simulator's switch would move to 7.2-7.5. So the lower r of the experiment can account for
+the paper's later switch.
 """
 from __future__ import annotations
 

@@ -1,16 +1,17 @@
-"""Speed of `ies design` (issue 28) on the built-in rig.
+"""Speed of `ies design`.
 
 * The slow-flow kernel (`sim.reduced.slow_flow.screen`): 50 clearances x 10 sphere radii x 20 excitation levels.
   Target <= 2 s (median of 5 repeats after one untimed call; numpy only, no JIT). Latest: 0.03-0.04 s.
 * The design's screening step (`uq.design.search.screen_designs`: the same grid for each end of the D interval and of the
   clearance tolerance, i.e. four slow-flow calls). Target <= 2 s. Latest: see `-s`.
-* A full design (screening + verification of the five best candidates, their neighbours and the paper's design as
-  baseline, 3 repetitions, 8 corners and the centre of the uncertainty box, 10 levels). Target <= 15 min on 2 cores.
-* The README's worked example, run as written; its recommendation pinned (clearance within 0.1 mm, worst case within
-  15 %, never worse than the paper's 0.58 mm).
+* A design like the one a new user tried on an unseen host (the cantilever of `_cantilever.py`, 8 clearances, 6 levels,
+  the box, 3 repetitions, default --candidates): target <= 5 min on 2 cores after compilation.
+* The README's worked example, run as written: target <= 5 min on 2 cores; its recommendation pinned (clearance within
+  0.1 mm, worst case within 15 %, its margin at least 20 %; the paper's 0.58 mm switching inside the range).
 
 Run: pytest -m benchmark tests/benchmarks/test_design_speed.py -s
 """
+import os
 import statistics
 import time
 
@@ -22,7 +23,7 @@ from sim.reduced.slow_flow import host_mode, screen
 from sim.hosts.rig import seed_rig_model
 
 pytestmark = pytest.mark.benchmark
-TARGET_S = 2.0
+SCREENING_TARGET_S = 2.0
 REPEATS = 5
 
 
@@ -38,9 +39,9 @@ def test_screening_50_clearances_10_radii_20_levels():
         result = screen(host, clearances, masses, a_base, 0.86)
         times.append(time.perf_counter() - started)
     median = statistics.median(times)
-    print(f"\nscreening 50 x 10 x 20 designs: median {median:.3f} s over {REPEATS} (target {TARGET_S} s)")
+    print(f"\nscreening 50 x 10 x 20 designs: median {median:.3f} s over {REPEATS} (target {SCREENING_TARGET_S} s)")
     assert result.tip.shape == (50, 10, 20) and np.all(np.isfinite(result.tip)) and np.all(result.tip > 0)
-    assert median <= TARGET_S
+    assert median <= SCREENING_TARGET_S
 
 
 def test_the_design_screening_step_50_clearances_10_radii_20_levels():
@@ -59,46 +60,74 @@ def test_the_design_screening_step_50_clearances_10_radii_20_levels():
         times.append(time.perf_counter() - started)
     median = statistics.median(times)
     print(f"\ndesign screening step (500 designs x 20 levels, 4 uncertainty ends): median {median:.3f} s "
-          f"(target {TARGET_S} s)")
-    assert screened.tip.shape == (500, 20) and median <= TARGET_S
+          f"(target {SCREENING_TARGET_S} s)")
+    assert screened.tip.shape == (500, 20) and median <= SCREENING_TARGET_S
 
 
-FULL_DESIGN = ["--excitation", "0.66um:6.6um:10", "--clearance", "0.3mm:1.5mm:7", "--radius", "5mm:7.92mm:4",
-               "--material", "brass,tungsten", "--baseline", "0.58mm,7.92mm,brass"]
-FULL_DESIGN_TARGET_S = 15 * 60
+#: the design of tests/benchmarks/test_design_brute_force.py (8 clearances, 6 levels, the box, 3 repetitions) on the
+#: cantilever, with the default --candidates
+TARGET_S = 5 * 60
+
+
+def _cpu_seconds() -> float:
+    """CPU seconds of this process and its finished children (the workers, once shut down)."""
+    import resource
+
+    return sum(resource.getrusage(who).ru_utime + resource.getrusage(who).ru_stime
+               for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
 
 
 def _run_design(argv, out):
+    """`ies design` in this process with one worker per core: (printed text, wall seconds, CPU seconds of this process
+    and the workers). On the shared machine the wall time depends on the others' load; CPU seconds / cores is what
+    the same design takes on quiet cores (plus the workers' start)."""
     import contextlib
     import io
     import os
 
+    from joblib.externals.loky import get_reusable_executor
+
     from uq.cli import main
 
     printed = io.StringIO()
-    started = time.perf_counter()
+    get_reusable_executor().shutdown(wait=True)
+    cpu, started = _cpu_seconds(), time.perf_counter()
     with contextlib.redirect_stdout(printed):
         assert main(["design", *argv, "--out", str(out), "--quiet", "--no-figures",
                      "--jobs", str(os.cpu_count() or 1)]) == 0
-    return printed.getvalue(), time.perf_counter() - started
+    seconds = time.perf_counter() - started
+    get_reusable_executor().shutdown(wait=True)  # the workers' CPU time counts once they are reaped
+    return printed.getvalue(), seconds, _cpu_seconds() - cpu
 
 
-def test_a_full_design_on_the_built_in_rig_takes_at_most_15_minutes(tmp_path):
+def _report(name, printed, seconds, cpu, out):
     import json
+    import os
 
+    data = json.loads((out / "design.json").read_text())
+    runs = sum(v["runs"] for v in data["verified"]) + data["search"]["reference_runs"]
+    cores = os.cpu_count() or 1
+    print(f"\n{printed}\n{name}: {seconds:.0f} s wall on {cores} cores at load average {os.getloadavg()[0]:.1f}, "
+          f"{cpu:.0f} CPU s ({cpu / cores:.0f} s on {cores} quiet cores), {len(data['verified'])} designs verified in "
+          f"{len(data['search']['rounds'])} rounds, {runs} runs in all ({data['search']['reference_runs']} for the "
+          f"similarity references; target {TARGET_S} s)")
+    return data
+
+
+def test_a_design_of_8_clearances_and_6_levels_on_an_unseen_host_within_5_minutes(tmp_path):
     from sim.integration.integrators import warm_up
+    from tests.benchmarks._cantilever import save_cantilever
+    from tests.benchmarks.test_design_brute_force import design_arguments
 
     warm_up("exact")  # compilation is not part of the design's time
-    printed, seconds = _run_design(FULL_DESIGN, tmp_path / "full")
-    data = json.loads((tmp_path / "full" / "design.json").read_text())
-    runs = sum(v["runs"] for v in data["verified"])
-    print(f"\n{printed}\nfull design: {seconds:.0f} s, {len(data['verified'])} designs verified by {runs} runs "
-          f"(target {FULL_DESIGN_TARGET_S} s)")
-    assert seconds <= FULL_DESIGN_TARGET_S
+    argv = design_arguments(save_cantilever(tmp_path / "cantilever.toml"))
+    printed, seconds, cpu = _run_design(argv, tmp_path / "unseen")
+    _report("8 clearances, 6 levels on the cantilever", printed, seconds, cpu, tmp_path / "unseen")
+    assert min(seconds, cpu / (os.cpu_count() or 1)) <= TARGET_S
 
 
 def readme_design_example() -> list[str]:
-    """The arguments of the README's worked example (the line `ies design --excitation 0.66um:6.6um:10 ...`)."""
+    """The arguments of the README's worked example (the line `ies design --excitation 0.66um:6.6um:...`)."""
     import shlex
     from pathlib import Path
 
@@ -107,20 +136,20 @@ def readme_design_example() -> list[str]:
     return [a for a in shlex.split(line.strip())[2:] if a]
 
 
-def test_the_readme_worked_example_finds_a_clearance_no_worse_than_the_papers(tmp_path):
-    import json
-
+def test_the_readme_worked_example_within_5_minutes_and_its_recommendation_pinned(tmp_path):
     from sim.integration.integrators import warm_up
 
     argv = readme_design_example()
     argv = [a for i, a in enumerate(argv) if a != "--out" and (i == 0 or argv[i - 1] != "--out")]
     warm_up("exact")
-    printed, seconds = _run_design(argv, tmp_path / "example")
-    data = json.loads((tmp_path / "example" / "design.json").read_text())
+    printed, seconds, cpu = _run_design(argv, tmp_path / "example")
+    data = _report("worked example", printed, seconds, cpu, tmp_path / "example")
     best, paper = data["recommendation"], data["baseline"]
-    print(f"\n{printed}\nworked example: {seconds:.0f} s")
-    # pinned (README): the paper's sphere at 0.58 mm; worst case 2.44 mm over 0.66-6.6 um (15 %: chaotic runs)
+    # pinned (README): 1.4 mm, worst case 0.293 mm (15 %: chaotic runs), margin 35 % to the switch at 8.9 um; the
+    # paper's 0.58 mm switches inside the range (3.6 um)
     assert best["material"] == "brass" and best["radius_m"] == pytest.approx(7.92e-3)
-    assert best["clearance_m"] == pytest.approx(0.58e-3, abs=0.1e-3)
-    assert best["worst_m"] == pytest.approx(2.44e-3, rel=0.15)
-    assert best["worst_m"] <= paper["worst_m"]
+    assert best["clearance_m"] == pytest.approx(1.4e-3, abs=0.1e-3)
+    assert best["worst_m"] == pytest.approx(0.293e-3, rel=0.15)
+    assert best["admissible"] and best["margin_worst"] >= 0.2
+    assert not paper["admissible"] and paper["switch_worst_m"] < max(data["settings"]["excitation"])
+    assert min(seconds, cpu / (os.cpu_count() or 1)) <= TARGET_S

@@ -7,11 +7,12 @@ from typing import Any
 
 from sim.common.options import positive_int
 from sim.model.parameters import PARAMETERS
-from uq.commands.study import add_run_arguments, engine
+from uq.commands.study import add_run_arguments, engine, print_files
 
 DESIGN_HELP = ("choose the clearance and the sphere (radius, material) for a host structure: the worst case of the "
-               "resonant tip amplitude over an excitation range and the uncertain D, clearance and k_H, screened by "
-               "the slow flow and verified by stepped-sine simulation (uq.design)")
+               "resonant tip amplitude over an excitation range and the uncertain D, clearance and k_H, with a margin to "
+               "the switch to the almost periodic response; screened by the slow flow, predicted by the similarity law "
+               "of the full model, verified by stepped-sine simulation (uq.design)")
 
 
 def add_design_arguments(parser: argparse.ArgumentParser) -> None:
@@ -29,8 +30,15 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--material", metavar="LIST", help="sphere materials, comma separated: brass, steel, tungsten "
                                                            "(default brass)")
     parser.add_argument("--model", metavar="FILE", help="the host as a modal-model file (default: the built-in rig)")
-    parser.add_argument("--objective", choices=("mean", "max"), help="the amplitude whose worst case is minimised: "
-                                                                     "the resonant mean (default) or max")
+    from uq.design.objectives import OBJECTIVES
+
+    parser.add_argument("--objective", metavar="NAME",
+                        help="what is minimised in the worst case (uq.design.objectives): "
+                             + "; ".join(f"{o.name}: {o.quantity}, {o.statistic} ({o.unit})" for o in OBJECTIVES.values())
+                             + f" (default {next(iter(OBJECTIVES))})")
+    parser.add_argument("--margin", metavar="FRACTION",
+                        help="the margin a design's switch to the almost periodic response must keep above the top of "
+                             "--excitation at every corner of the box, as a fraction in (0, 1] (default 0.2: 20 %%)")
     D, g, k_H = (PARAMETERS[name].spread for name in ("D", "g", "k_H"))  # Table 2's intervals (the one vocabulary)
     parser.add_argument("--damping", metavar="LOW:HIGH", help=f"interval of D_1 (default Table 2: {D.low:g}:{D.high:g})")
     parser.add_argument("--clearance-tolerance", metavar="LOW:HIGH",
@@ -40,7 +48,9 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--calibration", metavar="FILE",
                         help="`ies calibrate --json` output: its k_H / k_H* becomes the upper end of the k_H factor "
                              "(the crater's stiffening, as `ies reproduce` uses it)")
-    parser.add_argument("--candidates", type=positive_int, metavar="N", help="screened designs to verify (default 5)")
+    parser.add_argument("--candidates", type=positive_int, metavar="N",
+                        help="designs in the first verified batch, the best predicted (default 5); the search then "
+                             "verifies the best verified design's neighbours until it has them on every side")
     parser.add_argument("--reps", type=positive_int, metavar="N", help="repetitions per verification run (default 3)")
     parser.add_argument("--restitution", type=float, metavar="R",
                         help="modal restitution r (Eq. D.1) of the screening (default 0.86, the simulator's at the rig)")
@@ -57,20 +67,20 @@ def design_problem(args: argparse.Namespace) -> tuple[Any, Path, Any]:
     from uq.design import problem as d
 
     file = d.read_design_file(args.study) if args.study is not None else d.DesignFile()
-    given = {name: getattr(args, name) for name in d.DESIGN_SETTINGS if getattr(args, name, None) is not None}
+    given = {name: getattr(args, name) for name in d.DESIGN_SETTINGS if getattr(args, name, None) not in (None, False)}
     settings = {**d.DESIGN_SETTINGS, **file.settings, **given}
     return d.problem_of(settings, file.protocol), Path(args.out or settings["output"]), file.cluster
 
 
 def design_command(args: argparse.Namespace) -> int:
     """`ies design`: screen, verify and recommend (uq.design)."""
-    from uq.design.search import run_design
     from uq.design.results import design_table
+    from uq.design.search import run_design
 
     problem, out, cluster = design_problem(args)
     with engine(args, cluster) as client:
         result = run_design(problem, out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
                             progress=not args.quiet, figures=not args.no_figures, client=client)
     print(design_table(result))
-    print(f"wrote {len(result.files)} files to {result.folder}")
+    print_files(result.folder, result.files)
     return 0

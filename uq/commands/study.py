@@ -106,11 +106,16 @@ def _load_study(path: Path, kind: str) -> Any:
     return study
 
 
+def print_files(folder: Path, paths: list[Path]) -> None:
+    """Where the results are and the name of every file written there, on stdout (every study command and design)."""
+    print(f"results in {folder}/")
+    for path in paths:
+        print(f"  {path.name}")
+
+
 def _report(result: Any, figures: list[Path]) -> None:
     """Where the results are, and how many runs took how long, on stdout."""
-    print(f"results in {result.folder}/")
-    for path in [*result.files, *figures]:
-        print(f"  {path.name}")
+    print_files(result.folder, [*result.files, *figures])
     s = result.summary
     print(f"{s['tasks']} runs ({s['ran']} run now, {s['reused']} reused), {s['failed_runs']} failed, "
           f"{s['wall_time_s']:.1f} s")

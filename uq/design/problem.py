@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -41,7 +42,16 @@ PROTOCOL = {"eta_start": 0.96, "eta_stop": 1.01, "n_eta": 26, "wait": 2.0, "hold
             "start": "base-velocity", "repetition": "run", "integrator": "exact"}
 
 
-OBJECTIVES = ("mean", "max")
+#: the margin to the switch a design must keep above the top of the operating range (item "admissible", `uq.design`)
+MARGIN = 0.2
+
+
+#: the most values a range may have (COUNT); a design's runs are limited as a study's (`uq.problem.tasks.MAX_RUNS`,
+#: `--allow-large`), estimated at about SECONDS_PER_RUN each on one core (the rig's stepped sine of PROTOCOL)
+MAX_COUNT = 1000
+SECONDS_PER_RUN = 0.5
+#: the most (design, level) pairs the slow flow screens at once (its arrays: tens of MB)
+MAX_SCREENED = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -96,6 +106,8 @@ class DesignProblem:
     clearance_tolerance: tuple[float, float] = CLEARANCE_TOLERANCE
     k_H_factor: tuple[float, float] = K_H_FACTOR
     objective: str = "mean"
+    margin: float = MARGIN
+    allow_large: bool = False
     candidates: int = 5
     repetitions: int = 3
     restitution: float = RESTITUTION
@@ -124,8 +136,12 @@ class DesignProblem:
                 material(name)
             except SimulationInputError as exc:  # one line naming the known materials
                 raise StudyError(f"--material: {exc}") from None
-        if self.objective not in OBJECTIVES:
-            raise StudyError(f"--objective must be one of {', '.join(OBJECTIVES)}, got {self.objective!r}")
+        from uq.design.objectives import objective_named
+
+        objective_named(self.objective)
+        if not (math.isfinite(self.margin) and 0.0 < self.margin <= 1.0):
+            raise StudyError(f"--margin {self.margin:g}: give the margin to the switch as a fraction in (0, 1], e.g. 0.2 "
+                             "for 20 % above the top of the operating range")
         for name, (lo, hi) in (("--damping", self.D), ("--clearance-tolerance", self.clearance_tolerance),
                                ("--k-H-factor", self.k_H_factor)):
             if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
@@ -140,9 +156,23 @@ class DesignProblem:
             raise StudyError(f"--restitution must lie in (0, 1], got {self.restitution:g}")
         if self.candidates < 1 or self.repetitions < 1:
             raise StudyError("--candidates and --reps must be >= 1")
+        if not (math.isfinite(self.block_width) and self.block_width > 0 and math.isfinite(self.min_wall)
+                and self.min_wall > 0):
+            raise StudyError(f"--block-width and --min-wall must be positive lengths, got {self.block_width * 1e3:g} mm "
+                             f"and {self.min_wall * 1e3:g} mm")
+        if self.room() <= 0:
+            raise StudyError(f"--min-wall {self.min_wall * 1e3:g} mm: two walls of {self.min_wall * 1e3:g} mm leave no "
+                             f"room in the {self.block_width * 1e3:g} mm block for a cavity; give --min-wall below "
+                             f"{self.block_width * 1e3 / 2:g} mm or a wider --block-width")
         if self.baseline is not None and not self.fits(self.baseline):
             raise StudyError(f"--baseline: {self.baseline.label()} needs a {self.baseline.cavity() * 1e3:.2f} mm cavity;"
                              f" {self.room() * 1e3:.2f} mm fit between {self.min_wall * 1e3:g} mm walls")
+        screened = len(self.clearances) * len(self.radii) * len(self.materials) * len(self.excitation)
+        if screened > MAX_SCREENED:
+            raise StudyError(f"the grid of {len(self.clearances)} clearances x {len(self.radii)} radii x "
+                             f"{len(self.materials)} materials at {len(self.excitation)} levels is {screened:,} "
+                             f"(design, level) pairs, more than the {MAX_SCREENED:,} the screening holds in memory: give "
+                             "fewer values to --clearance, --radius or --excitation")
         if not any(self.fits(s) for s in self.grid()):
             raise StudyError(f"no design fits: the cavity 2R + 2g must stay within {self.room() * 1e3:.2f} mm "
                              f"({self.block_width * 1e3:g} mm block, walls of {self.min_wall * 1e3:g} mm); "
@@ -245,30 +275,42 @@ def _quantities() -> dict[str, Any]:
 
     return {"excitation": Quantity("base amplitude a_base", "m", {**LENGTH_UNITS, "nm": 1e-9}, (1e-10, 1e-2), "2um"),
             "acceleration": Quantity("base acceleration", "m/s2", {"m/s2": 1.0, "m/s^2": 1.0}, (1e-4, 1e4), "1m/s2"),
-            "clearance": PARAMETERS["g"].quantity, "radius": RADIUS}
+            "clearance": PARAMETERS["g"].quantity, "radius": RADIUS,
+            "block_width": Quantity("block width", "m", LENGTH_UNITS, (1e-3, 1.0), "28mm"),
+            "min_wall": Quantity("wall thickness", "m", LENGTH_UNITS, (1e-5, 0.5), "5.5mm")}
+
+
+#: a number alone, without a unit (`2e-3`, `0.5`): refused in a range, on the command line as in a study file
+_BARE_NUMBER = re.compile(r"^\s*[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?\s*$")
+
+
+def option_name(kind: str) -> str:
+    """The option of a setting: `--min-wall` for min_wall."""
+    return "--" + kind.replace("_", "-")
 
 
 def parse_range(text: str, kind: str, *, count: int, omega: float | None = None) -> tuple[float, ...]:
     """`START:STOP[:COUNT]` or one value, each a number with its unit (`0.2mm:1.2mm`, `2um:8um:7`, `7.92mm`) or, for
     the excitation, base accelerations (`0.5m/s2:2m/s2`, turned into amplitudes a / omega^2 at the resonance omega);
-    returns the COUNT (default `count`) equispaced values in SI. One line (StudyError) for a malformed, empty,
-    reversed, unitless or implausible range."""
+    returns the COUNT (default `count`, at most MAX_COUNT) equispaced values in SI. One line (StudyError) for a
+    malformed, empty, reversed, unitless (`1e-3m:2e-3`: every number needs its unit) or implausible range, or one of
+    more than MAX_COUNT values (with what it would cost)."""
     from sim.common.errors import SimulationInputError
     from sim.common.units import implausible, parse_quantity
 
     quantities = _quantities()
-    option = f"--{kind}"
+    option = option_name(kind)
     parts = [t.strip() for t in str(text).split(":")]
     if len(parts) > 3 or not all(parts[:2]):
         raise StudyError(f"{option} {text!r}: give START:STOP[:COUNT] or one value, with units, e.g. "
                          f"{_EXAMPLES.get(option, '1mm')}")
-    n = count if len(parts) < 3 else _count(parts[2], option)
+    n = count if len(parts) < 3 else _count(parts[2], option, text)
     accelerating = kind == "excitation" and any(u in parts[0] for u in ("m/s2", "m/s^2"))
     quantity = quantities["acceleration" if accelerating else kind]
     values = []
     for part in parts[:2]:
-        if not any(ch.isalpha() for ch in part):
-            raise StudyError(f"{option} {text!r}: {part!r} has no unit; write it with one, e.g. "
+        if _BARE_NUMBER.match(part):
+            raise StudyError(f"{option} {text!r}: {part!r} has no unit; write every number with one, e.g. "
                              f"{quantity.example}")
         try:
             value = parse_quantity(part, quantity)
@@ -293,14 +335,39 @@ def parse_range(text: str, kind: str, *, count: int, omega: float | None = None)
     return tuple(float(v) for v in np.linspace(values[0], values[-1], n)) if n > 1 else (float(values[0]),)
 
 
-def _count(text: str, option: str) -> int:
+def _count(text: str, option: str, whole: str) -> int:
     try:
         n = int(text)
     except ValueError:
         raise StudyError(f"{option}: COUNT {text!r} must be a whole number >= 1") from None
     if n < 1:
         raise StudyError(f"{option}: COUNT must be >= 1 (an empty range), got {n}")
+    if n > MAX_COUNT:
+        per_design = 9 * (n + 1) * 3 if option == "--excitation" else 9 * 11 * 3
+        what = (f"each verified design alone would take {per_design:.3g} runs (9 points of the box x {n} levels x 3 "
+                f"repetitions, about {duration(per_design * SECONDS_PER_RUN)} on one core)" if option == "--excitation"
+                else f"the screening would hold {n:.3g} values on this axis alone")
+        raise StudyError(f"{option} {whole!r}: COUNT {n} is more than {MAX_COUNT} values: {what}; give a COUNT of at "
+                         f"most {MAX_COUNT}")
     return n
+
+
+def duration(seconds: float) -> str:
+    """A duration in words: s, min, h, days or years."""
+    for unit, size in (("years", 3.15e7), ("days", 86400.0), ("h", 3600.0), ("min", 60.0)):
+        if seconds >= 2 * size:
+            return f"{seconds / size:.3g} {unit}"
+    return f"{seconds:.0f} s"
+
+
+def _number(value: Any, option: str, what: str) -> float:
+    """A plain number of a setting, or one line (StudyError) saying what it should be."""
+    try:
+        if isinstance(value, bool):
+            raise ValueError
+        return float(value)
+    except (TypeError, ValueError):
+        raise StudyError(f"{option} {value!r}: give {what}") from None
 
 
 def parse_interval(text: str, what: str, quantity: str | None = None) -> tuple[float, float]:
@@ -364,7 +431,7 @@ DESIGN_SETTINGS: dict[str, Any] = {
     "excitation": None, "clearance": "0.3mm:1.2mm:10", "radius": "7.92mm", "material": "brass", "model": None,
     "objective": "mean", "damping": None, "clearance_tolerance": None, "k_H_factor": None, "calibration": None,
     "candidates": 5, "reps": 3, "restitution": None, "baseline": None, "block_width": None, "min_wall": None,
-    "output": "ies-out/design"}
+    "margin": None, "allow_large": False, "output": "ies-out/design"}
 
 
 @dataclass(frozen=True)
@@ -423,7 +490,7 @@ def problem_of(settings: Mapping[str, Any], protocol: Mapping[str, Any] = PROTOC
             fields[key] = parse_interval(value[name], "--" + name.replace("_", "-"), quantity)
     for name in ("block_width", "min_wall"):
         if value[name] is not None:
-            fields[name] = parse_range(value[name], "radius", count=1)[0]
+            fields[name] = parse_range(value[name], name, count=1)[0]
     if value["calibration"] is not None:
         if value["k_H_factor"] is not None:
             raise StudyError("give --calibration or --k-H-factor, not both: the calibration sets the factor's upper end")
@@ -435,6 +502,9 @@ def problem_of(settings: Mapping[str, Any], protocol: Mapping[str, Any] = PROTOC
         fields["k_H_factor"] = (1.0, ratio)
     if value["restitution"] is not None:
         fields["restitution"] = float(value["restitution"])
+    if value["margin"] is not None:
+        fields["margin"] = _number(value["margin"], "--margin", "a fraction in (0, 1], e.g. 0.2 for 20 %")
+    fields["allow_large"] = bool(value["allow_large"])
     if value["baseline"] is not None:
         fields["baseline"] = parse_baseline(value["baseline"], radii, materials)
     problem = dataclasses.replace(problem, **fields)

@@ -1,20 +1,27 @@
-"""The design search of `ies design`: screening by the slow flow, verification of the best designs by stepped-sine
-simulation at the corners of the uncertainty box, and the recommendation (the best verified design)."""
+"""The design search of `ies design`: screening by the slow flow, prediction by the similarity law of the full model,
+verification by stepped-sine simulation at the corners of the uncertainty box, iterated over the best verified
+design's neighbours until the best has verified neighbours on every side, and the recommendation (the best
+admissible verified design)."""
 from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+import sys
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
+from uq.design.objectives import Objective, objective_named
+from uq.design.prediction import DesignPrediction, Predictor
 from uq.design.problem import (
+    SECONDS_PER_RUN,
     DesignProblem,
     Sphere,
     first_impacts,
     host_mode,
     host_model,
+    duration,
     levels_of,
     micrometres,
     no_absorber,
@@ -68,32 +75,100 @@ def screen_designs(problem: DesignProblem, mode: Any) -> Screened:
     return Screened(designs, tip, regime, switch, worst, time.perf_counter() - started)
 
 
-def candidates(problem: DesignProblem, screened: Screened) -> list[Sphere]:
-    """The designs to verify: the `problem.candidates` best screened designs that fit, the clearance neighbours of the
-    best of them on the grid (same sphere), and the baseline, each once, best first."""
-    order = [i for i in np.argsort(screened.worst, kind="stable") if np.isfinite(screened.worst[i])]
-    chosen = [screened.designs[i] for i in order[: problem.candidates]]
-    g = list(problem.clearances)
-    if chosen and chosen[0].clearance in g:
-        best = chosen[0]
-        k = g.index(best.clearance)
+def first_runs(problem: DesignProblem) -> tuple[int, int]:
+    """(runs of the first verified batch, an upper bound of the similarity references' runs for its spheres): what the
+    design runs at least before its search adds neighbours."""
+    from uq.design.prediction import LEVEL_CEILING, LEVEL_FLOOR, LEVEL_RATIO, REFERENCE_REPS
+
+    fitting = [s for s in problem.grid() if problem.fits(s)]
+    designs = min(problem.candidates, len(fitting)) + (problem.baseline is not None)
+    points = len(problem.corners(fitting[0] if fitting else problem.grid()[0]))
+    per_design = points * (len(problem.excitation) + 1) * problem.repetitions
+    spheres = min(problem.candidates, len({(s.radius, s.material) for s in fitting}))
+    levels = 1 + math.ceil(math.log(LEVEL_CEILING / LEVEL_FLOOR) / math.log(LEVEL_RATIO))
+    references = 3 * len(set(problem.D)) * (levels + 6) * min(REFERENCE_REPS, problem.repetitions)
+    return designs * per_design, spheres * references
+
+
+def check_size(problem: DesignProblem) -> None:
+    """Refuse, before any work, a design whose first batch and references exceed a study's run limit
+    (`uq.problem.tasks.MAX_RUNS`) unless `allow_large`, with the estimate in the line."""
+    from uq.problem.tasks import MAX_RUNS
+
+    verify, references = first_runs(problem)
+    total = verify + references
+    if total > MAX_RUNS and not problem.allow_large:
+        raise StudyError(f"this design would run at least {total} simulations before its search adds neighbours "
+                         f"({verify} to verify the first {min(problem.candidates, len(problem.grid()))} design(s) at "
+                         f"{len(problem.excitation)} levels, {problem.repetitions} repetitions; up to {references} for the "
+                         f"similarity references), about {duration(total * SECONDS_PER_RUN)} on one core; a design runs at "
+                         f"most {MAX_RUNS:,} without --allow-large: give fewer levels, candidates or repetitions, or pass "
+                         "--allow-large")
+
+
+def ranked(problem: DesignProblem, predictions: Mapping[Sphere, DesignPrediction]) -> list[Sphere]:
+    """Designs by their prediction: those predicted admissible (margin to the switch at the box's worst corner of at
+    least `problem.margin`) by their predicted worst case, then the others by their margin, largest first."""
+    top = max(problem.excitation)
+    admissible = [s for s, p in predictions.items() if p.margin(top) >= problem.margin]
+    others = [s for s in predictions if s not in admissible]
+    return (sorted(admissible, key=lambda s: (_finite(predictions[s].worst), _grid_order(problem, s)))
+            + sorted(others, key=lambda s: (-predictions[s].margin(top), _grid_order(problem, s))))
+
+
+def _finite(x: float) -> float:
+    return x if math.isfinite(x) else math.inf
+
+
+def _grid_order(problem: DesignProblem, s: Sphere) -> tuple[int, int, int]:
+    """A design's place on the grid (material, radius, clearance), for ties."""
+    def at(values: Sequence[Any], x: Any) -> int:
+        return list(values).index(x) if x in values else len(values)
+
+    return at(problem.materials, s.material), at(problem.radii, s.radius), at(problem.clearances, s.clearance)
+
+
+def material_axis(problem: DesignProblem) -> list[str]:
+    """The materials of the grid in the order of their density (the sphere's mass at a radius): the material axis on
+    which a design has neighbours."""
+    from sim.model.materials import material
+
+    return sorted(problem.materials, key=lambda name: material(name).density)
+
+
+def neighbours(problem: DesignProblem, sphere: Sphere) -> list[Sphere]:
+    """The designs one grid step away from `sphere` on each axis (clearance, radius, material by density) that fit
+    the cavity; none for a design off the grid (the baseline)."""
+    out = []
+    for axis, values in (("clearance", list(problem.clearances)), ("radius", list(problem.radii)),
+                         ("material", material_axis(problem))):
+        here = getattr(sphere, axis)
+        if here not in values:
+            return []
+        k = values.index(here)
         for j in (k - 1, k + 1):
-            if 0 <= j < len(g):
-                neighbour = Sphere(g[j], best.radius, best.material)
-                if problem.fits(neighbour) and neighbour not in chosen:
-                    chosen.append(neighbour)
-    if problem.baseline is not None and problem.baseline not in chosen:
-        chosen.append(problem.baseline)
-    return chosen
+            if 0 <= j < len(values):
+                other = dataclasses.replace(sphere, **{axis: values[j]})
+                if problem.fits(other):
+                    out.append(other)
+    return out
+
+
+def best_of(problem: DesignProblem, verified: Sequence[Verified]) -> list[Verified]:
+    """Verified designs best first: the admissible ones by their verified worst case, then the others by their margin
+    to the switch, largest first."""
+    top = max(problem.excitation)
+    ok = [v for v in verified if v.admissible(top, problem.margin)]
+    rest = [v for v in verified if v not in ok]
+    return (sorted(ok, key=lambda v: (_finite(v.worst), _grid_order(problem, v.sphere)))
+            + sorted(rest, key=lambda v: (-v.margin(top), _grid_order(problem, v.sphere))))
 
 
 def corners(problem: DesignProblem, sphere: Sphere) -> list[dict[str, float]]:
-    """The uncertainty box of one design as task parameters (D, g, k_H, m_a in SI): its 8 corners, then the nominal
-    point (D's midpoint, the clearance and k_H of the design) for the monotonicity check; built from the parameter
+    """The uncertainty box of one design as task parameters (D, g, k_H, m_a in SI): its distinct corners, then the
+    centre (D's midpoint, the clearance and k_H of the design) for the monotonicity check; built from the parameter
     rows (`DesignProblem.corners`)."""
     return problem.corners(sphere)
-
-
 
 
 def verification_model(problem: DesignProblem) -> Any:
@@ -103,55 +178,110 @@ def verification_model(problem: DesignProblem) -> Any:
     return IESModel(protocol=dict(problem.protocol), modal_file=problem.modal_file)
 
 
-def verify(problem: DesignProblem, spheres: Sequence[Sphere], model: Any, folder: Any, *, jobs: int | None,
-           scheduler: str | None, progress: bool, client: Any = None) -> list[Verified]:
-    """Stage 2: every corner and nominal point of every design at every level and repetition, through the study
-    runner (`uq.engine.runner.run_tasks`: cached in `folder`/tasks, resumable)."""
-    from uq.engine.runner import ResultStore, Task, run_tasks
+def margin_level(problem: DesignProblem) -> float:
+    """The base amplitude (m) of the margin check: the top of the operating range times 1 + margin."""
+    return max(problem.excitation) * (1.0 + problem.margin)
 
-    rig = model.rig
-    levels = levels_of(rig, problem.excitation)
-    amplitude = "mean" if problem.objective == "mean" else "max"
+
+def verify(problem: DesignProblem, objective: Objective, spheres: Sequence[Sphere], rig: Any,
+           run: Callable[[list[Any]], Mapping[Any, Any]], *, round_: int = 0,
+           predictions: Mapping[Sphere, DesignPrediction] | None = None) -> list[Verified]:
+    """Stage 3: every corner and the centre of the box of every design at every operating level and at the margin
+    level (`margin_level`), each with the problem's repetitions, through `run` (the study runner: cached in the
+    design's folder, resumable)."""
+    from sim.reduced.slow_flow import host_mode as mode_of
+    from uq.engine.runner import Task
+
+    excitation = np.array([*problem.excitation, margin_level(problem)])
+    levels = levels_of(rig, excitation)
+    omega_1 = float(rig.omega[0])
+    mode = mode_of(rig)
     boxes = {s: corners(problem, s) for s in spheres}
-    tasks = [Task.make(p, L, rep) for s in spheres for p in boxes[s] for L in levels
-             for rep in range(problem.repetitions)]
-    results, _ = run_tasks(model, tasks, problem.seed, ResultStore(folder), jobs=jobs, scheduler=scheduler,
-                           progress=progress, client=client)
-    from sim.model.system import a_noabs_star
-
+    tasks = [Task.make(p, L, rep) for s in spheres for p in boxes[s] for L in levels for rep in range(problem.repetitions)]
+    results = run(tasks)
     out = []
+    n_op = len(problem.excitation)
     for s in spheres:
         value = np.empty((len(boxes[s]), levels.size))
         se = np.zeros_like(value)
-        apr = np.zeros(levels.size)
+        apr = np.zeros_like(value)
         for i, p in enumerate(boxes[s]):
-            for k, (L, a_base) in enumerate(zip(levels, problem.excitation)):
+            for k, L in enumerate(levels):
                 runs = [results[Task.make(p, L, rep)] for rep in range(problem.repetitions)]
-                scale = a_noabs_star(rig, a_base)  # the run's amplitudes are normalised by a_noabs* (Sect. 5)
-                metres = np.array([r["outputs"].get(amplitude, math.nan) if not r.get("error") else math.nan
-                                   for r in runs]) * scale
-                value[i, k] = metres.mean()
-                se[i, k] = metres.std(ddof=1) / math.sqrt(len(runs)) if len(runs) > 1 else 0.0
-                apr[k] += sum(r["outputs"].get("apr", 0.0) for r in runs if not r.get("error"))
-        low, high = value[:-1].min(axis=0), value[:-1].max(axis=0)
-        nominal = value[-1]
-        outside = (nominal > high + 2.0 * se[-1]) | (nominal < low - 2.0 * se[-1])
-        out.append(Verified(s, low, high, nominal, apr / (len(boxes[s]) * problem.repetitions), outside,
-                            len(boxes[s]) * levels.size * problem.repetitions))
+                values = np.array([objective.of_run(r, omega_1) for r in runs])
+                value[i, k] = values.mean()
+                se[i, k] = values.std(ddof=1) / math.sqrt(values.size) if values.size > 1 else 0.0
+                apr[i, k] = np.mean([r["outputs"].get("apr", 0.0) if not r.get("error") else 0.0 for r in runs])
+        low, high = value[:-1, :n_op].min(axis=0), value[:-1, :n_op].max(axis=0)
+        nominal = value[-1, :n_op]
+        outside = (nominal > high + 2.0 * se[-1, :n_op]) | (nominal < low - 2.0 * se[-1, :n_op])
+        onset = np.array([first_impacts(dataclasses.replace(mode, D=p["D"]), p["g"]) for p in boxes[s]])
+        out.append(Verified(s, low, high, nominal, apr[:, :n_op].mean(axis=0), outside,
+                            len(boxes[s]) * levels.size * problem.repetitions, point_apr=apr, point_onset=onset,
+                            margin_high=float(np.max(value[:, -1])), excitation=tuple(float(x) for x in excitation),
+                            prediction=(predictions or {}).get(s), round=round_))
     return out
 
 
+@dataclasses.dataclass
+class Search:
+    """The verification rounds of a design search: the designs of each round, and why it stopped."""
+
+    rounds: list[list[Sphere]] = dataclasses.field(default_factory=list)
+    stop: str = ""
+
+
+def search(problem: DesignProblem, predictor: Predictor, verify_batch: Callable[[list[Sphere], int], list[Verified]],
+           screened: Screened, *, log: Callable[[str], None] = lambda line: None) -> tuple[list[Verified], Search]:
+    """Stage 2 and 3, iterated: predict the spheres of the best screened designs, verify the `problem.candidates` best
+    predicted designs (and the baseline), then, round by round, the unverified neighbours (`neighbours`) of the best
+    verified design (`best_of`), until it has verified neighbours on every axis or the grid ends there. Returns the
+    verified designs (best first) and the rounds."""
+    grid = set(problem.grid())
+    fitting = [screened.designs[i] for i in np.argsort(screened.worst, kind="stable")
+               if np.isfinite(screened.worst[i]) and screened.designs[i] in grid]
+    spheres = list(dict.fromkeys((s.radius, s.material) for s in fitting))[: problem.candidates]
+    first_spheres = [s for s in fitting if (s.radius, s.material) in spheres]
+    predictor.ensure(first_spheres)
+    predictions = {s: predictor.predict(s) for s in first_spheres}
+    batch = ranked(problem, predictions)[: problem.candidates]
+    if problem.baseline is not None and problem.baseline not in batch:
+        predictor.ensure([problem.baseline])
+        batch.append(problem.baseline)
+    verified: dict[Sphere, Verified] = {}
+    trail = Search()
+    while batch:
+        log(f"round {len(trail.rounds) + 1}: verifying {len(batch)} design(s): "
+            + "; ".join(s.label() for s in batch))
+        for v in verify_batch(batch, len(trail.rounds)):
+            verified[v.sphere] = v
+        trail.rounds.append(list(batch))
+        on_grid = [v for v in verified.values() if v.sphere in grid]
+        if not on_grid:
+            trail.stop = "no design of the grid was verified"
+            break
+        best = best_of(problem, on_grid)[0]  # an off-grid baseline has no neighbours to walk to
+        around = neighbours(problem, best.sphere)
+        batch = [s for s in around if s not in verified]
+        if not batch:
+            trail.stop = (f"the best verified design ({best.sphere.label()}) has every neighbour on the grid verified"
+                          if around else f"the best verified design ({best.sphere.label()}) has no neighbour on the grid")
+    return best_of(problem, list(verified.values())), trail
 
 
 def run_design(problem: DesignProblem, out: Any, *, jobs: int | None = 1, scheduler: str | None = None,
                resume: bool = False, progress: bool = True, figures: bool = True, client: Any = None) -> DesignResult:
-    """Screen, verify and write a design into the folder `out` (design.csv, design.json, design-levels.csv, the
-    figures): checks everything before any simulation; `resume` continues an interrupted design."""
+    """Screen, predict, verify and write a design into the folder `out` (design.csv, design.json, design-levels.csv,
+    results.nc, the figures): checks everything before any simulation; `resume` continues an interrupted design. A
+    design range in which no design keeps the margin to the switch is one line (StudyError) naming the best margin;
+    the verified runs stay in `out`/tasks for a rerun with --resume."""
     from pathlib import Path
 
-    from uq.engine.runner import dask_client, prepare_output
+    from uq.engine.runner import ResultStore, dask_client, prepare_output, run_tasks
 
     problem.check()
+    check_size(problem)
+    objective = objective_named(problem.objective)
     model = verification_model(problem)
     mode = host_mode(host_model(problem))
     g_min = min(problem.clearances) + problem.clearance_tolerance[0]
@@ -161,18 +291,45 @@ def run_design(problem: DesignProblem, out: Any, *, jobs: int | None = 1, schedu
                          f"{micrometres(max(problem.excitation))} um (no impacts, the IES does nothing); impacts begin at "
                          f"a_base = {micrometres(start)} um for g = {g_min * 1e3:.3g} mm: raise the excitation or lower the "
                          "clearance")
+    verify_runs, reference_runs = first_runs(problem)
+    if progress:
+        sys.stderr.write(f"ies design: at least {verify_runs} runs to verify the first designs and up to {reference_runs} "
+                         "for the similarity references; each further round verifies the best design's neighbours\n")
     screened = screen_designs(problem, mode)
-    spheres = candidates(problem, screened)
     with dask_client(scheduler, client) as connected:
         model = model.with_rig()
         folder = prepare_output(Path(out), resume=resume, study=("design", design_key(problem, model)))
         model.warm_up()
-        verified = verify(problem, spheres, model, folder, jobs=jobs, scheduler=None, progress=progress,
-                          client=connected)
-    verified.sort(key=lambda v: v.worst)
-    rig = model.rig
+        store = ResultStore(folder)
+
+        def run(tasks: list[Any]) -> Mapping[Any, Any]:
+            return run_tasks(model, tasks, problem.seed, store, jobs=jobs, scheduler=None, progress=progress,
+                             client=connected)[0]
+
+        rig = model.rig
+        predictor = Predictor(problem, objective, rig, run)
+
+        def verify_batch(spheres: list[Sphere], round_: int) -> list[Verified]:
+            predictor.ensure(spheres)
+            return verify(problem, objective, spheres, rig, run, round_=round_,
+                          predictions={s: predictor.predict(s) for s in spheres})
+
+        log = (lambda line: sys.stderr.write(f"ies design: {line}\n")) if progress else (lambda line: None)
+        verified, trail = search(problem, predictor, verify_batch, screened, log=log)
+    top = max(problem.excitation)
+    if not verified[0].admissible(top, problem.margin):
+        best = verified[0]
+        raise StudyError(f"no design keeps a margin of {problem.margin:.0%} to the switch: the best, "
+                         f"{best.sphere.label()}, has {best.margin(top):.0%} (it switches at "
+                         f"{micrometres(best.switch_worst())} um at the box's worst corner, the range ends at "
+                         f"{micrometres(top)} um); lower the top of --excitation, allow larger clearances or a lower "
+                         f"--margin (the runs are kept in {folder}: rerun with --resume)")
     result = DesignResult(problem, screened, verified, folder, levels_of(rig, problem.excitation),
-                          no_absorber(rig, problem.excitation, min(problem.D)), [])
+                          no_absorber(rig, problem.excitation, min(problem.D)), [], objective=objective,
+                          similarity=predictor.describe(), rounds=trail.rounds, stop=trail.stop,
+                          predictions={s: predictor.predict(s) for s in screened.designs
+                                       if predictor.laws.get((s.radius, s.material)) is not None},
+                          reference_runs=predictor.runs, omega_1=float(mode.omega))
     result.files.extend(write_design(result, mode))
     if figures:
         from uq.design.figures import plot_design_curves, plot_design_map
@@ -183,13 +340,18 @@ def run_design(problem: DesignProblem, out: Any, *, jobs: int | None = 1, schedu
     return result
 
 
+#: settings that change how many designs are verified, not what a run computes: a design resumed with another value
+#: reuses every finished run
+UNKEYED = ("candidates", "margin", "allow_large")
+
+
 def design_key(problem: DesignProblem, model: Any) -> str:
-    """SHA-256 of the problem and the model's settings: `--resume` continues only the same design."""
+    """SHA-256 of the problem (but UNKEYED) and the model's settings: `--resume` continues only the same design."""
     import hashlib
     import json
 
     from uq.engine.runner import describe_model
 
-    text = json.dumps({"problem": dataclasses.asdict(problem), "model": describe_model(model)}, sort_keys=True,
-                      default=str)
+    settings = {k: v for k, v in dataclasses.asdict(problem).items() if k not in UNKEYED}
+    text = json.dumps({"problem": settings, "model": describe_model(model)}, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()

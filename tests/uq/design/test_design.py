@@ -1,13 +1,18 @@
-"""`ies design` (uq.design): end to end on a tiny stepped sine, resumable, identical serially and in parallel, and
-each bad input refused with one line, exit 2, nothing written (issue 28)."""
+"""`ies design` (uq.design): end to end on a tiny stepped sine, resumable, identical serially and in parallel; the
+search on analytic stand-ins (same recommendation whatever the first batch, neighbours on every axis, the margin);
+each bad input refused with one line, exit 2, nothing written; and a new objective added inside a test (one row)
+running `ies design` end to end."""
 import csv
 import json
+import math
+import time
 
 import numpy as np
 import pytest
 
-from uq.design import problem as dp, results as dr, search as ds
 from uq.cli import main
+from uq.design import objectives as do, prediction as dq, problem as dp, results as dr, search as ds
+from uq.errors import StudyError
 
 TINY = """[study]
 kind = "design"
@@ -27,6 +32,12 @@ hold = 0.2
 """
 
 
+#: one sphere, two clearances: the smallest design a search walks (the objective's extension test)
+SMALL = TINY.replace('clearance = "0.4mm:0.7mm:4"', 'clearance = "0.4mm:0.5mm:2"').replace(
+    'radius = "6mm:7.92mm:2"', 'radius = "7.92mm"').replace('material = "brass,tungsten"', 'material = "tungsten"').replace(
+    'baseline = "0.58mm,7.92mm,brass"\n', "")
+
+
 def exit_code(argv):
     """main's exit code, whether it returns it or argparse raises SystemExit."""
     try:
@@ -35,9 +46,9 @@ def exit_code(argv):
         return stop.code
 
 
-def tiny_study(tmp_path, name="tiny.toml"):
+def tiny_study(tmp_path, name="tiny.toml", text=TINY):
     path = tmp_path / name
-    path.write_text(TINY.format(out=tmp_path / "out"))
+    path.write_text(text.format(out=tmp_path / "out"))
     return path
 
 
@@ -47,34 +58,41 @@ def test_a_tiny_design_end_to_end_resumes_and_is_the_same_in_parallel(tmp_path, 
     assert main(["design", str(study), "--jobs", "1", "--quiet"]) == 0
     printed = capsys.readouterr().out
     out = tmp_path / "out"
-    assert {p.name for p in out.iterdir()} >= {"design.csv", "design.json", "design-levels.csv", "design-map.png",
-                                               "design-map.pdf", "design-curves.png", "design-curves.pdf", "tasks",
-                                               "results.nc"}
+    written = {p.name for p in out.iterdir()}
+    assert written >= {"design.csv", "design.json", "design-levels.csv", "design-map.png", "design-map.pdf",
+                       "design-curves.png", "design-curves.pdf", "tasks", "results.nc"}
+    # every file written is named, as every other command does
+    assert f"results in {out}/" in printed and all(f"  {name}\n" in printed for name in written - {"tasks"})
     data = json.loads((out / "design.json").read_text())
     assert set(data) == set(dr.DESIGN_KEYS)
     best = data["recommendation"]
-    assert printed.strip().splitlines()[-2].startswith("recommendation: clearance ")
-    assert best["sentence"] in printed
-    # the recommendation is verified and the best verified design; the baseline is verified too
-    worst = [v["worst_m"] for v in data["verified"]]
-    assert best["worst_m"] == min(worst) and data["baseline"]["worst_m"] >= best["worst_m"]
+    assert next(line for line in printed.splitlines() if line.startswith("recommendation: clearance "))
+    assert best["sentence"] in printed and "margin" in best["sentence"]
+    # the recommendation is verified, admissible, and the best admissible verified design; the baseline is verified too
+    admissible = [v for v in data["verified"] if v["admissible"]]
+    assert best["admissible"] and best["worst_m"] == min(v["worst_m"] for v in admissible)
+    assert best["margin_worst"] >= data["settings"]["margin"]
     assert data["baseline"]["clearance_m"] == pytest.approx(0.58e-3)
+    # every verified design has its prediction beside its verification, and its round
+    assert all(v["predicted_worst"] > 0 and v["switch_worst_m"] > 0 and v["round"] >= 0 for v in data["verified"])
+    assert data["search"]["rounds"][0] and data["search"]["stop"] and data["similarity"]
     with open(out / "design.csv") as f:
         rows = list(csv.DictReader(f))
     assert list(rows[0]) == list(dr.DESIGN_CSV.names)
     assert sum(r["status"] != "screened" for r in rows) == len(data["verified"])
     assert all(float(r["cavity_m"]) == pytest.approx(2 * (float(r["radius_m"]) + float(r["clearance_m"])))
                for r in rows)
+    assert all(r["margin_worst"] and r["switch_worst_m"] for r in rows if r["status"] != "screened")
     # results.nc holds the same numbers as design-levels.csv
     from uq.outputs.results import open_study
 
-    ds = open_study(out)
+    nc = open_study(out)
     with open(out / "design-levels.csv") as f:
-        levels = list(csv.DictReader(f))
-    assert ds["high"].values.ravel().tolist() == pytest.approx([float(r["high_m"]) for r in levels], rel=1e-12)
-    assert ds["high"].attrs["units"] == "m" and ds.attrs["recommendation"] == best["sentence"]
-    # every verified design: 8 corners + the centre, at 2 levels, 1 repetition
-    assert all(v["runs"] == 9 * 2 for v in data["verified"])
+        levels = [r for r in csv.DictReader(f) if r["role"] == "operating"]
+    assert nc["high"].values.ravel().tolist() == pytest.approx([float(r["high_m"]) for r in levels], rel=1e-12)
+    assert nc["high"].attrs["units"] == "m" and nc.attrs["recommendation"] == best["sentence"]
+    # every verified design: 8 corners + the centre, at 2 operating levels and the margin level, 1 repetition
+    assert all(v["runs"] == 9 * 3 for v in data["verified"])
     # the worst case is in metres: below the structure without IES at the top of the range
     assert best["worst_m"] < max(data["no_absorber"]["tip_m"])
     # --resume runs nothing again and gives the same numbers; in parallel too
@@ -84,6 +102,44 @@ def test_a_tiny_design_end_to_end_resumes_and_is_the_same_in_parallel(tmp_path, 
     assert main(["design", str(study), "--jobs", "2", "--quiet", "--out", str(tmp_path / "par"), "--no-figures"]) == 0
     parallel = json.loads((tmp_path / "par" / "design.json").read_text())
     assert parallel["verified"] == data["verified"]
+
+
+def rms_acceleration(record, omega_1):
+    """The toy objective's value of one run: the RMS of the tip's fundamental acceleration at the resonant frequency,
+    (eta omega_1)^2 |c_1| / sqrt(2), from the run's per-frequency trace (m/s^2)."""
+    if record.get("error") or "trace" not in record:
+        return math.nan
+    trace = record["trace"]
+    k = int(np.argmax(trace["mean"]))
+    return (trace["eta"][k] * omega_1) ** 2 * trace["mean"][k] * trace["a_noabs"] / math.sqrt(2.0)
+
+
+@pytest.mark.slow
+def test_a_new_objective_is_one_row_and_runs_ies_design_end_to_end(tmp_path, capsys, monkeypatch):
+    """The extension of the objective table: worst-case RMS tip acceleration, added here as one row (quantity,
+    statistic, unit, screening predictor), chosen by --objective; its values are the amplitude objective's own runs
+    times (eta omega_1)^2 / sqrt(2), so each design's worst case lies within the eta range's bounds of that."""
+    row = do.Objective("rms-acceleration", "RMS tip acceleration", "RMS of the fundamental at the resonant frequency",
+                       "m/s^2", "m/s^2", 1.0, rms_acceleration,
+                       lambda tip, omega_1: omega_1**2 * np.asarray(tip) / math.sqrt(2.0))
+    monkeypatch.setitem(do.OBJECTIVES, row.name, row)
+    study = tiny_study(tmp_path, text=SMALL)
+    assert main(["design", str(study), "--jobs", "1", "--quiet", "--no-figures", "--objective", "rms-acceleration",
+                 "--out", str(tmp_path / "acc")]) == 0
+    printed = capsys.readouterr().out
+    data = json.loads((tmp_path / "acc" / "design.json").read_text())
+    assert data["objective"]["unit"] == "m/s^2" and "m/s^2" in printed
+    assert data["recommendation"]["worst_m"] is None and data["recommendation"]["worst"] > 0
+    assert main(["design", str(study), "--jobs", "1", "--quiet", "--no-figures", "--out", str(tmp_path / "amp")]) == 0
+    amplitude = {(v["clearance_m"], v["radius_m"], v["material"]): v["worst"]
+                 for v in json.loads((tmp_path / "amp" / "design.json").read_text())["verified"]}
+    omega_1 = data["host"]["omega_1_rad_per_s"]
+    both = [(v["worst"], amplitude[key]) for v in data["verified"]
+            if (key := (v["clearance_m"], v["radius_m"], v["material"])) in amplitude]
+    assert both
+    for acceleration, tip in both:
+        assert 0.97**2 * omega_1**2 / math.sqrt(2) * tip * (1 - 1e-9) <= acceleration
+        assert acceleration <= 1.0**2 * omega_1**2 / math.sqrt(2) * tip * (1 + 1e-9)
 
 
 def test_ranges_read_units_counts_and_accelerations():
@@ -100,6 +156,7 @@ def test_ranges_read_units_counts_and_accelerations():
     (["--excitation", "8um:2um"], "the range is reversed"),
     (["--excitation", "2um:8um:0"], "COUNT must be >= 1"),
     (["--excitation", "2:8"], "has no unit"),
+    (["--excitation", "2um:8um", "--clearance", "1e-3m:2e-3:3"], "'2e-3' has no unit"),
     (["--excitation", "2m:8m"], "implausible"),
     (["--excitation", "2parsec:8um"], "unknown unit"),
     (["--excitation", "2um:8um", "--clearance=-0.5mm:1mm"], "must be > 0"),
@@ -110,13 +167,38 @@ def test_ranges_read_units_counts_and_accelerations():
     (["--excitation", "0.01um:0.02um"], "never reaches the clearance"),
     (["--excitation", "2um:8um", "--model", "nothere.toml"], "--model"),
     (["--clearance", "0.5mm"], "--excitation is required"),
+    (["--excitation", "2um:8um", "--margin", "0"], "--margin 0: give the margin"),
+    (["--excitation", "2um:8um", "--margin", "20"], "fraction in (0, 1]"),
+    (["--excitation", "2um:8um", "--margin", "much"], "--margin 'much'"),
+    (["--excitation", "2um:8um", "--min-wall", "20mm"], "two walls of 20 mm leave no room in the 28 mm block"),
+    (["--excitation", "2um:8um", "--objective", "loudness"], "--objective must be one of mean, max"),
+    (["--excitation", "0.66um:6.6um:100000000"], "COUNT 100000000 is more than 1000 values"),
+    (["--excitation", "1um:6um:1000", "--clearance", "0.1mm:0.5mm:1000", "--radius", "5mm:7mm:10"],
+     "more than the 2,000,000 the screening holds"),
+    (["--excitation", "0.66um:6.6um:1000", "--reps", "20"], "at most 20,000 without --allow-large: give fewer levels"),
 ])
 def test_each_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, args, phrase):
     out = tmp_path / "out"
+    started = time.perf_counter()
     assert exit_code(["design", *args, "--out", str(out), "--jobs", "1", "--quiet"]) == 2
     err = capsys.readouterr().err.strip()
-    assert phrase in err and len(err.splitlines()) == 1 and "Traceback" not in err
+    assert phrase in err and len(err.splitlines()) == 1 and "Traceback" not in err, err
     assert not out.exists()
+    assert time.perf_counter() - started < 30  # refused before any work
+
+
+def test_an_absurd_count_is_refused_at_once_with_its_cost():
+    started = time.perf_counter()
+    with pytest.raises(StudyError, match=r"2\.7e\+09 runs .* about .* years on one core"):
+        dp.parse_range("0.66um:6.6um:100000000", "excitation", count=10)
+    assert time.perf_counter() - started < 1.0
+
+
+def test_a_unitless_stop_is_refused_the_same_in_a_study_file(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[study]\nkind = "design"\n[design]\nexcitation = "2um:8um"\nclearance = "1e-3m:2e-3:3"\n')
+    assert exit_code(["design", str(bad), "--out", str(tmp_path / "o")]) == 2
+    assert "--clearance '1e-3m:2e-3:3': '2e-3' has no unit" in capsys.readouterr().err
 
 
 def test_a_study_file_with_an_unknown_key_or_kind_is_refused(tmp_path, capsys):
@@ -129,7 +211,7 @@ def test_a_study_file_with_an_unknown_key_or_kind_is_refused(tmp_path, capsys):
     assert 'kind must be "design"' in capsys.readouterr().err
 
 
-def test_the_screening_is_worst_over_the_damping_interval_and_ranks_designs():
+def test_the_screening_is_worst_over_the_damping_interval():
     problem = dp.DesignProblem(excitation=(2e-6, 6e-6), clearances=(0.3e-3, 0.58e-3), radii=(6e-3, 7.92e-3))
     mode = dp.host_mode(dp.host_model(problem))
     screened = ds.screen_designs(problem, mode)
@@ -137,8 +219,149 @@ def test_the_screening_is_worst_over_the_damping_interval_and_ranks_designs():
                                                    radii=problem.radii, D=(0.0009, 0.0009),
                                                    clearance_tolerance=(0.0, 0.0)), mode)
     assert np.all(screened.tip >= low_damping.tip - 1e-15)
-    chosen = ds.candidates(problem, screened)
-    assert chosen[0] == screened.designs[int(np.argmin(screened.worst))]
+
+
+# --- the search on analytic stand-ins ---------------------------------------------------------------------------
+
+TOP = 6.6e-6
+
+
+def true_switch(s):
+    """The stand-in's switch (m) at the box's worst corner: proportional to g (the similarity law), earlier for a
+    lighter sphere."""
+    return 11e-6 * (s.clearance / 1e-3) * (s.mass / 0.0177) ** 0.3
+
+
+def true_worst(s):
+    """The stand-in's verified worst case (m): below the switch it grows with g (the onset of impacts) and falls with
+    the sphere's mass; on the almost periodic side it is 5x higher."""
+    value = 0.2e-3 * (s.clearance / 0.7e-3) * (0.0177 / s.mass) ** 0.2
+    return value if true_switch(s) > TOP else 5.0 * value
+
+
+class StandInPredictor:
+    """A predictor whose switch is the true one within 3 % and whose worst case ranks the designs badly."""
+
+    def __init__(self):
+        self.built = []
+
+    def ensure(self, spheres):
+        self.built += [s for s in spheres if (s.radius, s.material) not in self.built]
+
+    def predict(self, s):
+        corner = dq.Corner(0.00075, 0.0, 1.0)
+        wrong = 0.3e-3 * (1.0 + 40.0 * (s.clearance - 1.0e-3) ** 2 / 1e-6)  # best predicted at 1 mm
+        return dq.DesignPrediction(s, np.full(3, wrong), true_switch(s) * 1.03, "found", corner,
+                                   true_switch(s) * 1.1, "found", (0.1e-3, 0.5e-3))
+
+
+def stand_in_verify(problem, calls):
+    def verify_batch(spheres, round_):
+        calls.append(list(spheres))
+        out = []
+        for s in spheres:
+            w = true_worst(s)
+            apr = np.zeros((9, len(problem.excitation) + 1))
+            if true_switch(s) <= TOP * (1 + problem.margin):
+                apr[0, -1] = 1.0  # a corner almost periodic at the margin level
+            out.append(dr.Verified(s, np.full(3, 0.5 * w), np.full(3, w), np.full(3, 0.8 * w), np.zeros(3),
+                                   np.zeros(3, bool), 81, point_apr=apr, margin_high=w,
+                                   excitation=(*problem.excitation, TOP * (1 + problem.margin)),
+                                   prediction=StandInPredictor().predict(s), round=round_))
+        return out
+    return verify_batch
+
+
+def stand_in_problem(**kw):
+    settings = dict(excitation=(2.2e-6, 4.4e-6, TOP), clearances=tuple(np.round(np.linspace(0.2e-3, 1.6e-3, 8), 9)),
+                    radii=(7.92e-3,), block_width=60e-3)
+    return dp.DesignProblem(**{**settings, **kw})
+
+
+def screened_of(problem):
+    """A screening that ranks the grid in reverse (the slow flow's weakness on an unseen host)."""
+    designs = problem.grid()
+    worst = np.array([-d.clearance - d.radius for d in designs])
+    return dr.Screened(designs, np.zeros((len(designs), 3)), np.zeros((len(designs), 3), object), np.zeros(len(designs)),
+                       worst, 0.0)
+
+
+@pytest.mark.parametrize("candidates", [1, 2, 3, 5, 8])
+def test_the_search_recommends_the_same_design_whatever_the_first_batch(candidates):
+    problem = stand_in_problem(candidates=candidates)
+    calls = []
+    verified, trail = ds.search(problem, StandInPredictor(), stand_in_verify(problem, calls), screened_of(problem))
+    best = verified[0]
+    admissible = [s for s in problem.grid() if true_switch(s) > TOP * (1 + problem.margin)]
+    assert best.sphere == min(admissible, key=true_worst)  # the brute-force optimum of the stand-in
+    assert best.admissible(TOP, problem.margin)
+    g = list(problem.clearances)
+    k = g.index(best.sphere.clearance)
+    verified_g = {v.sphere.clearance for v in verified}
+    assert g[k - 1] in verified_g and g[k + 1] in verified_g  # verified neighbours on both sides
+    assert len(calls[0]) == candidates and trail.stop
+
+
+def test_the_search_walks_every_axis_radius_and_material_included():
+    problem = stand_in_problem(radii=(6e-3, 7e-3, 7.92e-3), materials=("brass", "steel", "tungsten"), candidates=1)
+    calls = []
+    verified, _ = ds.search(problem, StandInPredictor(), stand_in_verify(problem, calls), screened_of(problem))
+    admissible = [s for s in problem.grid() if problem.fits(s) and true_switch(s) > TOP * (1 + problem.margin)]
+    assert verified[0].sphere == min(admissible, key=true_worst)
+    best = verified[0].sphere
+    seen = {v.sphere for v in verified}
+    assert all(n in seen for n in ds.neighbours(problem, best))
+    assert ds.material_axis(problem) == ["steel", "brass", "tungsten"]  # by density
+
+
+def test_neighbours_stay_on_the_grid_and_in_the_cavity():
+    problem = stand_in_problem(radii=(6e-3, 7.92e-3), materials=("brass", "tungsten"), block_width=28e-3)
+    s = dp.Sphere(problem.clearances[0], 6e-3, "brass")
+    around = ds.neighbours(problem, s)
+    assert dp.Sphere(problem.clearances[1], 6e-3, "brass") in around
+    assert dp.Sphere(problem.clearances[0], 7.92e-3, "brass") in around
+    assert dp.Sphere(problem.clearances[0], 6e-3, "tungsten") in around
+    assert all(problem.fits(n) for n in around) and len(around) == 3
+    assert ds.neighbours(problem, dp.Sphere(0.58e-3, 7.92e-3, "brass")) == []  # off the grid
+
+
+def test_admissible_needs_the_margin_and_no_almost_periodic_run_anywhere_in_the_box():
+    problem = stand_in_problem()
+    s = dp.Sphere(1.2e-3, 7.92e-3, "brass")
+    v = stand_in_verify(problem, [])([s], 0)[0]
+    assert v.admissible(TOP, 0.2) and v.margin(TOP) == pytest.approx(true_switch(s) * 1.03 / TOP - 1)
+    seen = dataclass_replace(v, point_apr=np.where(np.arange(4) == 1, 1.0, 0.0)[None, :].repeat(9, 0))
+    assert not seen.admissible(TOP, 0.2) and seen.switch_worst() == pytest.approx(problem.excitation[1])
+    assert seen.switch_kind() == "verified"
+    assert not v.admissible(TOP, v.margin(TOP) + 0.01)
+    # an almost periodic label below a point's first impacts (a rattle, no resonance of the IES) does not count
+    rattle = dataclass_replace(seen, point_onset=np.full(9, problem.excitation[1] * 1.01))
+    assert rattle.admissible(TOP, 0.2) and rattle.apr_seen_at() == math.inf
+
+
+def dataclass_replace(obj, **changes):
+    import dataclasses
+
+    return dataclasses.replace(obj, **changes)
+
+
+def test_no_admissible_design_is_one_line_naming_the_best_margin(tmp_path, monkeypatch, capsys):
+    """A range in which every design switches: one line with the best margin and where it switches, exit 2; the
+    finished runs stay for --resume."""
+    def no_design_keeps_it(problem, predictor, verify_batch, screened, log=None):
+        s = problem.grid()[-1]
+        v = stand_in_verify(problem, [])([s], 0)[0]
+        return [dataclass_replace(v, point_apr=np.ones_like(v.point_apr))], ds.Search([[s]], "stand-in")
+
+    monkeypatch.setattr(ds, "search", no_design_keeps_it)
+    monkeypatch.setattr(dq.Predictor, "describe", lambda self: [])
+    out = tmp_path / "out"
+    code = exit_code(["design", "--excitation", "2um:8um:2", "--clearance", "0.3mm:0.5mm:2", "--out", str(out),
+                      "--quiet", "--jobs", "1", "--reps", "1"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1, err
+    assert "no design keeps a margin of 20% to the switch: the best, g 0.500 mm" in err and "switches at 2 um" in err
+    assert "--resume" in err and not (out / "design.json").exists()
 
 
 def test_a_host_whose_first_mode_does_not_move_the_walls_is_refused(tmp_path, capsys):
@@ -171,3 +394,17 @@ def test_a_calibration_sets_the_upper_end_of_the_k_H_factor(tmp_path, capsys):
     soft.write_text(json.dumps({"k_H": 0.9 * K_H_STAR}))
     assert exit_code(["design", "--excitation", "2um:8um", "--calibration", str(soft), "--out", str(tmp_path / "o")]) == 2
     assert "a crater should stiffen the contact" in capsys.readouterr().err
+
+
+def test_the_box_is_its_distinct_corners_and_its_centre():
+    problem = dp.DesignProblem(excitation=(2e-6,), clearances=(0.5e-3,), radii=(7.92e-3,))
+    sphere = dp.Sphere(0.5e-3, 7.92e-3, "brass")
+    points = ds.corners(problem, sphere)
+    corners = {dq.corner_of(p, sphere) for p in points[:-1]}
+    assert len(points) == 9 and len(corners) == 8
+    ends = [(D, t, f) for D in problem.D for t in problem.clearance_tolerance for f in problem.k_H_factor]
+    assert all(min(abs(c.D - D) + abs(c.tolerance - t) + abs(c.k_H_factor - f) for D, t, f in ends) < 1e-12
+               for c in corners)
+    centre = dq.corner_of(points[-1], sphere)
+    assert centre.D == pytest.approx(0.5 * sum(problem.D)) and centre.k_H_factor == pytest.approx(
+        0.5 * sum(problem.k_H_factor)) and points[-1]["g"] == pytest.approx(0.5e-3 + 0.016e-3)
