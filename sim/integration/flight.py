@@ -308,8 +308,10 @@ def free_flight(Y, Ynew, tau, md):
     _fly_sphere(Y, Ynew, tau, lay)
 
 
-# time maps of a contact step, t = t_a + h w(u) with u in [0, 1] (`time_map`)
-ONSET, REGULAR, RELEASE, GRAZE = 0, 1, 2, 3
+# time maps of a contact step, t = t_a + h w(u) with u in [0, 1] (`time_map`). numpy integers, not Python ones: a
+# kernel called with a Python constant is compiled once more for that literal value (numba's Literal[int]), which
+# doubled the exact integrator's compile time for no measurable speed.
+ONSET, REGULAR, RELEASE, GRAZE = (np.int64(kind) for kind in range(4))
 
 
 @kernel(inline="always")
