@@ -11,8 +11,8 @@ system it cannot run with one line; the commands' options and help are built fro
 is writing its module and one `INTEGRATORS` row.
 
 The kernels are numba functions cached on disk (`sim.integration.jit`: in the per-user kernel cache, one folder per
-version of their sources). The first run of a version of the code on a machine compiles them, which takes a minute
-or more; `warm_up` does it before a command's progress bar starts (so that the bar's rate and ETA measure simulation
+version of their sources). The first run of a version of the code on a machine compiles them, which takes about a
+minute (each form of the kernels in a process of its own where there are cores: `compile_in_children`); `warm_up` does it before a command's progress bar starts (so that the bar's rate and ETA measure simulation
 only) and says so while it happens, with an estimate of how long: a small test compilation (`compile_probe_s`, about
 a second) measures this machine's speed and present load, and the reference times of COMPILE_S_QUIET scale with it.
 """
@@ -21,7 +21,6 @@ from __future__ import annotations
 import contextlib
 import functools
 import importlib
-import io
 import os
 import subprocess
 import sys as _sys
@@ -114,6 +113,11 @@ def get_integrator(name: str, *, dt_scale: float | None = None) -> RunStep:
 #: entry kernels), measured by tests/benchmarks/test_cold_compile.py together with PROBE_S_QUIET
 COMPILE_S_QUIET = {name: record.compile_s_quiet for name, record in INTEGRATORS.items()}
 FURTHER_LAW_SHARE = 0.5
+#: the forms numba compiles each kernel in: without the energy ledger (lead-in, wait) and with it (hold, Eq. 9's
+#: terms); each has its own specialisations of the entry kernels, so they compile in parallel, and FORM_SHARE is the
+#: share of COMPILE_S_QUIET one form alone takes (the kernels both call are compiled by each: 54 s of 84 s measured)
+FORMS = ("plain", "ledger")
+FORM_SHARE = 0.65
 #: seconds `compile_probe_s` takes on the same quiet machine
 PROBE_S_QUIET = 0.75
 #: seconds after which `warm_up` says that it is compiling where it did not expect to (kernels it thought cached);
@@ -157,12 +161,16 @@ def compile_probe_s() -> float:
 def compile_estimate_s(laws: dict[str, list[str]], *, probe_s: float | None = None, cores: int | None = None) -> float:
     """Estimated seconds to compile the kernels of the integrators `laws` names, each for its list of contact laws,
     from COMPILE_S_QUIET scaled by this machine's speed against the quiet reference (`compile_probe_s` /
-    PROBE_S_QUIET). Integrators compile in parallel, one process each, while there are cores for them."""
+    PROBE_S_QUIET). With more than one core every (integrator, form) compiles in a process of its own
+    (`compile_in_children`), each taking FORM_SHARE of its integrator's time, in parallel while there are cores."""
     scale = (compile_probe_s() if probe_s is None else probe_s) / PROBE_S_QUIET
     each = [COMPILE_S_QUIET.get(name, max(COMPILE_S_QUIET.values())) * (1.0 + FURTHER_LAW_SHARE * (len(names) - 1))
             for name, names in laws.items()]
     cores = cores or os.cpu_count() or 1
-    return scale * max(max(each), sum(each) / min(cores, len(each)))
+    if cores == 1:
+        return scale * sum(each)
+    jobs = [share * FORM_SHARE for share in each for _ in FORMS]
+    return scale * max(max(jobs), sum(jobs) / min(cores, len(jobs)))
 
 
 def cached(name: str, law: str = "hertz") -> bool:
@@ -175,12 +183,12 @@ def cached(name: str, law: str = "hertz") -> bool:
     return folder is not None and any(folder.glob(f"{stem}.*.nbi"))
 
 
-def _run_tiny_system(run_step: RunStep, *, law: str = "hertz") -> None:
+def _run_tiny_system(run_step: RunStep, *, law: str = "hertz", forms: Iterable[str] = FORMS) -> None:
     """Short runs of a tiny impacting system (2 modes, the sphere sent into a wall) in every form a stepped-sine
     run calls the integrator (`sim.stepped_sine.protocol.run_sweep`): without the energy ledger (lead-in, wait)
     and with it (hold), with the contact law `law` (a name of `sim.model.contact_law.LAWS`; a law that takes r_cont
     with r_cont = 0.9). numba compiles one specialisation per form and law, so each kernel a worker will call is
-    compiled (or loaded) here, in the parent."""
+    compiled (or loaded) here, in the parent. forms: those of FORMS to run."""
     from sim.integration.energy import Ledger
     from sim.model.contact_law import contact_law_of, law_named
 
@@ -190,13 +198,13 @@ def _run_tiny_system(run_step: RunStep, *, law: str = "hertz") -> None:
                        beam_mass=1.0)
     contact = contact_law_of(law, 0.9 if law_named(law).takes_r_cont else None)
     sys = system_arrays(model, Impactor(contact_law=contact))
-    for ledger in (None, Ledger()):
+    for form in forms:
         y = np.zeros(2 * model.n_modes + 2)
         y[-1] = 0.5  # m/s: the sphere meets a wall within the first period
-        if ledger is None:
+        if form == "plain":
             run_step(y, 3, 2.0 * np.pi * 100.0, 1e-5, sys, None)
         else:
-            run_step(y, 3, 2.0 * np.pi * 100.0, 1e-5, sys, None, ledger=ledger)
+            run_step(y, 3, 2.0 * np.pi * 100.0, 1e-5, sys, None, ledger=Ledger())
 
 
 def _notice(what: str, estimate_s: float) -> str:
@@ -240,50 +248,56 @@ def warm_up(name: str, *, law: str = "hertz", stream: TextIO | None = None) -> f
     """Compile (or load from numba's on-disk cache) the kernels of the integrator `name` in this process by one
     short run of a tiny system, before any timed or progress-reported work. When that takes longer than
     NOTICE_AFTER_S (a cold cache), one line ``compiling ... (once per version of the code on this machine; about N s
-    here ...) ...`` goes to `stream` (stderr) while it happens, and one line with the time when it is done. Returns the seconds spent
-    (0 when this process has warmed the integrator with this law before). law: the run's contact law (its name in
-    `sim.model.contact_law.LAWS`; the kernels are compiled per law)."""
-    if (name, law) in _WARM:
-        return 0.0
-    run_step = get_integrator(name)
-    started = time.perf_counter()
-    with _announced(f"the {name} integrator's kernels", {name: [law]}, stream or _sys.stderr):
-        _run_tiny_system(run_step, law=law)
-    _WARM.add((name, law))
-    return time.perf_counter() - started
-
-
-#: what a compiling child process runs: warm the integrator argv[1] for each law argv[2:]
-_CHILD = "import sys; from sim.integration.integrators import warm_up; [warm_up(sys.argv[1], law=law) for law in sys.argv[2:]]"
+    here ...) ...`` goes to `stream` (stderr) while it happens, and one line with the time when it is done. Returns the
+    seconds spent (0 when this process has warmed the integrator with this law before). law: the run's contact law
+    (its name in `sim.model.contact_law.LAWS`; the kernels are compiled per law)."""
+    return warm_up_all([(name, law)], stream=stream)
 
 
 def warm_up_all(pairs: Iterable[tuple[str, str]], *, stream: TextIO | None = None) -> float:
-    """`warm_up` every (integrator, law) of `pairs` in this process. With several integrators to warm and several
-    cores, their kernels are first compiled in parallel, one child process per integrator (into numba's on-disk
-    cache, so this process then only loads them): a first run's compilation then takes about as long as its
-    slowest integrator's instead of the sum. Returns the seconds spent."""
+    """`warm_up` every (integrator, law) of `pairs` in this process. Kernels the cache lacks are first compiled in
+    parallel where there are several cores (`compile_in_children`), so that this process then only loads them: a
+    first run's compilation takes about as long as its slowest form instead of the sum. Returns the seconds spent."""
     pending = [pair for pair in dict.fromkeys(pairs) if pair not in _WARM]
     if not pending:
         return 0.0
-    stream = stream or _sys.stderr
-    started = time.perf_counter()
     laws: dict[str, list[str]] = {}
     for name, law in pending:
         laws.setdefault(name, []).append(law)
-    with _announced(f"the kernels of {', '.join(laws)}", laws, stream):
-        if len(laws) > 1 and (os.cpu_count() or 1) > 1:
-            for name in laws:
-                get_integrator(name)  # imports the kernels: a stale cache is discarded here, once (`sim.integration.jit`)
-            root = str(Path(__file__).resolve().parents[2])
-            env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))}
-            children = [subprocess.Popen([_sys.executable, "-c", _CHILD, name, *names], env=env,
-                                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-                        for name, names in laws.items()]
-            for child in children:  # a child that fails leaves the work to this process, which reports any error
-                child.wait()
+    runs = {name: get_integrator(name) for name in laws}  # refuses an unknown name; a stale cache is discarded here
+    started = time.perf_counter()
+    what = f"the {pending[0][0]} integrator's kernels" if len(laws) == 1 else f"the kernels of {', '.join(laws)}"
+    with _announced(what, laws, stream or _sys.stderr):
+        cold = {name: names for name, names in laws.items() if not cached(name)}
+        if cold and (os.cpu_count() or 1) > 1:
+            compile_in_children(cold)
         for name, law in pending:
-            warm_up(name, law=law, stream=io.StringIO())
+            _run_tiny_system(runs[name], law=law)
+            _WARM.add((name, law))
     return time.perf_counter() - started
+
+
+#: what a compiling child process runs: the integrator argv[1] in the form argv[2] (of FORMS) for each law argv[3:]
+_CHILD = ("import sys; from sim.integration import integrators as i; "
+          "[i._run_tiny_system(i.get_integrator(sys.argv[1]), law=law, forms=(sys.argv[2],)) for law in sys.argv[3:]]")
+
+
+def compile_in_children(laws: dict[str, list[str]]) -> None:
+    """Compile the kernels of each integrator of `laws` for its contact laws into the kernel cache, one child process
+    per (integrator, form of FORMS), all at once, and wait for them. A child that fails leaves its work to the caller,
+    which compiles what it does not find and reports any error; an interrupt stops the children."""
+    root = str(Path(__file__).resolve().parents[2])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))}
+    children = [subprocess.Popen([_sys.executable, "-c", _CHILD, name, form, *names], env=env,
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                for name, names in laws.items() for form in FORMS]
+    try:
+        for child in children:
+            child.wait()
+    finally:
+        for child in children:
+            if child.poll() is None:
+                child.kill()
 
 
 #: integrators warmed up in this process (the kernels' argument types do not depend on dt_scale)

@@ -40,27 +40,72 @@ def test_a_cold_cache_says_so_at_once_with_a_measured_estimate(monkeypatch):
     on this machine (twice as slow as the quiet reference: twice the reference time)."""
     stream = io.StringIO()
     said_before = []
+    children = []
     monkeypatch.setattr(integrators, "cached", lambda name, law="hertz": False)
     monkeypatch.setattr(integrators, "compile_probe_s", lambda: 2.0 * integrators.PROBE_S_QUIET)
+    monkeypatch.setattr(integrators, "compile_in_children", children.append)
+    monkeypatch.setattr(integrators.os, "cpu_count", lambda: 1)
     monkeypatch.setattr(integrators, "_run_tiny_system", lambda run_step, law: said_before.append(stream.getvalue()))
     integrators.warm_up("ode3", stream=stream)
-    expected = 2.0 * integrators.COMPILE_S_QUIET["ode3"]
+    expected = 2.0 * integrators.COMPILE_S_QUIET["ode3"]  # one core: the forms one after the other
+    assert children == []
     assert said_before == [integrators._notice("the ode3 integrator's kernels", expected)]
     assert f"about {expected:.0f} s here" in said_before[0]
     assert stream.getvalue().splitlines()[-1].startswith("kernels compiled in ")
 
 
 def test_the_estimate_adds_laws_and_shares_the_cores():
-    reference = integrators.COMPILE_S_QUIET
-    one = integrators.compile_estimate_s({"exact": ["hertz"]}, probe_s=integrators.PROBE_S_QUIET)
+    reference, share, quiet = integrators.COMPILE_S_QUIET, integrators.FORM_SHARE, integrators.PROBE_S_QUIET
+    one = integrators.compile_estimate_s({"exact": ["hertz"]}, probe_s=quiet, cores=1)
     assert one == pytest.approx(reference["exact"])
-    two_laws = integrators.compile_estimate_s({"exact": ["hertz", "hertz-damped"]}, probe_s=integrators.PROBE_S_QUIET)
+    two_laws = integrators.compile_estimate_s({"exact": ["hertz", "hertz-damped"]}, probe_s=quiet, cores=1)
     assert two_laws == pytest.approx(reference["exact"] * (1 + integrators.FURTHER_LAW_SHARE))
+    # two cores: the two forms of one integrator at once; two integrators' four forms share them
+    assert integrators.compile_estimate_s({"exact": ["hertz"]}, probe_s=quiet, cores=2) == pytest.approx(
+        reference["exact"] * share)
     both = {"exact": ["hertz"], "ode3": ["hertz"]}
-    assert integrators.compile_estimate_s(both, probe_s=integrators.PROBE_S_QUIET, cores=2) == pytest.approx(
-        reference["exact"])  # in parallel
-    assert integrators.compile_estimate_s(both, probe_s=integrators.PROBE_S_QUIET, cores=1) == pytest.approx(
+    assert integrators.compile_estimate_s(both, probe_s=quiet, cores=2) == pytest.approx(
+        (reference["exact"] + reference["ode3"]) * share)
+    assert integrators.compile_estimate_s(both, probe_s=quiet, cores=1) == pytest.approx(
         reference["exact"] + reference["ode3"])
+
+
+def test_a_cold_cache_compiles_each_form_in_a_child_of_its_own(monkeypatch):
+    """Several cores: one child per (integrator, form), started at once, before this process loads the kernels."""
+    started, order = [], []
+
+    class Child:
+        def __init__(self, argv, **options):
+            started.append(argv[3:])
+
+        def wait(self):
+            order.append("waited")
+
+        def poll(self):
+            return 0
+
+    monkeypatch.setattr(integrators.subprocess, "Popen", Child)
+    monkeypatch.setattr(integrators, "cached", lambda name, law="hertz": False)
+    monkeypatch.setattr(integrators.os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(integrators, "_run_tiny_system", lambda run_step, law: order.append("loaded"))
+    integrators.warm_up_all([("exact", "hertz"), ("exact", "hertz-damped"), ("ode3", "hertz")], stream=io.StringIO())
+    assert started == [["exact", "plain", "hertz", "hertz-damped"], ["exact", "ledger", "hertz", "hertz-damped"],
+                       ["ode3", "plain", "hertz"], ["ode3", "ledger", "hertz"]]
+    assert order == ["waited"] * 4 + ["loaded"] * 3
+
+
+def test_a_compiling_child_runs_its_form():
+    """The child's program itself (the session's kernels are cached, so it only loads them)."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(integrators.__file__).resolve().parents[2]
+    for form in integrators.FORMS:
+        done = subprocess.run([sys.executable, "-c", integrators._CHILD, "exact", form, "hertz"], capture_output=True,
+                              text=True, env={**os.environ, "PYTHONPATH": str(root)})
+        assert done.returncode == 0, done.stderr[-2000:]
 
 
 def test_the_probe_compiles_afresh_each_time():
