@@ -58,10 +58,19 @@ def level_list(text: str) -> tuple[float, ...]:
 
 def positive_int(text: str) -> int:
     """An integer >= 1."""
+    return _int_from(text, 1, "a positive integer (1 or more)")
+
+
+def count(text: str) -> int:
+    """An integer >= 0."""
+    return _int_from(text, 0, "an integer >= 0")
+
+
+def _int_from(text: str, least: int, what: str) -> int:
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a positive integer (1 or more), got {value}")
+        raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}") from None
+    if value < least:
+        raise argparse.ArgumentTypeError(f"must be {what}, got {value}")
     return value

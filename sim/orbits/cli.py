@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from sim.common.errors import SimulationInputError
-from sim.common.options import figure_file
+from sim.common.options import count, figure_file
 
 def _period_multiple(text: str) -> int:
     from sim.orbits.shooting import MAX_PERIOD_MULTIPLE
@@ -27,16 +27,6 @@ def _period_multiple(text: str) -> int:
     if not 1 <= value <= MAX_PERIOD_MULTIPLE:
         raise argparse.ArgumentTypeError(f"must be an integer in 1..{MAX_PERIOD_MULTIPLE} (the period multiple k of "
                                          f"a kT orbit), got {value}")
-    return value
-
-
-def _count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {value}")
     return value
 
 
@@ -62,7 +52,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"the slow flow's modal restitution r for the slow-flow start (default {DEFAULT_RESTITUTION})")
     parser.add_argument("--max-period", dest="max_period", type=_period_multiple, default=2, metavar="K",
                         help="largest period multiple k of a kT orbit found by period doubling (default 2, at most 8)")
-    parser.add_argument("--switches", type=_count, default=2, metavar="N",
+    parser.add_argument("--switches", type=count, default=2, metavar="N",
                         help="branch switchings at symmetry-breaking and period-doubling points, those nearest to a "
                              "stable orbit first (default 2; 0: the start's branch only)")
     parser.add_argument("--integrator", default="exact", choices=("exact", "ode3"),
