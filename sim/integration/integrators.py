@@ -269,12 +269,20 @@ def warm_up_all(pairs: Iterable[tuple[str, str]], *, stream: TextIO | None = Non
     what = f"the {pending[0][0]} integrator's kernels" if len(laws) == 1 else f"the kernels of {', '.join(laws)}"
     with _announced(what, laws, stream or _sys.stderr):
         cold = {name: names for name, names in laws.items() if not cached(name)}
-        if cold and (os.cpu_count() or 1) > 1:
+        if cold and (os.cpu_count() or 1) > 1 and _shared_cache():
             compile_in_children(cold)
         for name, law in pending:
             _run_tiny_system(runs[name], law=law)
             _WARM.add((name, law))
     return time.perf_counter() - started
+
+
+def _shared_cache() -> bool:
+    """Whether child processes can hand their kernels to this one: a kernel cache folder exists (not where no
+    folder can be written, `sim.common.kernel_cache`; there the children would compile for nothing)."""
+    from sim.integration import jit
+
+    return jit.cache_folder() is not None
 
 
 #: what a compiling child process runs: the integrator argv[1] in the form argv[2] (of FORMS) for each law argv[3:]

@@ -93,6 +93,13 @@ def test_a_cold_cache_compiles_each_form_in_a_child_of_its_own(monkeypatch):
                        ["ode3", "plain", "hertz"], ["ode3", "ledger", "hertz"]]
     assert order == ["waited"] * 4 + ["loaded"] * 3
 
+    # where no kernel cache folder can be written the children could hand nothing over: this process compiles alone
+    started.clear()
+    monkeypatch.setattr(integrators, "_WARM", set())
+    monkeypatch.setattr(integrators, "_shared_cache", lambda: False)
+    integrators.warm_up("exact", stream=io.StringIO())
+    assert started == []
+
 
 def test_a_compiling_child_runs_its_form():
     """The child's program itself (the session's kernels are cached, so it only loads them)."""
