@@ -12,9 +12,10 @@ is writing its module and one `INTEGRATORS` row.
 
 The kernels are numba functions cached on disk (`sim.integration.jit`: in the per-user kernel cache, one folder per
 version of their sources). The first run of a version of the code on a machine compiles them, which takes about a
-minute (each form of the kernels in a process of its own where there are cores: `compile_in_children`); `warm_up` does it before a command's progress bar starts (so that the bar's rate and ETA measure simulation
-only) and says so while it happens, with an estimate of how long: a small test compilation (`compile_probe_s`, about
-a second) measures this machine's speed and present load, and the reference times of COMPILE_S_QUIET scale with it.
+minute (each form of the kernels in a process of its own where there are cores: `compile_in_children`); `warm_up`
+does it before a command's progress bar starts (so that the bar's rate and ETA measure simulation only) and says so
+while it happens, with an estimate of how long: a small test compilation (`compile_probe_s`, about a second)
+measures this machine's speed and present load, and the reference times of COMPILE_S_QUIET scale with it.
 """
 from __future__ import annotations
 
@@ -226,12 +227,13 @@ def _announced(what: str, laws: dict[str, list[str]], stream: TextIO) -> Iterato
         stream.flush()
 
     cold = not all(cached(name) for name in laws)
-    if cold:
-        say_so(compile_estimate_s(laws))
+    if cold:  # compiled in children where they can hand their kernels over (`warm_up_all`), else here
+        say_so(compile_estimate_s(laws, cores=None if _shared_cache() else 1))
     # unexpected (e.g. a law compiled for the first time): no test compilation while numba holds its lock; the quiet
     # reference scaled by the load
     load = os.getloadavg()[0] / (os.cpu_count() or 1) if hasattr(os, "getloadavg") else 1.0
-    notice = threading.Timer(NOTICE_AFTER_S, say_so, args=(compile_estimate_s(laws, probe_s=PROBE_S_QUIET * max(1.0, load)),))
+    expected = compile_estimate_s(laws, probe_s=PROBE_S_QUIET * max(1.0, load), cores=1)  # here, in this process
+    notice = threading.Timer(NOTICE_AFTER_S, say_so, args=(expected,))
     started = time.perf_counter()
     if not cold:
         notice.start()
