@@ -306,7 +306,7 @@ def build_protocol(args: argparse.Namespace) -> Any:
     from sim.integration.integrators import integrator_named
     from sim.stepped_sine.protocol import SteppedSine
 
-    integrator_named(args.integrator).run_step(dt_scale=args.dt_scale)  # a step scale it does not take: one line now
+    integrator_named(args.integrator).check_dt_scale(args.dt_scale)
     start, stop, n = parse_grid(args.eta, "--eta")
     wait = args.wait if args.wait is not None else (15.0 if args.no_impactor else 3.0)
     return SteppedSine(eta_start=start, eta_stop=stop, n_eta=n, sequence=args.sequence, wait=wait,
@@ -589,7 +589,7 @@ def cache_command(args: argparse.Namespace) -> int:
     from sim.integration import jit
 
     root, chosen_by = kernel_cache.cache_root()
-    current = f"{jit.CACHE_GROUP}-{jit.fingerprint()[:16]}"
+    current = kernel_cache.folder_name(jit.CACHE_GROUP, jit.fingerprint())
     if args.clear:
         removed, freed = kernel_cache.clear(root)
         left = kernel_cache.version_folders(root)
@@ -612,8 +612,8 @@ def cache_command(args: argparse.Namespace) -> int:
     print(f"kernel cache: {root} ({chosen_by}{moved})")
     labels = {"sim": "simulator", "bem_contact": "contact solver", "scans": "scan resampling"}
     for entry in folders:
-        what = labels.get(entry.group, entry.group) + (
-            {True: " (this version)", False: " (another version)"}[entry.path.name == current] if entry.group == "sim" else "")
+        version = " (this version)" if entry.path.name == current else " (another version)"
+        what = labels.get(entry.group, entry.group) + (version if entry.group == "sim" else "")
         print(f"  {entry.path.name:<30} {_megabytes(entry.size):>9} {entry.files:>5} files  {what}, last used "
               f"{_ago(now - entry.last_used)}")
     if not folders:

@@ -100,12 +100,21 @@ def _prune(root: Path, group: str, keep: str) -> None:
         match = _VERSION_FOLDER.match(folder.name)
         if not match or match["group"] != group or folder.name == keep:
             continue
-        try:
-            used = (folder / LAST_USED).stat().st_mtime
-        except OSError:
-            used = folder.stat().st_mtime
-        if used < cutoff:
+        if _last_used(folder) < cutoff:
             _remove_version_folder(folder)
+
+
+def _last_used(folder: Path) -> float:
+    """When a process last used the version folder (its LAST_USED mark, else the folder's own time), epoch s."""
+    try:
+        return (folder / LAST_USED).stat().st_mtime
+    except OSError:
+        return folder.stat().st_mtime
+
+
+def folder_name(group: str, code_hash: str) -> str:
+    """The name of `group`'s version folder for sources with SHA-256 `code_hash`."""
+    return f"{group}-{code_hash[:16]}"
 
 
 _said_fallback = False
@@ -116,7 +125,7 @@ def version_folder(group: str, code_hash: str) -> Path | None:
     """The folder of `group`'s kernels compiled from sources with SHA-256 `code_hash`, made if needed (and marked
     as used); None where neither the cache root nor the temporary fallback can be written."""
     global _said_fallback
-    name = f"{group}-{code_hash[:16]}"
+    name = folder_name(group, code_hash)
     root, _ = cache_root()
     for candidate in (root, _fallback_root()):
         folder = candidate / name
@@ -221,11 +230,8 @@ def version_folders(root: Path | None = None) -> list[VersionFolder]:
         if not (match and folder.is_dir()):
             continue
         files = [path for path in folder.iterdir() if path.is_file()]
-        try:
-            used = (folder / LAST_USED).stat().st_mtime
-        except OSError:
-            used = folder.stat().st_mtime
-        found.append(VersionFolder(folder, match["group"], sum(path.stat().st_size for path in files), len(files), used))
+        found.append(VersionFolder(folder, match["group"], sum(path.stat().st_size for path in files), len(files),
+                                   _last_used(folder)))
     return sorted(found, key=lambda entry: -entry.last_used)
 
 
@@ -244,14 +250,11 @@ def _remove_version_folder(folder: Path) -> int:
     return freed
 
 
-def clear(root: Path | None = None, *, keep: Iterable[Path] = ()) -> tuple[int, int]:
-    """Delete the version folders in `root` (default: `cache_root`) except those in `keep`; returns (folders,
-    bytes) removed. Only the files numba and this module write are deleted; a folder holding anything else stays."""
-    keep = {Path(path).resolve() for path in keep}
+def clear(root: Path | None = None) -> tuple[int, int]:
+    """Delete the version folders in `root` (default: `cache_root`); returns (folders, bytes) removed. Only the files
+    numba and this module write are deleted; a folder holding anything else stays."""
     removed = freed = 0
     for entry in version_folders(root):
-        if entry.path.resolve() in keep:
-            continue
         freed += _remove_version_folder(entry.path)
         removed += not entry.path.exists()
     version_folder.cache_clear()

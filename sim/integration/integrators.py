@@ -56,13 +56,17 @@ class Integrator:
 
     def run_step(self, *, dt_scale: float | None = None) -> RunStep:
         """Its `run_step`, with ``dt_scale`` bound if given (one line if it takes none)."""
+        self.check_dt_scale(dt_scale)
         run_step = importlib.import_module(self.module).run_step
         if dt_scale is None or dt_scale == 1.0:
             return run_step
-        if not self.dt_scale:
+        return functools.partial(run_step, dt_scale=float(dt_scale))
+
+    def check_dt_scale(self, dt_scale: float | None) -> None:
+        """One line (SimulationInputError) if a step scale other than 1 is asked of an integrator that takes none."""
+        if dt_scale is not None and dt_scale != 1.0 and not self.dt_scale:
             scaled = ", ".join(i.name for i in INTEGRATORS.values() if i.dt_scale)
             raise SimulationInputError(f"dt_scale applies only to {scaled}, not to {self.name!r}")
-        return functools.partial(run_step, dt_scale=float(dt_scale))
 
     def supports(self, law: str) -> bool:
         """Whether it runs the contact law `law` (a name of `sim.model.contact_law.LAWS`)."""
@@ -165,7 +169,7 @@ def compile_estimate_s(laws: dict[str, list[str]], *, probe_s: float | None = No
     PROBE_S_QUIET). With more than one core every (integrator, form) compiles in a process of its own
     (`compile_in_children`), each taking FORM_SHARE of its integrator's time, in parallel while there are cores."""
     scale = (compile_probe_s() if probe_s is None else probe_s) / PROBE_S_QUIET
-    each = [COMPILE_S_QUIET.get(name, max(COMPILE_S_QUIET.values())) * (1.0 + FURTHER_LAW_SHARE * (len(names) - 1))
+    each = [COMPILE_S_QUIET[name] * (1.0 + FURTHER_LAW_SHARE * (len(names) - 1))
             for name, names in laws.items()]
     cores = cores or os.cpu_count() or 1
     if cores == 1:
@@ -174,7 +178,7 @@ def compile_estimate_s(laws: dict[str, list[str]], *, probe_s: float | None = No
     return scale * max(max(jobs), sum(jobs) / min(cores, len(jobs)))
 
 
-def cached(name: str, law: str = "hertz") -> bool:
+def cached(name: str) -> bool:
     """Whether the kernel cache holds the integrator `name`'s kernels for the present sources (`sim.integration.jit`;
     the laws share its files, so a law compiled for the first time is found out only by `warm_up`'s timer)."""
     from sim.integration import jit
@@ -218,7 +222,7 @@ def _duration(seconds: float) -> str:
 
 
 @contextlib.contextmanager
-def _announced(what: str, laws: dict[str, list[str]], stream: TextIO) -> Iterator[None]:
+def _announced(what: str, laws: dict[str, list[str]], cold: bool, stream: TextIO) -> Iterator[None]:
     """Say that `what` is being compiled and about how long it takes (`compile_estimate_s`): at once when the cache
     lacks the kernels, else once NOTICE_AFTER_S have passed; when done, how long it took. Silent when it is quick (the
     kernels came from the cache)."""
@@ -226,7 +230,6 @@ def _announced(what: str, laws: dict[str, list[str]], stream: TextIO) -> Iterato
         stream.write(_notice(what, estimate_s))
         stream.flush()
 
-    cold = not all(cached(name) for name in laws)
     if cold:  # compiled in children where they can hand their kernels over (`warm_up_all`), else here
         say_so(compile_estimate_s(laws, cores=None if _shared_cache() else 1))
     # unexpected (e.g. a law compiled for the first time): no test compilation while numba holds its lock; the quiet
@@ -248,9 +251,10 @@ def _announced(what: str, laws: dict[str, list[str]], stream: TextIO) -> Iterato
 
 def warm_up(name: str, *, law: str = "hertz", stream: TextIO | None = None) -> float:
     """Compile (or load from numba's on-disk cache) the kernels of the integrator `name` in this process by one
-    short run of a tiny system, before any timed or progress-reported work. When that takes longer than
-    NOTICE_AFTER_S (a cold cache), one line ``compiling ... (once per version of the code on this machine; about N s
-    here ...) ...`` goes to `stream` (stderr) while it happens, and one line with the time when it is done. Returns the
+    short run of a tiny system, before any timed or progress-reported work. When the cache lacks the kernels (or a
+    load takes longer than NOTICE_AFTER_S), one line ``compiling ... (once per version of the code on this machine;
+    about N s here ...) ...`` goes to `stream` (stderr) while it happens, and one line with the time when it is done.
+    Returns the
     seconds spent (0 when this process has warmed the integrator with this law before). law: the run's contact law
     (its name in `sim.model.contact_law.LAWS`; the kernels are compiled per law)."""
     return warm_up_all([(name, law)], stream=stream)
@@ -269,8 +273,8 @@ def warm_up_all(pairs: Iterable[tuple[str, str]], *, stream: TextIO | None = Non
     runs = {name: get_integrator(name) for name in laws}  # refuses an unknown name; a stale cache is discarded here
     started = time.perf_counter()
     what = f"the {pending[0][0]} integrator's kernels" if len(laws) == 1 else f"the kernels of {', '.join(laws)}"
-    with _announced(what, laws, stream or _sys.stderr):
-        cold = {name: names for name, names in laws.items() if not cached(name)}
+    cold = {name: names for name, names in laws.items() if not cached(name)}
+    with _announced(what, laws, bool(cold), stream or _sys.stderr):
         if cold and (os.cpu_count() or 1) > 1 and _shared_cache():
             compile_in_children(cold)
         for name, law in pending:

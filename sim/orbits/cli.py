@@ -33,6 +33,7 @@ def _period_multiple(text: str) -> int:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The options of `ies orbits` besides the system's (module docstring)."""
     from sim.orbits.response import STARTS
+    from sim.integration.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
     from sim.orbits.starts import DEFAULT_RESTITUTION
 
     parser.add_argument("--level", required=True, metavar="L1,L2,..|LO:HI",
@@ -55,10 +56,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--switches", type=count, default=2, metavar="N",
                         help="branch switchings at symmetry-breaking and period-doubling points, those nearest to a "
                              "stable orbit first (default 2; 0: the start's branch only)")
-    parser.add_argument("--integrator", default="exact", choices=("exact", "ode3"),
-                        help="time integrator of the shooting (default exact; ode3 for checks)")
+    parser.add_argument("--integrator", default=DEFAULT_INTEGRATOR, choices=tuple(INTEGRATORS),
+                        help=f"time integrator of the shooting (default {DEFAULT_INTEGRATOR}; the others for checks)")
+    scaled = " and ".join(name for name, record in INTEGRATORS.items() if record.dt_scale)
     parser.add_argument("--dt-scale", dest="dt_scale", type=float, default=1.0, metavar="X",
-                        help="ode3 step as a multiple of the paper's 2 pi/(15 omega_9) (default 1)")
+                        help=f"{scaled} step as a multiple of the paper's 2 pi/(15 omega_9) (default 1)")
     parser.add_argument("--sweep", metavar="DIR",
                         help="an `ies sweep --out DIR` folder whose stepped-sine points are drawn on the orbits")
     parser.add_argument("--out", required=True, metavar="DIR",

@@ -132,24 +132,26 @@ class Continuer:
         """The shooting map at the continuation coordinate (cached for the last few); SimulationDiverged where the
         coordinate gives no valid setting (a Newton step far off: the corrector then backtracks or refuses)."""
         key = float(coordinate)
-        try:
-            self.parameter.set(self.base, self.parameter.from_coordinate(key))
-        except (SimulationInputError, OverflowError) as exc:
-            raise SimulationDiverged(f"orbits: {self.parameter.name} out of range in a Newton step ({exc})") from None
         if self.parameter.name in EXCITATION:  # one map, moved to each excitation (the system stays)
             if self._map is None:
-                self._map = ShootingMap(self.parameter.set(self.base, self.parameter.from_coordinate(key)), self.k,
-                                        system=self._system)
+                self._map = ShootingMap(self._setting(key), self.k, system=self._system)
                 self._map_key = key
             elif self._map_key != key:
-                self._map.retarget(self.parameter.set(self.base, self.parameter.from_coordinate(key)))
+                self._map.retarget(self._setting(key))
                 self._map_key = key
             return self._map
         if key not in self._maps:
             if len(self._maps) > 8:
                 self._maps.pop(next(iter(self._maps)))
-            self._maps[key] = ShootingMap(self.parameter.set(self.base, self.parameter.from_coordinate(key)), self.k)
+            self._maps[key] = ShootingMap(self._setting(key), self.k)
         return self._maps[key]
+
+    def _setting(self, key: float) -> OrbitSetting:
+        """The setting at the continuation coordinate `key`; SimulationDiverged where it is not a valid one."""
+        try:
+            return self.parameter.set(self.base, self.parameter.from_coordinate(key))
+        except (SimulationInputError, OverflowError) as exc:
+            raise SimulationDiverged(f"orbits: {self.parameter.name} out of range in a Newton step ({exc})") from None
 
     def residual(self, u: np.ndarray) -> tuple[np.ndarray, MapValue]:
         """The scaled shooting residual at u (SimulationDiverged where the integrator fails)."""

@@ -198,16 +198,9 @@ def parameter_branch(setting: OrbitSetting, name: str, bounds: tuple[float, floa
     the slow flow at the upper bound (Newton's method reaches it there, `sim.orbits.starts`) and runs down (the
     homotopy of `slow_flow_orbit`, kept whole); otherwise from the setting's orbit (`slow_flow_orbit`) along
     `direction` (+1: increasing)."""
-    from sim.orbits.starts import slow_flow_state
-
     lo, hi = sorted(float(b) for b in bounds)
     if name == "higher_damping":
-        top = replace(setting, higher_damping=hi)
-        candidates = slow_flow_candidates(top, restitution)
-        if not candidates:
-            raise OrbitNotConverged(f"orbits: the slow flow has no two-impact orbit at eta {setting.eta:g}, level "
-                                    f"{setting.level:g} (r = {restitution:g})")
-        start = solve_orbit(top, slow_flow_state(top, candidates[0]), symmetric=setting.symmetric_walls)
+        start = slow_flow_orbit(replace(setting, higher_damping=hi), restitution=restitution, damping=(1.0,))
         return continue_branch(start, name, (lo, hi), direction=-1.0, origin="slow flow at the higher damping",
                                detect=detect, progress=progress)
     start = slow_flow_orbit(setting, restitution=restitution, progress=progress)

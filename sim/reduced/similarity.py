@@ -16,7 +16,8 @@ therefore depends on g and k_H only through
 
 and so does the switch, as a level l_s(kappa, D_1). Every clearance of a design grid, every k_H factor and every
 clearance tolerance of the uncertainty box lies on this one family of curves. kappa enters only weakly: on the
-built-in rig a factor 2 in g (1.41 in kappa) moves the switch by about half a level (module `uq.design`).
+built-in rig a factor 2 in g (1.41 in kappa) moves the switch by about half a level
+(tests/benchmarks/test_slow_flow_switch.py).
 
 The predictor
 -------------
@@ -24,9 +25,10 @@ The predictor
 predicted, on a grid of own levels with the full stepped-sine simulator, and bisects each reference's switch
 bracket (last SMR level, first APR level] down to `resolution` levels. A level counts as APR when at least half of
 its repetitions reach their resonant level almost periodically (the majority rule of
-`sim.stepped_sine.landmarks.landmarks`). The switch is the first one from below (`ReferenceCurve.bracket`): far above it the
-response can turn strongly modulated again for a few levels (seen at 17-18 a_base*(g) on the cantilever of the
-design benchmarks), which `landmarks`' rule "APR from there on" would take for the switch. `SimilarityLaw` then predicts, for any (kappa, D_1):
+`sim.stepped_sine.landmarks.landmarks`, APR_SHARE). The switch is the first one from below
+(`ReferenceCurve.bracket`): far above it the response can turn strongly modulated again for a few levels (seen at
+17-18 a_base*(g) on the cantilever of the design benchmarks), which `landmarks`' rule "APR from there on" would take
+for the switch. `SimilarityLaw` then predicts, for any (kappa, D_1):
 
 * the switch level: the references' bracket midpoints, interpolated linearly in log kappa and in D_1 (clamped
   outside the references); a reference without a switch on its grid makes the prediction a bound ("above" its
@@ -40,21 +42,10 @@ The references' cost is independent of how many clearances a design grid has. Th
 (`sim.reduced.slow_flow`) stays the screening where it is right (the first impacts, the trends with the sphere
 mass, the APR level within 5-13 %); its fold is only a lower bound of the switch.
 
-Validity, measured (tests/benchmarks/test_slow_flow_switch.py): each design's switch and SMR level predicted from
-two references at g/2 and 2 g (the design's own g never simulated for the prediction) against its own simulation on
-levels 2-9 step 0.5 (own levels; stepped sine eta 0.96:1.0:21 up, 3 s + 5 s, exact integrator, 2 repetitions, seed
-2024); "agrees" = within one grid step (0.5) of the simulated interval; SMR level = the resonant mean / a_noabs*
-averaged over the SMR levels from 2 up (single levels differ by up to 61 %: the strongly modulated response is
-chaotic and two repetitions are few).
-
-  host, design        g (mm)  m_a (g)  simulated switch  predicted        agrees  SMR level sim / predicted
-  rig                 0.58    17.7     5.0 -> 5.5        5.29             yes     0.055 / 0.060 (+10 %)
-  rig, m_a/2          0.58     8.8     2.0 -> 2.5        2.32             yes     0.074 / 0.078 (+5 %)
-  rig, 2 m_a          0.58    35.4     none up to 9      none up to 12    yes     0.040 / 0.041 (+1 %)
-  rig, 2 g*           1.16    17.7     5.5 -> 6.0        5.64             yes     0.052 / 0.057 (+9 %)
-  cantilever          0.58    17.7     none up to 9      none up to 12    yes     0.044 / 0.045 (+1 %)
-  cantilever, m_a/2   0.58     8.8     4.5 -> 5.0        4.64             yes     0.061 / 0.061 (+1 %)
-  3D solid rig        0.58    17.7     5.5 -> 6.0        5.30             yes     0.053 / 0.058 (+11 %)
+Validity: tests/benchmarks/test_slow_flow_switch.py predicts each design's switch and SMR level from two references
+at g/2 and 2 g (the design's own g never simulated for the prediction) and compares them with its own simulation, on
+seven designs over three hosts (the rig, the sphere half and twice as heavy, twice the clearance, a cantilever, the
+3D solid); its target and latest figures are in tests/benchmarks/README.md.
 
 The cantilever is a uniform steel beam of another length, section and mass (tests/benchmarks/_cantilever.py: 55 Hz,
 1.30 kg, m_a phi_c^2 = 5.2 % with the paper's sphere against the rig's 117 Hz, 1.57 kg, 3.5 %).
@@ -68,9 +59,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sim.common.errors import SimulationInputError
+from sim.stepped_sine.landmarks import APR_SHARE
 
-#: a level is APR when at least this share of its repetitions is (the majority rule of `landmarks`)
-APR_SHARE = 0.5
 #: the bracket width (levels) down to which `reference_curves` bisects each reference's switch
 RESOLUTION = 0.25
 
@@ -213,8 +203,13 @@ class SimilarityLaw:
     def value(self, k: float, D: float, level: float) -> float:
         """The predicted response per a_noabs* at own level `level`, kappa `k`, damping `D`: on the side of the predicted
         switch where `level` lies."""
-        apr_side = self.is_apr(k, D, level)
-        return sum(c.side_value(level, apr_side) * w for c, w in self._blend(k, D))
+        return float(self.values(k, D, [level])[0])
+
+    def values(self, k: float, D: float, levels: Sequence[float]) -> np.ndarray:
+        """`value` at each of `levels`, the switch and the blend found once."""
+        s, blend = self.switch(k, D), self._blend(k, D)
+        return np.array([sum(c.side_value(x, s.kind != "above" and x >= s.level) * w for c, w in blend)
+                         for x in levels], dtype=float)
 
     def is_apr(self, k: float, D: float, level: float) -> bool:
         """True where `level` lies at or above the predicted switch."""

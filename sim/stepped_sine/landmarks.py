@@ -18,6 +18,9 @@ import numpy as np
 
 from sim.stepped_sine.measures import PAPER_APR_ETA, PAPER_APR_LEVEL, PAPER_OPTIMUM_LEVEL, REGIME_CV_THRESHOLD
 
+#: a level is APR when at least this share of its repetitions is (the majority rule)
+APR_SHARE = 0.5
+
 
 @dataclass(frozen=True)
 class Landmarks:
@@ -79,7 +82,7 @@ def landmarks(results: Sequence) -> Landmarks:
         apr_samples.append(float(np.mean(apr)))
         k = int(np.argmin(np.abs(r.eta - PAPER_APR_ETA)))
         impacts.append(float(r.impacts_per_period[k]) if abs(r.eta[k] - PAPER_APR_ETA) < 1e-9 else float("nan"))
-    mostly_apr = np.array(apr_samples) >= 0.5
+    mostly_apr = np.array(apr_samples) >= APR_SHARE
     tail = np.flatnonzero(np.cumprod(mostly_apr[::-1])[::-1])  # indices of the mostly-APR levels at the top
     first_apr = float(levels[tail[0]]) if tail.size else None
     below = np.flatnonzero(~mostly_apr[: tail[0] if tail.size else levels.size])

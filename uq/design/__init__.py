@@ -6,9 +6,10 @@ margin above the top of that range at every corner of the box.
 
 Why the margin. An IES works best just below that switch (Sect. 5.3: the optimum at a_base/a_base* ~ 6.7 lies at the
 switch): below it the response is strongly modulated and low, above it the amplitude jumps several-fold onto the
-almost periodic branch (3.5x on the cantilever of the design benchmarks, 4.1x on the rig in the README's example). A design whose worst corner switches
-within the range, or just above it, is one tolerance away from that jump; `--margin` (default 20 %) is the distance a
-design must keep, and the recommendation says where its amplitude jumps and by how much.
+almost periodic branch (3.5x on the cantilever of the design benchmarks, 4.1x on the rig in the README's example).
+A design whose worst corner switches within the range, or just above it, is one tolerance away from that jump;
+`--margin` (default 20 %) is the distance a design must keep, and the recommendation says where its amplitude jumps
+and by how much.
 
 Method, in three stages (`uq.design.search`):
 

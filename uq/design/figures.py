@@ -219,7 +219,7 @@ def plot_design_curves(result: Any, path: Path) -> Path:
             ax.fill_between(a, v.low * scale, v.high * scale, color=colour, alpha=0.2, lw=0)
             ax.plot(a, v.nominal * scale, marker="o", color=colour, ms=3, lw=2.2 if v is best else 1.0,
                     ls="--" if v is result.baseline and v is not best else "-", label=role + v.sphere.label())
-        margin_at = max(p.excitation) * (1.0 + p.margin) * 1e6
+        margin_at = p.margin_level() * 1e6
         ax.axvline(margin_at, color="0.4", ls="-.", lw=1.0,
                    label=f"top of the range + {p.margin:.0%} margin ({margin_at:.3g} {MICROMETRE})")
         prediction = best.prediction

@@ -98,11 +98,13 @@ class Predictor:
     """The similarity laws of the spheres a design needs, built on demand through `run` (a function from a list of
     `uq.engine.runner.Task` to their records, the study runner's cache), and their predictions per design."""
 
-    def __init__(self, problem: DesignProblem, objective: Objective, rig: Any, run: Callable[[list[Any]], Mapping[Any, Any]]):
+    def __init__(self, problem: DesignProblem, objective: Objective, rig: Any,
+                 run: Callable[[list[Any]], Mapping[Any, Any]]) -> None:
         from sim.model.system import Nominal, a_base_star
 
         self.problem, self.objective, self.rig, self._run = problem, objective, rig, run
         self.laws: dict[tuple[float, str], SphereLaw] = {}
+        self._predicted: dict[Sphere, DesignPrediction] = {}  # a law never changes once built
         self._a_star = lambda g: a_base_star(rig, Nominal(clearance=g))  # a_base*(g) (m), Sect. 5.3 with g* -> g
         self._a_star_nominal = a_base_star(rig)
 
@@ -131,7 +133,7 @@ class Predictor:
             for D in sorted(set(p.D)):
                 references.append((k, D))
                 realisations.append(((k / k_H) ** 2, k_H, D))
-        top = max(p.excitation) * (1.0 + p.margin) * REACH
+        top = p.margin_level() * REACH
         low = min(p.excitation) / self._a_star(max(gs) + t_hi)
         high = top / self._a_star(min(gs) + t_lo)
         low = min(max(low, LEVEL_FLOOR), LEVEL_CEILING)
@@ -185,6 +187,8 @@ class Predictor:
         from sim.model.system import a_noabs_star
         from sim.reduced.similarity import kappa
 
+        if sphere in self._predicted:
+            return self._predicted[sphere]
         entry = self.laws.get((sphere.radius, sphere.material))
         if entry is None:
             return None
@@ -197,7 +201,7 @@ class Predictor:
             g, D = float(point["g"]), float(point["D"])
             k = kappa(float(point["k_H"]), g)
             own = a / self._a_star(g)
-            values = np.array([law.value(k, D, x) for x in own]) * scale
+            values = law.values(k, D, own) * scale
             per_level = np.maximum(per_level, values)
             s = law.switch(k, D)
             switches.append((s.level * self._a_star(g), s.kind, corner_of(point, sphere), k))
@@ -206,8 +210,10 @@ class Predictor:
         below, above = law.jump(k_w, worst_corner.D)
         at_switch = a_noabs_star(self.rig, a_s)
         nominal = switches[-1]
-        return DesignPrediction(sphere, per_level, float(a_s), kind, worst_corner, float(nominal[0]), nominal[1],
-                                (below * at_switch, above * at_switch))
+        prediction = DesignPrediction(sphere, per_level, float(a_s), kind, worst_corner, float(nominal[0]), nominal[1],
+                                      (below * at_switch, above * at_switch))
+        self._predicted[sphere] = prediction
+        return prediction
 
     def describe(self) -> list[dict[str, Any]]:
         """Each sphere's references as plain data (design.json "similarity")."""

@@ -28,8 +28,6 @@ BOX_OPTIONS = {"D": "D", "g": "clearance_tolerance", "k_H": "k_H_factor"}
 
 #: the built-in rig's block across the cavity and its walls (Sect. 2: 28 mm, 17 mm cavity in the paper's design)
 BLOCK_WIDTH = 28e-3
-
-
 MIN_WALL = 5.5e-3
 
 
@@ -146,7 +144,7 @@ class DesignProblem:
                                ("--k-H-factor", self.k_H_factor)):
             if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
                 raise StudyError(f"{name}: give an interval LOW:HIGH with LOW <= HIGH, got {lo:g}:{hi:g}")
-        if not 0 < self.D[0] and self.D[1] < 1:
+        if not (0 < self.D[0] and self.D[1] < 1):
             raise StudyError(f"--damping: D_1 must lie in (0, 1), got {self.D[0]:g}:{self.D[1]:g}")
         if self.k_H_factor[0] <= 0:
             raise StudyError(f"--k-H-factor: the factor on Eq. 8's k_H must be > 0, got {self.k_H_factor[0]:g}")
@@ -201,6 +199,10 @@ class DesignProblem:
                                              high=getattr(self, BOX_OPTIONS[row.name])[1])
             boxed.append((row, spread))
         return boxed
+
+    def margin_level(self) -> float:
+        """The base amplitude (m) of the margin check: the top of the operating range times 1 + margin."""
+        return max(self.excitation) * (1.0 + self.margin)
 
     def corners(self, sphere: Sphere) -> list[dict[str, float]]:
         """The uncertainty box of one design as task parameters (SI; the rows with a spread, then m_a): its corners

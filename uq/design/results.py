@@ -38,8 +38,8 @@ class Verified:
     point (corners, then the centre) and level (the operating ones, then the margin level) the share of its
     repetitions that are almost periodic; point_onset: per box point the base amplitude (m) of its first impacts
     (Eq. 7, mode 1: below it a response is linear and its "almost periodic" label means nothing); margin_high: the
-    objective's highest value over the box at the margin level (SI); excitation: the base amplitudes (m) of those levels; prediction: the similarity law's
-    (`uq.design.prediction.DesignPrediction`); round: the search round that verified it (0 = the first batch)."""
+    objective's highest value over the box at the margin level (SI); excitation: the base amplitudes (m) of those
+    levels; prediction: the similarity law's (`uq.design.prediction.DesignPrediction`); round: the search round that verified it (0 = the first batch)."""
 
     sphere: Sphere
     low: np.ndarray

@@ -164,13 +164,6 @@ def best_of(problem: DesignProblem, verified: Sequence[Verified]) -> list[Verifi
             + sorted(rest, key=lambda v: (-v.margin(top), _grid_order(problem, v.sphere))))
 
 
-def corners(problem: DesignProblem, sphere: Sphere) -> list[dict[str, float]]:
-    """The uncertainty box of one design as task parameters (D, g, k_H, m_a in SI): its distinct corners, then the
-    centre (D's midpoint, the clearance and k_H of the design) for the monotonicity check; built from the parameter
-    rows (`DesignProblem.corners`)."""
-    return problem.corners(sphere)
-
-
 def verification_model(problem: DesignProblem) -> Any:
     """The study model that simulates one run of a design (`uq.problem.models.IESModel`; the sphere mass m_a per task)."""
     from uq.problem.models import IESModel
@@ -178,25 +171,20 @@ def verification_model(problem: DesignProblem) -> Any:
     return IESModel(protocol=dict(problem.protocol), modal_file=problem.modal_file)
 
 
-def margin_level(problem: DesignProblem) -> float:
-    """The base amplitude (m) of the margin check: the top of the operating range times 1 + margin."""
-    return max(problem.excitation) * (1.0 + problem.margin)
-
-
 def verify(problem: DesignProblem, objective: Objective, spheres: Sequence[Sphere], rig: Any,
            run: Callable[[list[Any]], Mapping[Any, Any]], *, round_: int = 0,
            predictions: Mapping[Sphere, DesignPrediction] | None = None) -> list[Verified]:
     """Stage 3: every corner and the centre of the box of every design at every operating level and at the margin
-    level (`margin_level`), each with the problem's repetitions, through `run` (the study runner: cached in the
-    design's folder, resumable)."""
+    level (`DesignProblem.margin_level`), each with the problem's repetitions, through `run` (the study runner: cached
+    in the design's folder, resumable)."""
     from sim.reduced.slow_flow import host_mode as mode_of
     from uq.engine.runner import Task
 
-    excitation = np.array([*problem.excitation, margin_level(problem)])
+    excitation = np.array([*problem.excitation, problem.margin_level()])
     levels = levels_of(rig, excitation)
     omega_1 = float(rig.omega[0])
     mode = mode_of(rig)
-    boxes = {s: corners(problem, s) for s in spheres}
+    boxes = {s: problem.corners(s) for s in spheres}
     tasks = [Task.make(p, L, rep) for s in spheres for p in boxes[s] for L in levels for rep in range(problem.repetitions)]
     results = run(tasks)
     out = []
@@ -246,7 +234,6 @@ def search(problem: DesignProblem, predictor: Predictor, verify_batch: Callable[
     predictions = {s: predictor.predict(s) for s in first_spheres}
     batch = ranked(problem, predictions)[: problem.candidates]
     if problem.baseline is not None and problem.baseline not in batch:
-        predictor.ensure([problem.baseline])
         batch.append(problem.baseline)
     verified: dict[Sphere, Verified] = {}
     trail = Search()

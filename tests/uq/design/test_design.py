@@ -164,6 +164,7 @@ def test_ranges_read_units_counts_and_accelerations():
     (["--excitation", "2um:8um", "--radius", "9mm:12mm"], "no design fits"),
     (["--excitation", "2um:8um", "--baseline", "0.58mm,9mm,brass"], "--baseline"),
     (["--excitation", "2um:8um", "--damping", "0.0009:0.0007"], "LOW <= HIGH"),
+    (["--excitation", "2um:8um", "--damping", "0.5:1.5"], "D_1 must lie in (0, 1)"),
     (["--excitation", "0.01um:0.02um"], "never reaches the clearance"),
     (["--excitation", "2um:8um", "--model", "nothere.toml"], "--model"),
     (["--clearance", "0.5mm"], "--excitation is required"),
@@ -399,7 +400,7 @@ def test_a_calibration_sets_the_upper_end_of_the_k_H_factor(tmp_path, capsys):
 def test_the_box_is_its_distinct_corners_and_its_centre():
     problem = dp.DesignProblem(excitation=(2e-6,), clearances=(0.5e-3,), radii=(7.92e-3,))
     sphere = dp.Sphere(0.5e-3, 7.92e-3, "brass")
-    points = ds.corners(problem, sphere)
+    points = problem.corners(sphere)
     corners = {dq.corner_of(p, sphere) for p in points[:-1]}
     assert len(points) == 9 and len(corners) == 8
     ends = [(D, t, f) for D in problem.D for t in problem.clearance_tolerance for f in problem.k_H_factor]
