@@ -69,7 +69,7 @@ and the docstring of `bem_contact.cli`.
 
 def study_settings() -> str:
     """The method tables of a study file ([KIND] with its ``method``): every setting of every registered method with
-    its default, its option and its meaning (`uq.problem.method.Setting`)."""
+    its default, its option and its meaning (`uq.problem.study.Setting`)."""
     parts = ["## Study files: the methods' tables\n",
              "A study file's `[study] kind` chooses the table of its method's settings; the common tables ([study], "
              "[variant], [parameters.NAME], [excitation], [cluster]) are described in the docstring of "

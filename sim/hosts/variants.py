@@ -4,7 +4,6 @@ the damping of the higher modes, the 3D solid's variants (neck, update, contact 
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np

@@ -96,7 +96,7 @@ class SphereLaw:
 
 class Predictor:
     """The similarity laws of the spheres a design needs, built on demand through `run` (a function from a list of
-    `uq.engine.runner.Task` to their records, the study runner's cache), and their predictions per design."""
+    `uq.problem.tasks.Task` to their records, the study runner's cache), and their predictions per design."""
 
     def __init__(self, problem: DesignProblem, objective: Objective, rig: Any,
                  run: Callable[[list[Any]], Mapping[Any, Any]]) -> None:
@@ -157,7 +157,7 @@ class Predictor:
     def _evaluator(self, realisations: Sequence[tuple[float, float, float]], mass: float,
                    counted: list[int]) -> Callable[[list[tuple[int, float]]], list[Any]]:
         from sim.reduced.similarity import Outcome
-        from uq.engine.runner import Task
+        from uq.problem.tasks import Task
 
         reps = self.reps()
         omega_1 = float(self.rig.omega[0])

@@ -178,7 +178,7 @@ def verify(problem: DesignProblem, objective: Objective, spheres: Sequence[Spher
     level (`DesignProblem.margin_level`), each with the problem's repetitions, through `run` (the study runner: cached
     in the design's folder, resumable)."""
     from sim.reduced.slow_flow import host_mode as mode_of
-    from uq.engine.runner import Task
+    from uq.problem.tasks import Task
 
     excitation = np.array([*problem.excitation, problem.margin_level()])
     levels = levels_of(rig, excitation)

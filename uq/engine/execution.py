@@ -139,7 +139,7 @@ def _netcdf(study: Study, model: Any, folder: Path, plan: Plan, records: dict, s
 
     method = study.method
     base = base_dataset(study, model, plan.points, records, stats, regimes)
-    parts = [method.base_dataset(base) if hasattr(method, "base_dataset") else base]
+    parts = [method.base_dataset(base)]
     for table in method.tables:
         if table.dims is not None and table.file.file in analysis.rows:
             parts.append(xr.Dataset(table_variables(list(_columns(table, analysis)), analysis.rows[table.file.file],

@@ -40,11 +40,6 @@ def describe_model(model: Any) -> Any:
     return repr(model)
 
 
-def task_key(task: Task, model: Any, seed: int, version: str) -> str:
-    """Stable key of a task (hex SHA-256 of its parameters, the model settings, seed and code version)."""
-    return _keyer(model, seed, version)(task)
-
-
 def _keyer(model: Any, seed: int, version: str) -> Callable[[Task], str]:
     """Key function with the study-wide part (model settings, seed, version) hashed once."""
     common = hashlib.sha256(json.dumps({"seed": seed, "model": describe_model(model), "version": version},

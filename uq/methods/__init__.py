@@ -20,7 +20,7 @@ from uq.methods.response import Response
 from uq.methods.sobol import Saltelli
 from uq.methods.surrogate import PCE
 from uq.problem.method import Method
-from uq.problem.study import Study, parse_study, read_study
+from uq.problem.study import Study, kinds_of, parse_study, read_study
 
 #: name -> method, in the order `ies --help` lists their kinds; a kind's first method is its default
 METHODS: dict[str, Method] = {m.name: m for m in (IntervalMethod(), Saltelli(), PCE(), Response())}
@@ -37,10 +37,7 @@ def register(method: Method) -> Method:
 
 def kinds() -> dict[str, list[Method]]:
     """kind -> its methods, in registry order (the first is the kind's default)."""
-    out: dict[str, list[Method]] = {}
-    for method in METHODS.values():
-        out.setdefault(method.kind, []).append(method)
-    return out
+    return kinds_of(METHODS)
 
 
 def load_study(path: str | Path) -> Study:

@@ -28,11 +28,12 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from sim.common.outputs import Column, OutputFile, header
+from sim.model.parameters import PARAMETERS
 from uq.errors import StudyError
 from uq.outputs.tables import PARAMETERS_COLUMN, parameter_columns
 from uq.problem.method import Analysis, Method, Plan, Runs, Table
-from uq.problem.space import ParameterSpace
-from uq.problem.study import Context, Setting, Study, numeric, read_fixed_values
+from uq.problem.space import ParameterSpace, resolve_value
+from uq.problem.study import Context, Setting, Study, check_number, numeric, warn_implausible
 
 
 @dataclass(frozen=True)
@@ -237,7 +238,26 @@ def _designs(value: Any, context: Context) -> tuple[str, ...]:
 
 
 def _fix(value: Any, context: Context) -> dict[str, float]:
-    return read_fixed_values(value, context.space, context.base_dir, context.source)
+    """[interval] fix: parameters held at a value in the residual design (a number, with a unit where the quantity has
+    one, or "best_estimate")."""
+    space = context.space
+    if not isinstance(value, Mapping):
+        raise StudyError(f"[interval] fix must be a table like {{ k_H = \"best_estimate\" }}, got {value!r}")
+    out = {}
+    for pname, raw in value.items():
+        if pname not in space.names:
+            raise StudyError(f"[interval] fix: unknown parameter '{pname}'; known: {', '.join(space.names)}")
+        if raw == "best_estimate":
+            if f"{pname}_best_estimate" not in space.extras:
+                raise StudyError(f"[interval] fix: '{pname}' has no best estimate; give a number")
+            fixed = space.extras[f"{pname}_best_estimate"]
+        elif pname in PARAMETERS and PARAMETERS[pname].quantity is not None:  # k_H, g, k_t: also with a unit
+            fixed = resolve_value(pname, raw, base_dir=context.base_dir)
+            warn_implausible(context.source, f"[interval] fix.{pname}", pname, fixed)
+        else:
+            fixed = check_number(f"[interval] fix.{pname}", raw, positive=space[pname].positive)
+        out[pname] = float(fixed)
+    return out
 
 
 POINTS_CSV = OutputFile("points.csv", "ies interval", "The repetition statistics of every design point and level.", (

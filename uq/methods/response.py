@@ -149,7 +149,6 @@ def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: 
     the first run's random offset), into folder/trace-LEVEL: trace.csv, trace.json, Figs. 4/9a (trace.png) and
     the walls and the sphere (motion.png)."""
     import csv
-    import dataclasses
 
     from sim.plots.figures import plot_motion, plot_trace
     from uq.outputs.figures import series_label
@@ -168,8 +167,7 @@ def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: 
         if level not in resonant:
             raise StudyError(f"level {level:g} is not among the study's levels; it cannot be traced")
         last = int(np.argmin(np.abs(grid - resonant[level])))
-        visit = dataclasses.replace(protocol, eta_stop=float(grid[last]), n_eta=last + 1) if last else \
-            dataclasses.replace(protocol, eta_stop=float(grid[0]), n_eta=1)
+        visit = dataclasses.replace(protocol, eta_stop=float(grid[last]), n_eta=last + 1)
         trace = record_trace(rig, impactor, level, visit, periods=periods, seed=study.seed)
         out = folder / f"trace-{level:g}"
         out.mkdir(parents=True, exist_ok=True)

@@ -271,7 +271,7 @@ class SobolMethod(Method):
     def analyse(self, study: Study, model: Any, plan: Plan, runs: Runs) -> Analysis:
         """S1, ST with their confidence per output and level (sobol.csv, in both definitions of the indices), the
         variance and its noise share per level (variance.csv)."""
-        out = Analysis(rows={"sobol.csv": [], "variance.csv": [], **{t.file.file: [] for t in self.tables[2:]}})
+        out = Analysis(rows={t.file.file: [] for t in self.tables})
         per_level: dict[str, dict] = {}
         results = []
         for o in model.banded_outputs:

@@ -41,7 +41,7 @@ from sim.plots.figures import (
 )
 from sim.common.files import pyplot, save_figure
 from sim.plots.redraw import KINDS, PlotOptions, kind_of, register, selected
-from uq.outputs.results import nominal_regimes
+from uq.outputs.results import nominal_regimes, study_kind
 
 _YLABEL = {"mean": f"mean resonant level {RESPONSE_LABEL}", "max": f"max resonant level {RESPONSE_LABEL}",
            "value": "response", "restitution": "modal coefficient of restitution $r$ (tip)",
@@ -69,14 +69,6 @@ def _save(fig: Any, folder: Path, stem: str, options: PlotOptions) -> list[Path]
 
 def _study(folder: Path) -> dict:
     return json.loads((folder / "study.json").read_text())
-
-
-def _kind_is(kind: str):
-    def detect(folder: Path) -> bool:
-        path = folder / "study.json"
-        return path.is_file() and json.loads(path.read_text()).get("study", {}).get("kind") == kind
-
-    return detect
 
 
 def _curve(points: list[dict], design: str, point: str, output: str) -> tuple[np.ndarray, ...]:
@@ -551,7 +543,7 @@ def series_label(sub: str) -> str:
         return sub
 
 
-register("ies sobol", _kind_is("sobol"))(sobol_figure)
+register("ies sobol", study_kind("sobol"))(sobol_figure)
 
 
 def _result_children(folder: Path) -> list[Path]:

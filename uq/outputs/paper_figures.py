@@ -4,8 +4,8 @@ A row (`PaperFigure`) says everything `ies reproduce NAME` and the figure code n
 file stem of its drawing and the folder OUT/NAME), its study file, the function that draws it from a response
 study's data (`draw`; for a study run once per value of a parameter when `series`), the table printed after the
 run, whether `ies reproduce all` runs it, and for the interval studies the joint-band figure of an output. Adding a
-figure is adding a row: `ies reproduce`'s choices, the [response] figures a study file may ask for (`uq.problem.study`),
-the drawing of a response folder (`uq.outputs.figures.response_figures`, also `ies plot`) and the printed summary all read
+figure is adding a row: `ies reproduce`'s choices, the [response] figures a study file may ask for (`uq.methods.response`),
+the drawing of a response folder (`response_figures`, also `ies plot`) and the printed summary all read
 this table.
 
 The printed tables (`response_table`, `scattering_table`, `interval_table`) are the library functions behind the
@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 from sim.plots.redraw import register
+from uq.outputs.results import study_kind
 
 if TYPE_CHECKING:
     from sim.plots.redraw import PlotOptions
@@ -204,15 +205,6 @@ def box_figure(output: str) -> PaperFigure:
     return PAPER_FIGURES[DEFAULT_BOX_FIGURE]
 
 
-def _study_kind(kind: str) -> Callable[[Path], bool]:
-    """Whether a folder holds a study of `kind` (its study.json says so)."""
-    def detect(folder: Path) -> bool:
-        path = folder / "study.json"
-        return path.is_file() and json.loads(path.read_text()).get("study", {}).get("kind") == kind
-
-    return detect
-
-
-register("ies interval", _study_kind("interval"))(interval_figures)
-register("response study (ies response, ies reproduce of a response figure)", _study_kind("response"))(response_figures)
+register("ies interval", study_kind("interval"))(interval_figures)
+register("response study (ies response, ies reproduce of a response figure)", study_kind("response"))(response_figures)
 

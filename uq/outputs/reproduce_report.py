@@ -1,4 +1,4 @@
-"""What `ies reproduce` leaves for a reader beside its data : `OUT/summary.txt` (what ran, the
+"""What `ies reproduce` leaves for a reader beside its data: `OUT/summary.txt` (what ran, the
 tables it printed, the paper's statement beside each figure's table), each figure's printed table in
 `OUT/FIG/table.txt`, and `OUT/index.md`, which lists every figure and table of the folder with one line on
 what it shows. Column-level detail stays in the output reference (uq/OUTPUTS.md).

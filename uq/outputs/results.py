@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import csv
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -54,7 +54,7 @@ def nominal_regimes(points: list[dict], output: str = "mean") -> dict[float, str
 
 def parameter_value(row: dict, name: str) -> float:
     """The value of parameter `name` in a row of runs.csv or points.csv, whose column carries the unit (g_m,
-    k_H_N_per_m1p5, `uq.problem.space.column_name`) or is the bare name (dimensionless parameters)."""
+    k_H_N_per_m1p5, `sim.model.parameters.column_name`) or is the bare name (dimensionless parameters)."""
     if name in row:
         return float(row[name])
     (column,) = [c for c in row if c.startswith(f"{name}_")]
@@ -270,3 +270,12 @@ def open_study(folder: str | Path) -> xarray.Dataset:
     from uq.outputs.netcdf import open_results
 
     return open_results(folder)
+
+
+def study_kind(kind: str) -> Callable[[Path], bool]:
+    """Whether a folder holds a study of `kind` (its study.json says so)."""
+    def detect(folder: Path) -> bool:
+        path = folder / "study.json"
+        return path.is_file() and json.loads(path.read_text()).get("study", {}).get("kind") == kind
+
+    return detect

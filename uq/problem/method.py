@@ -123,6 +123,10 @@ class Method(ABC):
     def analyse(self, study: Study, model: Any, plan: Plan, runs: Runs) -> Analysis:
         """The method's tables, summary and warnings from the runs (analysis)."""
 
+    def base_dataset(self, ds: Any) -> Any:
+        """results.nc's runs and repetition statistics (`uq.outputs.netcdf.base_dataset`) as this method keeps them."""
+        return ds
+
     def figures(self, folder: Path, options: Any = None) -> list[Path]:
         """Draw a finished folder's figures (from its data files); the files written."""
         return []

@@ -20,8 +20,8 @@ from typing import Iterable, Mapping
 import numpy as np
 
 from sim.common.errors import SimulationInputError
-from sim.model.parameters import (K_H_BEST_ESTIMATE_FACTOR, K_H_NOMINAL, N_PER_MM15, PARAMETERS,  # noqa: F401
-                                  UncertainParameter, column_name, table2_parameters)
+from sim.model.parameters import (K_H_BEST_ESTIMATE_FACTOR, K_H_NOMINAL, PARAMETERS, UncertainParameter,
+                                  column_name, table2_parameters)
 from uq.errors import StudyError
 
 # Table 2 of the seed paper (SI units) is the table2 rows of `sim.model.parameters.PARAMETERS`, the one vocabulary of

@@ -154,7 +154,7 @@ class Study:
                           contact_law=self.contact_law)
 
     def context(self) -> Context:
-        """What its method's settings are read against (`uq.problem.method.Context`)."""
+        """What its method's settings are read against (`Context`)."""
         return Context(self.kind, self.space, Path(self.source).parent if self.source else Path("."), self.source)
 
     def to_dict(self) -> dict:
@@ -258,7 +258,7 @@ def _number(table: str, key: str, value: Any, *, integer: bool = False, positive
     return check_number(f"[{table}] {key}", value, integer=integer, positive=positive)
 
 
-def _kinds(methods: Mapping[str, Any]) -> dict[str, list[Any]]:
+def kinds_of(methods: Mapping[str, Any]) -> dict[str, list[Any]]:
     """kind -> its methods, in registry order (the first is the kind's default)."""
     kinds: dict[str, list[Any]] = {}
     for method in methods.values():
@@ -269,7 +269,7 @@ def _kinds(methods: Mapping[str, Any]) -> dict[str, list[Any]]:
 def parse_study(data: Mapping[str, Any], methods: Mapping[str, Any], *, base_dir: Path = Path("."),
                 source: str = "", elsewhere: Mapping[str, str] | None = None) -> Study:
     """Validate the parsed TOML of a study (see `read_study`)."""
-    kinds = _kinds(methods)
+    kinds = kinds_of(methods)
     elsewhere = dict(elsewhere or {})
     known_tables = {**COMMON_TABLES, **{kind: None for kind in kinds}}
     for table in data:
@@ -417,7 +417,7 @@ def with_settings(study: Study, methods: Mapping[str, Any], given: Mapping[str, 
     given = {k: v for k, v in given.items() if v is not None}
     if not given:
         return study
-    method, settings = method_settings(_kinds(methods)[study.kind], study.table, study.context(), given)
+    method, settings = method_settings(kinds_of(methods)[study.kind], study.table, study.context(), given)
     return replace(study, method=method, settings=settings)
 
 def _parse_contact_law(head: Mapping[str, Any], space: ParameterSpace) -> str:
@@ -480,7 +480,7 @@ def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir
             # an optional parameter's missing bound is its nominal value (a fixed value needs nominal only)
             fallback = spec.get("nominal", p.nominal) if p in listed_optional else getattr(p, key)
             values[key] = resolve_value(p.name, spec.get(key, fallback), base_dir=base_dir)
-            _warn_implausible(source, f"[parameters.{p.name}] {key}", p.name, values[key])
+            warn_implausible(source, f"[parameters.{p.name}] {key}", p.name, values[key])
         if "best_estimate" in spec:
             if p.name != "k_H":
                 raise StudyError(f"[parameters.{p.name}] best_estimate is only defined for k_H")
@@ -492,7 +492,7 @@ def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir
     return ParameterSpace(tuple(params), extras)
 
 
-def _warn_implausible(source: str, where: str, name: str, value: object) -> None:
+def warn_implausible(source: str, where: str, name: str, value: object) -> None:
     """One warning line on stderr when a value of g or k_H in study file `source` has an implausible magnitude
     (probably a unit slip)."""
     if isinstance(value, (int, float)) and not isinstance(value, bool):
@@ -508,26 +508,6 @@ def _check_param_table(name: str, spec: Any) -> Mapping[str, Any]:
         if key not in _PARAM_KEYS:
             raise StudyError(f"unknown key '{key}' in [parameters.{name}]; known: {', '.join(sorted(_PARAM_KEYS))}")
     return spec
-
-
-def read_fixed_values(fix: Any, space: ParameterSpace, base_dir: Path, source: str) -> dict[str, float]:
-    if not isinstance(fix, Mapping):
-        raise StudyError(f"[interval] fix must be a table like {{ k_H = \"best_estimate\" }}, got {fix!r}")
-    out = {}
-    for pname, raw in fix.items():
-        if pname not in space.names:
-            raise StudyError(f"[interval] fix: unknown parameter '{pname}'; known: {', '.join(space.names)}")
-        if raw == "best_estimate":
-            if f"{pname}_best_estimate" not in space.extras:
-                raise StudyError(f"[interval] fix: '{pname}' has no best estimate; give a number")
-            value = space.extras[f"{pname}_best_estimate"]
-        elif pname in PARAMETERS and PARAMETERS[pname].quantity is not None:  # k_H, g, k_t: also with a unit
-            value = resolve_value(pname, raw, base_dir=base_dir)
-            _warn_implausible(source, f"[interval] fix.{pname}", pname, value)
-        else:
-            value = float(_number("interval", f"fix.{pname}", raw, positive=space[pname].positive))
-        out[pname] = float(value)
-    return out
 
 
 def _parse_protocol(exc: Mapping[str, Any]) -> dict[str, Any]:
