@@ -169,7 +169,8 @@ def compile_estimate_s(laws: dict[str, list[str]], *, probe_s: float | None = No
     PROBE_S_QUIET). With more than one core every (integrator, form) compiles in a process of its own
     (`compile_in_children`), each taking FORM_SHARE of its integrator's time, in parallel while there are cores."""
     scale = (compile_probe_s() if probe_s is None else probe_s) / PROBE_S_QUIET
-    each = [COMPILE_S_QUIET[name] * (1.0 + FURTHER_LAW_SHARE * (len(names) - 1))
+    # an integrator registered after this module was imported (a plug-in) counts as the slowest
+    each = [COMPILE_S_QUIET.get(name, max(COMPILE_S_QUIET.values())) * (1.0 + FURTHER_LAW_SHARE * (len(names) - 1))
             for name, names in laws.items()]
     cores = cores or os.cpu_count() or 1
     if cores == 1:
