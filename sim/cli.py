@@ -264,17 +264,18 @@ def level_value(text: str, option: str = "--level") -> float:
     from sim.stepped_sine.protocol import check_level
 
     text = str(text).strip()
-    if text and text[-1].isalpha():
+    if text[:1] in "0123456789.+-" and text and text[-1].isalpha():  # a number with its unit
         quantity = Quantity("base amplitude a_base", "m", {**LENGTH_UNITS, "nm": 1e-9}, (1e-10, 1e-2), "3.3um")
         value = parse_quantity(text, quantity)
         if not value > 0:
             raise SimulationInputError(f"{option} {text!r}: a base amplitude must be positive")
         return BaseAmplitude(value)
     try:
-        return check_level(float(text))
+        level = float(text)
     except ValueError:
         raise SimulationInputError(f"{option} must be a level a_base/a_base* like 7.4 or a base amplitude like 3.3um, "
                                    f"got {text!r}") from None
+    return check_level(level)
 
 
 def level_option(text: str) -> float:

@@ -113,7 +113,7 @@ def _own_material(text: str, kind: str) -> Material:
         if units is None or not match:
             raise SimulationInputError(f"{what}: cannot read {item.strip()!r}; give E=...GPa,nu=...,density=...kg/m3")
         unit = match.group(2).lower().replace(" ", "")
-        factor = units.get(unit, 1.0 if key == "e" and unit == "" else None)
+        factor = units.get(unit, 1.0 if unit == "" else None)  # a bare number is SI
         if factor is None:
             raise SimulationInputError(f"{what}: unknown unit {match.group(2)!r} for {key}; use "
                                        f"{', '.join(u for u in units if u) or 'a plain number'}")
