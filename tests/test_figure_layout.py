@@ -543,7 +543,7 @@ def _design_result(tmp: Path, radii: tuple, materials: tuple) -> Any:
     from uq.design import prediction as dq, problem as dp, results as dr, search as ds
 
     problem = dp.DesignProblem(excitation=tuple(np.linspace(1e-6, 6e-6, 6)), clearances=(0.3e-3, 0.45e-3, 0.6e-3),
-                               radii=radii, materials=materials, baseline=dp.Sphere(0.58e-3, 7.92e-3, "brass"))
+                               radii=radii, materials=materials, baseline=dp.Design(0.58e-3, 7.92e-3, "brass"))
     screened = ds.screen_designs(problem, dp.host_mode(dp.host_model(problem)))
     corner = dq.Corner(0.00075, 0.0, 1.0)
     predictions = {d: dq.DesignPrediction(d, np.linspace(0.1, 0.4, 6) * 1e-3 * d.clearance / 0.45e-3,
@@ -557,7 +557,7 @@ def _design_result(tmp: Path, radii: tuple, materials: tuple) -> Any:
                             excitation=(*problem.excitation, 7.2e-6), prediction=predictions[d])
                 for k, d in zip((1.0, 1.5, 2.0, 2.5), chosen)]
     return dr.DesignResult(problem, screened, verified, tmp, np.arange(1.0, 7.0), 3.0 * level, [],
-                           predictions=predictions, rounds=[[v.sphere for v in verified]], stop="stand-in",
+                           predictions=predictions, rounds=[[v.design for v in verified]], stop="stand-in",
                            omega_1=2 * np.pi * 117.4)
 
 

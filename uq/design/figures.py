@@ -29,8 +29,8 @@ def _values(result: Any, material: str, radius: float) -> dict[str, tuple[np.nda
     """Per source (verified, predicted, screened) the clearances (m) and worst cases (objective unit, SI) of one sphere."""
     o, s = result.objective, result.screened
     g = np.asarray(result.problem.clearances)
-    verified = {v.sphere.clearance: v.worst for v in result.verified
-                if v.sphere.material == material and v.sphere.radius == radius}
+    verified = {v.design.clearance: v.worst for v in result.verified
+                if v.design.material == material and v.design.radius == radius}
     predicted = {d.clearance: p.worst for d, p in result.predictions.items()
                  if d.material == material and d.radius == radius and p is not None}
     screened = {}
@@ -58,7 +58,7 @@ def _margin_edge(result: Any, material: str, radius: float) -> float | None:
 
 def _marks(ax: Any, result: Any, material: str, radius: float | None, y_of: Any) -> None:
     """The recommendation (star) and the baseline (diamond) on one panel; y_of(sphere) gives the y value."""
-    best = result.recommendation.sphere
+    best = result.recommendation.design
     if best.material == material and (radius is None or best.radius == radius):
         ax.plot(best.clearance * 1e3, y_of(best), "*", color="tab:red", ms=15, mec="k", ls="", zorder=5,
                 label="recommendation")
@@ -90,16 +90,16 @@ def _clearance_curves(result: Any, path: Path) -> Path:
             xs, ys = values["predicted"]
             if xs.size:
                 ax.plot(xs * 1e3, ys * scale, "--", color=colour, marker=".", label=f"predicted, similarity law{name}")
-            verified = [v for v in result.verified if v.sphere.material == material and v.sphere.radius == R]
+            verified = [v for v in result.verified if v.design.material == material and v.design.radius == R]
             ok = [v for v in verified if v.admissible(result.top, p.margin)]
             bad = [v for v in verified if v not in ok]
             if ok:
-                ax.plot([v.sphere.clearance * 1e3 for v in ok], [v.worst * scale for v in ok], "o", color=colour,
+                ax.plot([v.design.clearance * 1e3 for v in ok], [v.worst * scale for v in ok], "o", color=colour,
                         mec="k", ls="", label=f"verified{name}")
             if bad:
-                ax.plot([v.sphere.clearance * 1e3 for v in bad], [v.worst * scale for v in bad], "o", mfc="w",
+                ax.plot([v.design.clearance * 1e3 for v in bad], [v.worst * scale for v in bad], "o", mfc="w",
                         mec=colour, ls="", label=f"verified, margin not kept{name}")
-            worst = {v.sphere: v.worst for v in result.verified}
+            worst = {v.design: v.worst for v in result.verified}
             _marks(ax, result, material, R, lambda s: worst.get(s, math.nan) * scale)
             edge = _margin_edge(result, material, R)
             if edge is not None:
@@ -218,7 +218,7 @@ def plot_design_curves(result: Any, path: Path) -> Path:
             role = ("recommended: " if v is best else "baseline: " if v is result.baseline else "")
             ax.fill_between(a, v.low * scale, v.high * scale, color=colour, alpha=0.2, lw=0)
             ax.plot(a, v.nominal * scale, marker="o", color=colour, ms=3, lw=2.2 if v is best else 1.0,
-                    ls="--" if v is result.baseline and v is not best else "-", label=role + v.sphere.label())
+                    ls="--" if v is result.baseline and v is not best else "-", label=role + v.design.label())
         margin_at = p.margin_level() * 1e6
         ax.axvline(margin_at, color="0.4", ls="-.", lw=1.0,
                    label=f"top of the range + {p.margin:.0%} margin ({margin_at:.3g} {MICROMETRE})")

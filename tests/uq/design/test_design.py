@@ -164,7 +164,13 @@ def test_ranges_read_units_counts_and_accelerations():
     (["--excitation", "2um:8um", "--radius", "9mm:12mm"], "no design fits"),
     (["--excitation", "2um:8um", "--baseline", "0.58mm,9mm,brass"], "--baseline"),
     (["--excitation", "2um:8um", "--damping", "0.0009:0.0007"], "LOW <= HIGH"),
-    (["--excitation", "2um:8um", "--damping", "0.5:1.5"], "D_1 must lie in (0, 1)"),
+    (["--excitation", "2um:8um", "--damping", "0.5:1.5"], "high end must lie in (0, 1)"),
+    (["--excitation", "2um:8um", "--damping", "0.0009:0.001"], "does not contain the host's nominal D_1 = 0.085 %"),
+    (["--excitation", "2um:8um", "--wall-material", "wood"],
+     "unknown wall material 'wood'; choose one of steel, aluminium, titanium, brass, cast-iron"),
+    (["--excitation", "2um:8um", "--material", "brass,gold"], "unknown sphere material 'gold'; choose one of brass, "
+                                                              "steel, tungsten"),
+    (["--excitation", "2um:8um", "--wall-material", "E=70GPa"], "missing nu"),
     (["--excitation", "0.01um:0.02um"], "never reaches the clearance"),
     (["--excitation", "2um:8um", "--model", "nothere.toml"], "--model"),
     (["--clearance", "0.5mm"], "--excitation is required"),
@@ -257,7 +263,7 @@ class StandInPredictor:
 
 
 def stand_in_verify(problem, calls):
-    def verify_batch(spheres, round_):
+    def verify_batch(spheres, round_, reps_at=None):
         calls.append(list(spheres))
         out = []
         for s in spheres:
@@ -294,11 +300,11 @@ def test_the_search_recommends_the_same_design_whatever_the_first_batch(candidat
     verified, trail = ds.search(problem, StandInPredictor(), stand_in_verify(problem, calls), screened_of(problem))
     best = verified[0]
     admissible = [s for s in problem.grid() if true_switch(s) > TOP * (1 + problem.margin)]
-    assert best.sphere == min(admissible, key=true_worst)  # the brute-force optimum of the stand-in
+    assert best.design == min(admissible, key=true_worst)  # the brute-force optimum of the stand-in
     assert best.admissible(TOP, problem.margin)
     g = list(problem.clearances)
-    k = g.index(best.sphere.clearance)
-    verified_g = {v.sphere.clearance for v in verified}
+    k = g.index(best.design.clearance)
+    verified_g = {v.design.clearance for v in verified}
     assert g[k - 1] in verified_g and g[k + 1] in verified_g  # verified neighbours on both sides
     assert len(calls[0]) == candidates and trail.stop
 
@@ -308,27 +314,27 @@ def test_the_search_walks_every_axis_radius_and_material_included():
     calls = []
     verified, _ = ds.search(problem, StandInPredictor(), stand_in_verify(problem, calls), screened_of(problem))
     admissible = [s for s in problem.grid() if problem.fits(s) and true_switch(s) > TOP * (1 + problem.margin)]
-    assert verified[0].sphere == min(admissible, key=true_worst)
-    best = verified[0].sphere
-    seen = {v.sphere for v in verified}
+    assert verified[0].design == min(admissible, key=true_worst)
+    best = verified[0].design
+    seen = {v.design for v in verified}
     assert all(n in seen for n in ds.neighbours(problem, best))
     assert ds.material_axis(problem) == ["steel", "brass", "tungsten"]  # by density
 
 
 def test_neighbours_stay_on_the_grid_and_in_the_cavity():
     problem = stand_in_problem(radii=(6e-3, 7.92e-3), materials=("brass", "tungsten"), block_width=28e-3)
-    s = dp.Sphere(problem.clearances[0], 6e-3, "brass")
+    s = dp.Design(problem.clearances[0], 6e-3, "brass")
     around = ds.neighbours(problem, s)
-    assert dp.Sphere(problem.clearances[1], 6e-3, "brass") in around
-    assert dp.Sphere(problem.clearances[0], 7.92e-3, "brass") in around
-    assert dp.Sphere(problem.clearances[0], 6e-3, "tungsten") in around
+    assert dp.Design(problem.clearances[1], 6e-3, "brass") in around
+    assert dp.Design(problem.clearances[0], 7.92e-3, "brass") in around
+    assert dp.Design(problem.clearances[0], 6e-3, "tungsten") in around
     assert all(problem.fits(n) for n in around) and len(around) == 3
-    assert ds.neighbours(problem, dp.Sphere(0.58e-3, 7.92e-3, "brass")) == []  # off the grid
+    assert ds.neighbours(problem, dp.Design(0.58e-3, 7.92e-3, "brass")) == []  # off the grid
 
 
 def test_admissible_needs_the_margin_and_no_almost_periodic_run_anywhere_in_the_box():
     problem = stand_in_problem()
-    s = dp.Sphere(1.2e-3, 7.92e-3, "brass")
+    s = dp.Design(1.2e-3, 7.92e-3, "brass")
     v = stand_in_verify(problem, [])([s], 0)[0]
     assert v.admissible(TOP, 0.2) and v.margin(TOP) == pytest.approx(true_switch(s) * 1.03 / TOP - 1)
     seen = dataclass_replace(v, point_apr=np.where(np.arange(4) == 1, 1.0, 0.0)[None, :].repeat(9, 0))
@@ -346,23 +352,60 @@ def dataclass_replace(obj, **changes):
     return dataclasses.replace(obj, **changes)
 
 
-def test_no_admissible_design_is_one_line_naming_the_best_margin(tmp_path, monkeypatch, capsys):
-    """A range in which every design switches: one line with the best margin and where it switches, exit 2; the
-    finished runs stay for --resume."""
-    def no_design_keeps_it(problem, predictor, verify_batch, screened, log=None):
-        s = problem.grid()[-1]
-        v = stand_in_verify(problem, [])([s], 0)[0]
-        return [dataclass_replace(v, point_apr=np.ones_like(v.point_apr))], ds.Search([[s]], "stand-in")
+def test_no_admissible_design_after_verification_exits_3_and_writes_every_verified_design(tmp_path, monkeypatch,
+                                                                                         capsys):
+    """A range in which every verified design has one almost periodic run (1 of 3) at the margin level: the conservative
+    rule makes none admissible; one line with the best margin, how many designs fit the block and where to widen it,
+    exit 3; design.csv and design.json hold every verified design, marked not admissible, and no recommendation."""
+    def every_design_switches(problem, predictor, verify_batch, screened, log=None):
+        n = len(problem.excitation)
+        out = []
+        for s in problem.grid():
+            apr = np.zeros((9, n + 1))
+            apr[0, -1] = 1.0 / 3.0
+            out.append(dr.Verified(s, np.full(n, 0.5e-4), np.full(n, 1e-4), np.full(n, 0.8e-4), np.zeros(n),
+                                   np.zeros(n, bool), 9 * (n + 1) * 3, point_apr=apr, margin_high=1e-4,
+                                   excitation=(*problem.excitation, problem.margin_level()),
+                                   prediction=dataclass_replace(StandInPredictor().predict(s), per_level=np.full(n, 1e-4)),
+                                   worst_interval=(0.9e-4, 1.1e-4)))
+        return out, ds.Search([problem.grid()], "stand-in")
 
-    monkeypatch.setattr(ds, "search", no_design_keeps_it)
+    monkeypatch.setattr(ds, "search", every_design_switches)
     monkeypatch.setattr(dq.Predictor, "describe", lambda self: [])
     out = tmp_path / "out"
-    code = exit_code(["design", "--excitation", "2um:8um:2", "--clearance", "0.3mm:0.5mm:2", "--out", str(out),
+    code = exit_code(["design", "--excitation", "2um:8um:2", "--clearance", "0.3mm:3mm:4", "--out", str(out),
                       "--quiet", "--jobs", "1", "--reps", "1"])
     err = capsys.readouterr().err.strip()
+    assert code == 3 and len(err.splitlines()) == 1 and "Traceback" not in err, err
+    assert "no verified design keeps a margin of 20% to the switch: the best, g 0.300 mm" in err
+    assert "1 of 4 designs fit the 28 mm block" in err and "--block-width 32.9mm takes them all" in err
+    assert "--resume" in err
+    data = json.loads((out / "design.json").read_text())
+    assert data["recommendation"] is None and data["refusal"] in err
+    assert len(data["verified"]) == 4 and not any(v["admissible"] for v in data["verified"])
+    with open(out / "design.csv") as f:
+        rows = [r for r in csv.DictReader(f) if r["status"] != "screened"]
+    assert len(rows) == 4 and {r["admissible"] for r in rows} == {"0"}
+    assert not any(cell == "None" for r in rows for cell in r.values())
+
+
+def test_a_design_the_similarity_law_sees_no_room_for_is_refused_before_verification(tmp_path, monkeypatch, capsys):
+    """Where every prediction switches inside the range + margin, one line with the predicted margins, exit 2, and
+    not one verification run."""
+    verified = []
+    monkeypatch.setattr(dq.Predictor, "ensure", lambda self, spheres: None)
+    monkeypatch.setattr(dq.Predictor, "predict", lambda self, s: dq.DesignPrediction(
+        s, np.full(2, 1e-4), 9e-6 * s.clearance / 1e-3, "found", dq.Corner(0.00075, 0.0, 1.0), 1e-5, "found",
+        (1e-4, 4e-4)))
+    monkeypatch.setattr(ds, "verify", lambda *a, **k: verified.append(a) or [])
+    out = tmp_path / "out"
+    code = exit_code(["design", "--excitation", "2um:8um:2", "--clearance", "0.3mm:1mm:3", "--out", str(out),
+                      "--quiet", "--jobs", "1", "--reps", "1", "--block-width", "32mm"])
+    err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1, err
-    assert "no design keeps a margin of 20% to the switch: the best, g 0.500 mm" in err and "switches at 2 um" in err
-    assert "--resume" in err and not (out / "design.json").exists()
+    assert "the similarity law predicts no design keeping a margin of 20%" in err
+    assert "g 1.000 mm, brass R 7.92 mm: 12% (switch at 9 um)" in err and "3 of 3 designs fit" in err
+    assert not verified and not (out / "design.json").exists()
 
 
 def test_a_host_whose_first_mode_does_not_move_the_walls_is_refused(tmp_path, capsys):
@@ -399,7 +442,7 @@ def test_a_calibration_sets_the_upper_end_of_the_k_H_factor(tmp_path, capsys):
 
 def test_the_box_is_its_distinct_corners_and_its_centre():
     problem = dp.DesignProblem(excitation=(2e-6,), clearances=(0.5e-3,), radii=(7.92e-3,))
-    sphere = dp.Sphere(0.5e-3, 7.92e-3, "brass")
+    sphere = dp.Design(0.5e-3, 7.92e-3, "brass")
     points = problem.corners(sphere)
     corners = {dq.corner_of(p, sphere) for p in points[:-1]}
     assert len(points) == 9 and len(corners) == 8
