@@ -74,15 +74,37 @@ def test_a_tiny_design_end_to_end_resumes_and_is_the_same_in_parallel(tmp_path, 
     assert best["margin_worst"] >= data["settings"]["margin"]
     assert data["baseline"]["clearance_m"] == pytest.approx(0.58e-3)
     # every verified design has its prediction beside its verification, and its round
-    assert all(v["predicted_worst"] > 0 and v["switch_worst_m"] > 0 and v["round"] >= 0 for v in data["verified"])
+    assert all(v["predicted_worst_m"] > 0 and v["switch_worst_m"] > 0 and v["round"] >= 0 for v in data["verified"])
     assert data["search"]["rounds"][0] and data["search"]["stop"] and data["similarity"]
+    # one name per quantity: no key both with and without _m, the slow flow's as screened_*
+    for v in data["verified"]:
+        assert not {k for k in v if k + "_m" in v}, v.keys()
+    # the worst case with its interval, the cells deciding it (with extra repetitions for the recommendation)
+    low, high = best["worst_interval_m"]
+    assert low < high and low <= best["worst_m"] * 1.5 and high >= best["worst_m"] * 0.5
+    assert best["deciding"] and max(c["runs"] for c in best["deciding"]) >= 2 * data["settings"]["repetitions"]
+    assert data["search"]["settling"]["text"] and data["settings"]["apr_rule"] == "any run"
+    # the check: an ies sweep line with the sphere, the clearance and the level as a base amplitude
+    check = best["check_command"]
+    assert check.startswith("ies sweep --level ") and "um --radius " in check and f"--material {best['material']}" in check
+    assert "--g " in check and "--wall-material steel" in check and f"check it: {check}" in printed
+    import shlex
+
+    assert main([*shlex.split(check)[1:], "--out", str(tmp_path / "check")]) == 0  # it runs as printed
+    # normalised by the host's own D_1* (the rig: Table 2's 0.085 %), the box's D interval from the host, both stated
+    assert data["host"]["D_star"] == pytest.approx(0.00085) and data["no_absorber"]["D_1"] == pytest.approx(0.00085)
+    assert data["host"]["normalisation"]["D_star"] == pytest.approx(0.00085) and "box: D_1 0.075-0.09 %" in printed
     with open(out / "design.csv") as f:
         rows = list(csv.DictReader(f))
     assert list(rows[0]) == list(dr.DESIGN_CSV.names)
     assert sum(r["status"] != "screened" for r in rows) == len(data["verified"])
     assert all(float(r["cavity_m"]) == pytest.approx(2 * (float(r["radius_m"]) + float(r["clearance_m"])))
                for r in rows)
-    assert all(r["margin_worst"] and r["switch_worst_m"] for r in rows if r["status"] != "screened")
+    assert all(r["margin_worst"] and r["switch_worst_m"] and r["worst_interval_low_m"] for r in rows
+               if r["status"] != "screened")
+    assert not any(cell == "None" for r in rows for cell in r.values())  # empty cells, not None
+    with open(out / "design-levels.csv") as f:
+        assert "None" not in f.read()
     # results.nc holds the same numbers as design-levels.csv
     from uq.outputs.results import open_study
 
@@ -92,7 +114,7 @@ def test_a_tiny_design_end_to_end_resumes_and_is_the_same_in_parallel(tmp_path, 
     assert nc["high"].values.ravel().tolist() == pytest.approx([float(r["high_m"]) for r in levels], rel=1e-12)
     assert nc["high"].attrs["units"] == "m" and nc.attrs["recommendation"] == best["sentence"]
     # every verified design: 8 corners + the centre, at 2 operating levels and the margin level, 1 repetition
-    assert all(v["runs"] == 9 * 3 for v in data["verified"])
+    assert all(v["runs"] >= 9 * 3 for v in data["verified"]) and any(v["runs"] == 9 * 3 for v in data["verified"])
     # the worst case is in metres: below the structure without IES at the top of the range
     assert best["worst_m"] < max(data["no_absorber"]["tip_m"])
     # --resume runs nothing again and gives the same numbers; in parallel too
@@ -129,12 +151,12 @@ def test_a_new_objective_is_one_row_and_runs_ies_design_end_to_end(tmp_path, cap
     printed = capsys.readouterr().out
     data = json.loads((tmp_path / "acc" / "design.json").read_text())
     assert data["objective"]["unit"] == "m/s^2" and "m/s^2" in printed
-    assert data["recommendation"]["worst_m"] is None and data["recommendation"]["worst"] > 0
+    assert "worst_m" not in data["recommendation"] and data["recommendation"]["worst_m_per_s2"] > 0
     assert main(["design", str(study), "--jobs", "1", "--quiet", "--no-figures", "--out", str(tmp_path / "amp")]) == 0
-    amplitude = {(v["clearance_m"], v["radius_m"], v["material"]): v["worst"]
+    amplitude = {(v["clearance_m"], v["radius_m"], v["material"]): v["worst_m"]
                  for v in json.loads((tmp_path / "amp" / "design.json").read_text())["verified"]}
     omega_1 = data["host"]["omega_1_rad_per_s"]
-    both = [(v["worst"], amplitude[key]) for v in data["verified"]
+    both = [(v["worst_m_per_s2"], amplitude[key]) for v in data["verified"]
             if (key := (v["clearance_m"], v["radius_m"], v["material"])) in amplitude]
     assert both
     for acceleration, tip in both:
