@@ -474,3 +474,54 @@ def test_the_box_is_its_distinct_corners_and_its_centre():
     centre = dq.corner_of(points[-1], sphere)
     assert centre.D == pytest.approx(0.5 * sum(problem.D)) and centre.k_H_factor == pytest.approx(
         0.5 * sum(problem.k_H_factor)) and points[-1]["g"] == pytest.approx(0.5e-3 + 0.016e-3)
+
+
+def test_a_steel_sphere_on_aluminium_walls_has_eq_8s_ratio_of_contact_moduli(tmp_path):
+    """Eq. 8 with both bodies: k_H on an aluminium wall over k_H on steel is E*_Al / E*_steel, 1/E* = (1 - nu_s^2)/E_s
+    + (1 - nu_w^2)/E_w with the handbook values (steel 207 GPa, 0.30; 6061-T6 68.9 GPa, 0.33): about 0.51 (issue 40,
+    item 3). The design takes the wall from the host's [host] table, or --wall-material, without --k-H-factor; the box's
+    k_H corners are Table 2's factors on that value."""
+    from sim.hosts.modal_file import load_modal_model, save_modal_model
+    from sim.hosts.rig import seed_rig_model
+    from sim.model.materials import WALL_MATERIALS
+
+    def e_star(E1, nu1, E2, nu2):
+        return 1.0 / ((1 - nu1**2) / E1 + (1 - nu2**2) / E2)
+
+    expected = e_star(207e9, 0.30, 68.9e9, 0.33) / e_star(207e9, 0.30, 207e9, 0.30)
+    steel = dp.Design(1e-3, 5e-3, "steel")
+    aluminium = dp.Design(1e-3, 5e-3, "steel", WALL_MATERIALS["aluminium"])
+    assert aluminium.k_H / steel.k_H == pytest.approx(expected, rel=1e-12) and 0.50 < expected < 0.52
+    # the host's [host] wall_material reaches every design, and --wall-material wins over it
+    path = save_modal_model(dataclass_replace(seed_rig_model(), wall=WALL_MATERIALS["aluminium"]), tmp_path / "host.toml")
+    assert 'wall_material = "aluminium"' in path.read_text() and load_modal_model(path).wall_material.name == "aluminium"
+    settings = {**dp.DESIGN_SETTINGS, "excitation": "2um:6um:2", "radius": "5mm", "material": "steel",
+                "clearance": "1mm", "model": str(path)}
+    on_host = dp.problem_of(settings)
+    assert on_host.wall.name == "aluminium" and on_host.grid()[0].k_H == pytest.approx(aluminium.k_H, rel=1e-12)
+    k_H = sorted({p["k_H"] for p in on_host.corners(on_host.grid()[0])[:-1]})
+    assert k_H == pytest.approx([aluminium.k_H * f for f in on_host.k_H_factor], rel=1e-12)
+    assert dp.problem_of({**settings, "wall_material": "steel"}).grid()[0].k_H == pytest.approx(steel.k_H, rel=1e-12)
+
+
+def test_the_box_takes_the_hosts_damping_interval_else_table_2s_relative_one_around_its_D_1(tmp_path):
+    """Issue 40, item 2: a host with D_1 = 0.1 % and no interval gets Table 2's relative interval around its own D_1*
+    (0.0882-0.1059 %), said so; one with a [host] damping_interval gets that; the structure without IES is at its
+    nominal D_1* (a_noabs* = phi_tip (phi^T M b) a_base / (2 D_1*), Sect. 5)."""
+    from sim.hosts.modal_file import save_modal_model
+    from sim.hosts.rig import seed_rig_model
+
+    model = seed_rig_model()
+    damping = model.damping_ratios.copy()
+    damping[0] = 0.001
+    path = save_modal_model(dataclass_replace(model, damping_ratios=damping, damping_interval=None), tmp_path / "h.toml")
+    settings = {**dp.DESIGN_SETTINGS, "excitation": "2um:6um:2", "model": str(path)}
+    problem = dp.problem_of(settings)
+    assert problem.D == pytest.approx((0.001 * 0.00075 / 0.00085, 0.001 * 0.0009 / 0.00085))
+    assert "Table 2's relative interval" in problem.damping_source and "D_1 0.08824-0.1059 %" in problem.box_text()
+    host = dp.host_model(problem)
+    a = np.array([3.0e-6])
+    assert dp.no_absorber(host, a)[0] == pytest.approx(abs(host.phi_tip[0] * host.participation[0]) * 3.0e-6 / 0.002)
+    save_modal_model(dataclass_replace(model, damping_ratios=damping, damping_interval=(0.0009, 0.0012)), path)
+    own = dp.problem_of(settings)
+    assert own.D == (0.0009, 0.0012) and own.damping_source == "the host's damping interval"
