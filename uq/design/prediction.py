@@ -156,6 +156,11 @@ class Predictor:
 
     def _evaluator(self, realisations: Sequence[tuple[float, float, float]], mass: float,
                    counted: list[int]) -> Callable[[list[tuple[int, float]]], list[Any]]:
+        """The references' outcomes at own levels: the share of almost periodic runs and the objective per a_noabs*.
+        Below a reference's first impacts, own level D_1 / D_1* (Eq. 7, mode 1: the linear wall amplitude at resonance
+        reaches g at a_base = 2 D_1 g / (phi_c phi^T M b), a_base*(g) at D_1*), the response is linear and its almost
+        periodic label (a cv below 0.1) means nothing: it counts as no switch, as in `Verified.apr_seen_at` (a
+        reference of the rig at own level 0.51 had one such run, and the law put the switch there)."""
         from sim.reduced.similarity import Outcome
         from uq.problem.tasks import Task
 
@@ -173,7 +178,9 @@ class Predictor:
             out = []
             for request in batch:
                 runs = [records[t] for t in tasks[request]]
-                apr = [r["outputs"].get("apr", 0.0) for r in runs if not r.get("error")]
+                i, own = request
+                linear = own < realisations[i][2] / self.rig.D_star  # below its first impacts (`onset_own_level`)
+                apr = [0.0 if linear else r["outputs"].get("apr", 0.0) for r in runs if not r.get("error")]
                 values = [self.objective.of_run(r, omega_1) / r["trace"]["a_noabs"] for r in runs
                           if not r.get("error") and "trace" in r]
                 values = [v for v in values if math.isfinite(v)]

@@ -525,3 +525,18 @@ def test_the_box_takes_the_hosts_damping_interval_else_table_2s_relative_one_aro
     save_modal_model(dataclass_replace(model, damping_ratios=damping, damping_interval=(0.0009, 0.0012)), path)
     own = dp.problem_of(settings)
     assert own.D == (0.0009, 0.0012) and own.damping_source == "the host's damping interval"
+
+
+def test_an_almost_periodic_label_below_a_references_first_impacts_is_no_switch():
+    """A linear response is periodic (cv below 0.1): below a reference's first impacts, own level D_1 / D_1*, its
+    label does not count for the similarity law's switch (it put the rig's switch at own level 0.5 once)."""
+    problem = dp.DesignProblem(excitation=(2e-6,), clearances=(1e-3,), radii=(7.92e-3,))
+
+    def every_run_almost_periodic(tasks):
+        return {t: {"outputs": {"apr": 1.0, "mean": 0.1}, "trace": {"a_noabs": 1e-3}} for t in tasks}
+
+    rig = dp.host_model(problem)
+    predictor = dq.Predictor(problem, do.objective_named("mean"), rig, every_run_almost_periodic)
+    evaluate = predictor._evaluator([(1e-3, 8.9e9, 0.00075)], 0.0177, [0])
+    below, above = evaluate([(0, 0.5), (0, 0.9)])  # onset at 0.00075 / 0.00085 = 0.88
+    assert below.apr == 0.0 and above.apr == 1.0
