@@ -83,39 +83,64 @@ def plot_design_map(result: Any, path: Path) -> Path:
     return _clearance_radius_map(result, path)
 
 
+#: the map's axis reaches this factor above the highest interval of the decisive verified designs
+HEADROOM = 1.15
+#: verified designs up to this factor above the recommendation's worst case decide the map's axis
+DECISIVE = 3.0
+
+
+def _above(ax: Any, xs: np.ndarray, ys: Any, top: float, colour: str, label: str | None, row: int | None,
+           **kw: Any) -> None:
+    """Points of a series above the axis top, as triangles at the top edge, with their value in text row `row` below
+    the edge (None: without)."""
+    for x, y in zip(xs, ys):
+        ax.plot([x], [top * 0.97], "^", color=colour, ms=6, ls="", label=label, **kw)
+        if row is not None:
+            ax.annotate(f"{y:.2g}", (x, top * 0.97), xytext=(5, -4 - 10 * row), textcoords="offset points",
+                        fontsize=LEGEND_PT, color=colour)
+        label = None
+
+
 def _clearance_curves(result: Any, path: Path) -> Path:
     """One radius: per material the verified worst cases with their 95 % intervals (filled: admissible; open: not),
-    the similarity law's prediction and the slow flow's screening; the axis spans the verified and predicted values
-    (the slow flow, a lower bound of the switch and far above near it, is marked at the top edge where it leaves)."""
+    the similarity law's prediction and the slow flow's screening. The axis spans the decisive verified designs (on the
+    grid, up to DECISIVE times the recommendation's worst case) with their intervals; whatever lies above (the slow
+    flow, a lower bound of the switch and far above near it; the baseline; predictions beyond a switch) is a triangle
+    at the top edge with its value."""
     p, o = result.problem, result.objective
     R = p.radii[0]
     scale = o.shown_scale
     with plot_to(path, figsize=(6.4, 5.0)) as (fig, ax):
         shown = [v for v in result.verified if v.design.radius == R]
         values = {m: _values(result, m, R) for m in p.materials}
-        span = [y for v in shown for y in (v.worst, *v.worst_interval) if np.isfinite(y)]
-        span += [y for m in p.materials for y in values[m]["predicted"][1]]
-        top_y = 1.12 * max(span) * scale if span else None
-        bottom_y = 0.0
+        best = result.recommendation.worst
+        decisive = [v for v in shown if v.design in set(p.grid()) and v.worst <= DECISIVE * best] or shown
+        span = [y for v in decisive for y in (v.worst, *v.worst_interval) if np.isfinite(y)]
+        top = HEADROOM * max(span) * scale if span else math.inf
+        above_label = f"above the axis (predicted, verified: value in {o.shown_in})"
         edges = []
         for k, material in enumerate(p.materials):
             colour = CURVE_COLOURS[(k + 1) % len(CURVE_COLOURS)]
             name = f" ({material})" if len(p.materials) > 1 else ""
-            xs, ys = values[material]["screened"]
-            if xs.size:
+            for source, style, label, row in (("screened", ":", f"screened, slow flow{name}", None),
+                                              ("predicted", "--", f"predicted, similarity law{name}", 0)):
+                xs, ys = values[material][source]
+                if not xs.size:
+                    continue
                 ys = ys * scale
-                within = ys <= top_y if top_y is not None else np.ones(ys.size, bool)
-                ax.plot(np.where(within, xs * 1e3, np.nan), np.where(within, ys, np.nan), ":", color=colour,
-                        label=f"screened, slow flow{name}")
-                if (~within).any():
-                    ax.plot(xs[~within] * 1e3, np.full((~within).sum(), top_y * 0.985), "^", color=colour, ms=6,
-                            ls="", label=f"slow flow above the axis{name}")
-            xs, ys = values[material]["predicted"]
-            if xs.size:
-                ax.plot(xs * 1e3, ys * scale, "--", color=colour, marker=".", label=f"predicted, similarity law{name}")
+                within = ys <= top
+                ax.plot(np.where(within, xs * 1e3, np.nan), np.where(within, ys, np.nan), style, color=colour,
+                        marker="." if source == "predicted" else None, label=label)
+                _above(ax, xs[~within] * 1e3, ys[~within], top, colour, above_label, row, alpha=0.6)
+                above_label = None if (~within).any() else above_label
             mine = [v for v in shown if v.design.material == material]
             for admissible in (True, False):
                 group = [v for v in mine if v.admissible(result.top, p.margin) == admissible]
+                high = [v for v in group if v.worst * scale > top]
+                group = [v for v in group if v not in high]
+                _above(ax, np.array([v.design.clearance * 1e3 for v in high]), [v.worst * scale for v in high], top,
+                       colour, above_label, 1, mfc="w")
+                above_label = None if high else above_label
                 if not group:
                     continue
                 x = np.array([v.design.clearance * 1e3 for v in group])
@@ -124,11 +149,11 @@ def _clearance_curves(result: Any, path: Path) -> Path:
                                for v in group])
                 hi = np.array([v.worst_interval[1] * scale if np.isfinite(v.worst_interval[1]) else v.worst * scale
                                for v in group])
-                ax.errorbar(x, y, yerr=[np.maximum(y - lo, 0), np.maximum(hi - y, 0)], fmt="o", color=colour,
-                            mec=colour if admissible else colour, mfc=colour if admissible else "w", capsize=3,
+                ax.errorbar(x, y, yerr=[np.maximum(y - lo, 0), np.maximum(np.minimum(hi, top) - y, 0)], fmt="o",
+                            color=colour, mfc=colour if admissible else "w", capsize=3,
                             label=f"verified, 95 % interval{name}" if admissible else f"verified, not admissible{name}")
-            worst = {v.design: v.worst for v in result.verified}
-            _marks(ax, result, material, R, lambda s: worst.get(s, math.nan) * scale)
+            worst = {v.design: min(v.worst * scale, top * 0.97) for v in result.verified}
+            _marks(ax, result, material, R, lambda s: worst.get(s, math.nan))
             edge = _margin_edge(result, material, R)
             if edge is not None:
                 edges.append(edge)
@@ -138,8 +163,8 @@ def _clearance_curves(result: Any, path: Path) -> Path:
                        color="0.85", lw=0, zorder=0,
                        label=f"predicted to switch below the top ({max(p.excitation) * 1e6:.3g} {MICROMETRE}) + "
                              f"{p.margin:.0%}")
-        if top_y is not None:
-            ax.set_ylim(bottom_y, top_y)
+        if math.isfinite(top):
+            ax.set_ylim(0.0, top)
         ax.set_xlabel("clearance $g$ (mm)")
         ax.set_ylabel(f"worst case of the {o.quantity} ({o.shown_in})")
         ax.set_title(_sphere_title(result, R), fontsize="medium")

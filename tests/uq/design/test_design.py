@@ -540,3 +540,24 @@ def test_an_almost_periodic_label_below_a_references_first_impacts_is_no_switch(
     evaluate = predictor._evaluator([(1e-3, 8.9e9, 0.00075)], 0.0177, [0])
     below, above = evaluate([(0, 0.5), (0, 0.9)])  # onset at 0.00075 / 0.00085 = 0.88
     assert below.apr == 0.0 and above.apr == 1.0
+
+
+def test_the_readmes_modal_file_loads_and_its_host_reaches_the_design(tmp_path):
+    """The format in README.md ("Your own structure") is a modal file as written: it loads, its D_1 is the nominal
+    D_1*, its [host] interval and aluminium walls reach the design's box and Eq. 8."""
+    import re
+    from pathlib import Path
+
+    from sim.hosts.modal_file import load_modal_model
+
+    readme = (Path(__file__).resolve().parents[3] / "README.md").read_text()
+    section = readme[readme.index("## Your own structure"):]
+    (block,) = re.findall(r"```toml\n(.*?)```", section, flags=re.S)[:1]
+    path = tmp_path / "beam.toml"
+    path.write_text(block)
+    model = load_modal_model(path)
+    assert model.D_star == 0.001 and model.damping_interval == (0.0009, 0.0012)
+    assert model.wall_material.name == "aluminium" and model.n_modes == 3
+    problem = dp.problem_of({**dp.DESIGN_SETTINGS, "excitation": "1.2um:6um:6", "model": str(path), "radius": "5mm",
+                             "material": "steel", "clearance": "0.4mm:1.8mm:8"})
+    assert problem.D == (0.0009, 0.0012) and problem.wall.name == "aluminium"
