@@ -178,10 +178,6 @@ SETTLE_MIN = 2
 SETTLE_MAX = 5
 
 
-#: extra repetitions per design: {design: {(box point, operating level): runs}}; the others have the problem's
-Repetitions = dict
-
-
 def verify(problem: DesignProblem, objective: Objective, designs: Sequence[Design], rig: Any,
            run: Callable[[list[Any]], Mapping[Any, Any]], *, round_: int = 0,
            predictions: Mapping[Design, DesignPrediction] | None = None,

@@ -561,3 +561,37 @@ def test_the_readmes_modal_file_loads_and_its_host_reaches_the_design(tmp_path):
     problem = dp.problem_of({**dp.DESIGN_SETTINGS, "excitation": "1.2um:6um:6", "model": str(path), "radius": "5mm",
                              "material": "steel", "clearance": "0.4mm:1.8mm:8"})
     assert problem.D == (0.0009, 0.0012) and problem.wall.name == "aluminium"
+
+
+@pytest.mark.parametrize("gap, settled, most", [(0.20, True, 9), (0.01, False, 15)])
+def test_overlapping_intervals_get_more_repetitions_until_they_part_or_the_budget_is_spent(gap, settled, most):
+    """Two admissible designs whose worst cases' intervals shrink as 1/sqrt(runs) at their deciding cell: 0.20 apart
+    they part after 9 runs a cell (3 rounds of the design's 3); 0.01 apart they overlap still at the budget, 15 runs
+    (5x), and the ranking is said to be within the noise. The winner's deciding cell always gets at least 2x."""
+    problem = stand_in_problem(repetitions=3)
+    a, b = problem.grid()[5], problem.grid()[6]
+    worst = {a: 1.0, b: 1.0 + gap}
+
+    def verify_batch(designs, round_, reps_at):
+        out = []
+        for s in designs:
+            n = reps_at.get(s, {}).get((0, 2), problem.repetitions)
+            half = 0.25 / math.sqrt(n)
+            runs = np.full((9, 4), problem.repetitions)
+            runs[0, 2] = n
+            out.append(dr.Verified(s, np.full(3, 0.5), np.full(3, worst[s]), np.full(3, 0.5), np.zeros(3),
+                                   np.zeros(3, bool), int(runs.sum()), point_apr=np.zeros((9, 4)),
+                                   excitation=(*problem.excitation, problem.margin_level()),
+                                   prediction=StandInPredictor().predict(s), worst_interval=(worst[s] - half,
+                                                                                            worst[s] + half),
+                                   deciding=((0, 2),), point_runs=runs))
+        return out
+
+    reps_at = {}
+    verified = {v.design: v for v in verify_batch([a, b], 0, reps_at)}
+    settling = ds.settle(problem, verified, reps_at, lambda designs: verify_batch(designs, 0, reps_at))
+    assert settling.winner == a and settling.runner_up == b
+    assert settling.overlap == (not settled) and settling.most_runs == most and settling.budget == 15
+    assert reps_at[a][(0, 2)] == most and reps_at[b][(0, 2)] == most
+    text = settling.text(verified, lambda x: f"{x:.3g}", "mm")
+    assert ("ranking settled" in text) == settled and ("within the noise" in text) == (not settled)
