@@ -9,10 +9,15 @@ What is computed (`orbit_response`):
    stepped sine's start at `at` and solves for a kT orbit (k = 1 .. max_period) from there; "linear" starts at
    the linear orbit (only where the walls do not reach the sphere).
 2. The start's branch, continued both ways over the range (once when it closes on itself).
-3. Branch switching at up to `switches` symmetry-breaking and period-doubling points (period multiple at most
-   `max_period`), those with the fewest unstable multipliers first (the ones nearest to a stable orbit), and
-   the new branches continued with detection too (not switched again).
-4. The linear orbits (no impact, the sphere at rest where the walls do not reach it) on LINEAR_POINTS values of
+3. Branch switching at every located symmetry-breaking and period-doubling point of every branch (period multiple
+   at most `max_period`; at most `switches` switchings when given, those with the fewest unstable multipliers
+   first: the ones nearest to a stable orbit), the new branches continued with detection too and switched in turn;
+   a point that a switched branch has already come back through is not switched again (the same asymmetric pair).
+4. At every change of stability of every branch, a direct simulation from the perturbed orbit on its unstable side
+   and Newton's method from its end state for a kT orbit, k <= max_period (`sim.orbits.searches`): what it finds
+   that no branch has is continued both ways as a branch of its own (and switched and searched from in turn). At
+   most MAX_BRANCHES branches in all; what is left undone is said in `notes`.
+5. The linear orbits (no impact, the sphere at rest where the walls do not reach it) on LINEAR_POINTS values of
    the range where they exist: they are unstable in the frictionless model (a sphere given any speed drifts into
    a wall: the multiplier 1 of its free flight is a Jordan block), but they are the response a sphere at rest
    would keep. Impacting orbits may coexist with them (the sphere's own motion drives the walls). Where no start
@@ -32,6 +37,7 @@ import numpy as np
 from sim.common.errors import SimulationDiverged, SimulationInputError
 from sim.orbits.bifurcations import PERIOD_DOUBLING, SYMMETRY_BREAKING, detect, outside_count, switch_branch
 from sim.orbits.continuation import Branch, BranchPoint, continue_branch
+from sim.orbits.searches import search, stability_changes
 from sim.orbits.setting import OrbitSetting, parameter
 from sim.orbits.shooting import MAX_PERIOD_MULTIPLE, OrbitNotConverged, PeriodicOrbit, solve_orbit
 from sim.orbits.starts import (DEFAULT_RESTITUTION, linear_orbit, linear_wall_amplitude, simulated_state,
@@ -48,6 +54,8 @@ SIMULATION_PERIODS = 400
 LINEAR_POINTS = 41
 #: The range eta may span (the primary resonance and well beyond: the orbits near it are what is asked for).
 ETA_BOUNDS = (0.5, 2.0)
+#: Most branches of one response (the start's, the switched ones and the searches' finds).
+MAX_BRANCHES = 16
 
 
 @dataclass
@@ -57,7 +65,8 @@ class OrbitResponse:
     base: the setting the parameter is varied from; parameter: "eta" or "level"; bounds: its range; branches:
     the impacting branches (the start's first, then the switched ones); linear: the linear orbits (a branch without
     continuation; None where there are none); impacts: False when the walls never reach the sphere over the range;
-    notes: what was tried and did not work (one line each).
+    notes: what was tried and did not work, and what each search found (one line each); searches: the direct
+    simulations at the changes of stability (`sim.orbits.searches.Search`).
     """
 
     base: OrbitSetting
@@ -67,6 +76,7 @@ class OrbitResponse:
     linear: Branch | None = None
     impacts: bool = True
     notes: list[str] = field(default_factory=list)
+    searches: list = field(default_factory=list)
 
     @property
     def all_branches(self) -> list[Branch]:
@@ -139,13 +149,14 @@ def _start(base: OrbitSetting, name: str, lo: float, hi: float, how: str, *, at:
 
 
 def orbit_response(base: OrbitSetting, name: str, bounds: tuple[float, float], *, start: str = "slow-flow",
-                   at: float | None = None, max_period: int = 2, switches: int = 2,
+                   at: float | None = None, max_period: int = 2, switches: int | None = None, searches: bool = True,
                    restitution: float = DEFAULT_RESTITUTION,
                    progress: Callable[[], None] | None = None) -> OrbitResponse:
     """The periodic orbits of `base` with the parameter `name` ("eta" or "level") over `bounds` (module docstring).
     start: one of STARTS; at: the parameter value to start at (None: the start's own choice); max_period: the
-    largest period multiple k of a switched branch (1..MAX_PERIOD_MULTIPLE); switches: branch switchings at most;
-    restitution: the slow flow's r for the slow-flow start; progress: called once per accepted point."""
+    largest period multiple k of a switched or found branch (1..MAX_PERIOD_MULTIPLE); switches: branch switchings
+    at most (None: every located one); searches: the direct simulations at the changes of stability; restitution:
+    the slow flow's r for the slow-flow start; progress: called once per accepted point."""
     if name not in ("eta", "level"):
         raise SimulationInputError(f"orbits: the response is continued in eta or the level, not {name!r}")
     lo, hi = check_range(name, bounds)
@@ -171,22 +182,90 @@ def orbit_response(base: OrbitSetting, name: str, bounds: tuple[float, float], *
         return result
     if orbit.linear and start != "linear":
         result.notes.append("the start converged to the linear orbit (no impacts)")
-    first = continue_branch(orbit, name, (lo, hi), direction=1.0, origin=f"{start} start", detect=detect,
-                            progress=progress)
-    if not first.stop.startswith("closed loop"):
-        back = continue_branch(orbit, name, (lo, hi), direction=-1.0, detect=detect, progress=progress)
-        first.points = back.points[:0:-1] + first.points
-        first.stop = f"{back.stop} / {first.stop}"
-    result.branches.append(first)
-    candidates = [p for p in first.points if p.label in (SYMMETRY_BREAKING, PERIOD_DOUBLING)
-                  and (p.label == SYMMETRY_BREAKING or 2 * p.orbit.k <= max_period)]
-    candidates.sort(key=lambda p: (outside_count(p.orbit), p.orbit.max_multiplier))
-    for point in candidates[:max(0, int(switches))]:
-        try:
-            result.branches.append(switch_branch(point, name, (lo, hi), progress=progress))
-        except (OrbitNotConverged, SimulationDiverged, SimulationInputError) as exc:
-            result.notes.append(f"switching at the {point.label} at {name} {par.get(point.orbit.setting):.5g}: {exc}")
+    result.branches.append(_both_ways(orbit, name, (lo, hi), f"{start} start", progress))
+    _grow(result, max_period=max_period, switches=switches, searches=searches, progress=progress)
     return result
+
+
+def _both_ways(orbit: PeriodicOrbit, name: str, bounds: tuple[float, float], origin: str,
+               progress: Callable[[], None] | None) -> Branch:
+    """The branch through `orbit` continued up and then down over `bounds` (once when it closes on itself)."""
+    branch = continue_branch(orbit, name, bounds, direction=1.0, origin=origin, detect=detect, progress=progress)
+    if not branch.stop.startswith("closed loop"):
+        back = continue_branch(orbit, name, bounds, direction=-1.0, detect=detect, progress=progress)
+        branch.points = back.points[:0:-1] + branch.points
+        branch.unlocated = back.unlocated + branch.unlocated
+        branch.stop = f"{back.stop} / {branch.stop}"
+    return branch
+
+
+def _switching_points(branch: Branch, max_period: int) -> list[BranchPoint]:
+    """The located symmetry-breaking and period-doubling points of a branch at which a branch of period <=
+    max_period T bifurcates."""
+    return [p for p in branch.points if p.label == SYMMETRY_BREAKING and p.orbit.symmetric
+            or p.label == PERIOD_DOUBLING and 2 * p.orbit.k <= max_period]
+
+
+def _reached(point: BranchPoint, branches: list[Branch]) -> bool:
+    """Whether a switched branch already came back through its parent at this point (`Branch.rejoins`)."""
+    value = branches[0].parameter.get(point.orbit.setting)
+    for branch in branches:
+        if branch.rejoins is not None and branch.k == point.orbit.k:
+            a, b = sorted(branch.rejoins)
+            if a - 1e-9 * max(abs(a), 1.0) <= value <= b + 1e-9 * max(abs(b), 1.0):
+                return True
+    return False
+
+
+def _grow(result: OrbitResponse, *, max_period: int, switches: int | None, searches: bool,
+          progress: Callable[[], None] | None) -> None:
+    """Steps 3 and 4 of the module docstring on `result`'s branches, appending the new ones."""
+    name, (lo, hi) = result.parameter, result.bounds
+    par = parameter(name)
+    switched, done = 0, 0  # switchings made; branches whose points have been looked at
+    pending: list[tuple[BranchPoint, Branch]] = []
+    searched: set[tuple[int, int, float]] = set()  # (branch, side, where in scale units) of the searches made
+    while done < len(result.branches) or pending:
+        while done < len(result.branches):  # the new branches' switching points, nearest to a stable orbit first
+            pending.extend((p, result.branches[done]) for p in _switching_points(result.branches[done], max_period))
+            done += 1
+        pending.sort(key=lambda item: (outside_count(item[0].orbit), item[0].orbit.max_multiplier))
+        if pending:
+            point, _ = pending.pop(0)
+            where = f"{point.label} at {name} {par.get(point.orbit.setting):.5g}"
+            if _reached(point, result.branches):
+                continue
+            if switches is not None and switched >= switches or len(result.branches) >= MAX_BRANCHES:
+                result.notes.append(f"not switched at the {where} (--switches or {MAX_BRANCHES} branches reached)")
+                continue
+            try:
+                result.branches.append(switch_branch(point, name, (lo, hi), progress=progress))
+                switched += 1
+            except (OrbitNotConverged, SimulationDiverged, SimulationInputError) as exc:
+                result.notes.append(f"switching at the {where}: {exc}")
+            continue
+        if not searches:
+            break
+        found_any = False
+        for branch in list(result.branches):
+            for point, side in stability_changes(branch):
+                key = (id(branch), side, round(par.to_coordinate(par.get(point.orbit.setting)) / par.scale))
+                if key in searched:  # one search per branch, side and scale unit of the parameter
+                    continue
+                searched.add(key)
+                if len(result.branches) >= MAX_BRANCHES:
+                    result.notes.append(f"no search at {name} {par.get(point.orbit.setting):.5g} ({MAX_BRANCHES} "
+                                        "branches reached)")
+                    continue
+                outcome = search(branch, point, side, max_period, result.branches)
+                result.searches.append(outcome)
+                result.notes.append(outcome.note)
+                if outcome.found is not None:
+                    origin = f"simulation from {par.name} = {par.get(outcome.start.setting):.6g}"
+                    result.branches.append(_both_ways(outcome.found, name, (lo, hi), origin, progress))
+                    found_any = True
+        if not found_any:
+            break
 
 
 def parameter_branch(setting: OrbitSetting, name: str, bounds: tuple[float, float], *,
