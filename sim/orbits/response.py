@@ -39,7 +39,7 @@ from sim.orbits.bifurcations import PERIOD_DOUBLING, SYMMETRY_BREAKING, detect, 
 from sim.orbits.continuation import Branch, BranchPoint, continue_branch
 from sim.orbits.searches import search, stability_changes
 from sim.orbits.setting import OrbitSetting, parameter
-from sim.orbits.shooting import MAX_PERIOD_MULTIPLE, OrbitNotConverged, PeriodicOrbit, solve_orbit
+from sim.orbits.shooting import MAX_PERIOD_MULTIPLE, OrbitNotConverged, PeriodicOrbit, ShootingMap, solve_orbit
 from sim.orbits.starts import (DEFAULT_RESTITUTION, linear_orbit, linear_wall_amplitude, simulated_state,
                                slow_flow_candidates, slow_flow_orbit, stepped_sine_state)
 
@@ -56,6 +56,19 @@ LINEAR_POINTS = 41
 ETA_BOUNDS = (0.5, 2.0)
 #: Most branches of one response (the start's, the switched ones and the searches' finds).
 MAX_BRANCHES = 16
+#: A switching point lies where a switched branch came back through its parent within this share of the parameter's
+#: scale (`_reached`).
+REJOIN = 0.01
+#: Map runs (`sim.orbits.shooting.ShootingMap.runs`) for the switchings and searches of one response, beyond its
+#: first branch (steps 3-4): about 12 s of CPU on the rig (0.1 ms a run), the most promising first (`_grow`).
+GROWTH_RUNS = 100_000
+#: Most points of a switched branch (its stop says so when it is reached), and fewer when the budget's rest
+#: (GROWTH_RUNS) would not pay for them at RUNS_PER_POINT map runs a point (measured on the rig at 7.4: 130-170): on the
+#: rig the asymmetric branches from the two-impact orbit's symmetry breakings are all unstable (|mu| 3-5000) and wind
+#: through folds in a few 1e-4 of eta, a bridge between two symmetry breakings taking 240-360 points, a branch up to
+#: a thousand.
+SWITCHED_POINTS = 400
+RUNS_PER_POINT = 150
 
 
 @dataclass
@@ -207,65 +220,79 @@ def _switching_points(branch: Branch, max_period: int) -> list[BranchPoint]:
 
 
 def _reached(point: BranchPoint, branches: list[Branch]) -> bool:
-    """Whether a switched branch already came back through its parent at this point (`Branch.rejoins`)."""
-    value = branches[0].parameter.get(point.orbit.setting)
+    """Whether a switched branch already came back through its parent at this point (`Branch.rejoins`, within
+    REJOIN of the parameter's scale: the located point and the branch's passage through its parent are both within
+    ~1e-6 of the bifurcation in eta)."""
+    par = branches[0].parameter
+    value = par.to_coordinate(par.get(point.orbit.setting))
     for branch in branches:
         if branch.rejoins is not None and branch.k == point.orbit.k:
-            a, b = sorted(branch.rejoins)
-            if a - 1e-9 * max(abs(a), 1.0) <= value <= b + 1e-9 * max(abs(b), 1.0):
+            a, b = sorted(par.to_coordinate(v) for v in branch.rejoins)
+            if a - REJOIN * par.scale <= value <= b + REJOIN * par.scale:
                 return True
     return False
 
 
 def _grow(result: OrbitResponse, *, max_period: int, switches: int | None, searches: bool,
           progress: Callable[[], None] | None) -> None:
-    """Steps 3 and 4 of the module docstring on `result`'s branches, appending the new ones."""
+    """Steps 3 and 4 of the module docstring on `result`'s branches, appending the new ones: one list of tasks, the
+    searches at changes of stability first, then the switchings by their point's unstable multipliers (the nearest
+    to a stable orbit first), each new branch's tasks added as it comes, within GROWTH_RUNS map runs."""
     name, (lo, hi) = result.parameter, result.bounds
     par = parameter(name)
-    switched, done = 0, 0  # switchings made; branches whose points have been looked at
-    pending: list[tuple[BranchPoint, Branch]] = []
+    tasks: list[tuple[tuple, int, str, Branch, BranchPoint, int]] = []
     searched: set[tuple[int, int, float]] = set()  # (branch, side, where in scale units) of the searches made
-    while done < len(result.branches) or pending:
-        while done < len(result.branches):  # the new branches' switching points, nearest to a stable orbit first
-            pending.extend((p, result.branches[done]) for p in _switching_points(result.branches[done], max_period))
-            done += 1
-        pending.sort(key=lambda item: (outside_count(item[0].orbit), item[0].orbit.max_multiplier))
-        if pending:
-            point, _ = pending.pop(0)
-            where = f"{point.label} at {name} {par.get(point.orbit.setting):.5g}"
+    switched, skipped, budget_from = 0, [], ShootingMap.runs
+
+    def add(branch: Branch) -> None:
+        for point in _switching_points(branch, max_period):
+            tasks.append(((1, outside_count(point.orbit), point.orbit.max_multiplier), len(tasks), "switch", branch,
+                          point, 0))
+        for point, side in (stability_changes(branch) if searches else []):
+            tasks.append(((0, 0, 0.0), len(tasks), "search", branch, point, side))
+
+    for branch in result.branches:
+        add(branch)
+    while tasks:
+        tasks.sort(key=lambda task: task[:2])
+        _, _, kind, branch, point, side = tasks.pop(0)
+        where = f"{name} {par.get(point.orbit.setting):.5g}"
+        if kind == "switch":
             if _reached(point, result.branches):
                 continue
-            if switches is not None and switched >= switches or len(result.branches) >= MAX_BRANCHES:
-                result.notes.append(f"not switched at the {where} (--switches or {MAX_BRANCHES} branches reached)")
+            if switches is not None and switched >= switches:
+                result.notes.append(f"not switched at the {point.label} at {where} (--switches {switches})")
                 continue
-            try:
-                result.branches.append(switch_branch(point, name, (lo, hi), progress=progress))
-                switched += 1
-            except (OrbitNotConverged, SimulationDiverged, SimulationInputError) as exc:
-                result.notes.append(f"switching at the {where}: {exc}")
+        else:
+            key = (id(branch), side, round(par.to_coordinate(par.get(point.orbit.setting)) / par.scale))
+            if key in searched:  # one search per branch, side and scale unit of the parameter
+                continue
+            searched.add(key)
+        if ShootingMap.runs - budget_from > GROWTH_RUNS or len(result.branches) >= MAX_BRANCHES:
+            skipped.append(f"{'the ' + point.label if kind == 'switch' else 'a search'} at {where}")
             continue
-        if not searches:
-            break
-        found_any = False
-        for branch in list(result.branches):
-            for point, side in stability_changes(branch):
-                key = (id(branch), side, round(par.to_coordinate(par.get(point.orbit.setting)) / par.scale))
-                if key in searched:  # one search per branch, side and scale unit of the parameter
-                    continue
-                searched.add(key)
-                if len(result.branches) >= MAX_BRANCHES:
-                    result.notes.append(f"no search at {name} {par.get(point.orbit.setting):.5g} ({MAX_BRANCHES} "
-                                        "branches reached)")
-                    continue
-                outcome = search(branch, point, side, max_period, result.branches)
-                result.searches.append(outcome)
-                result.notes.append(outcome.note)
-                if outcome.found is not None:
-                    origin = f"simulation from {par.name} = {par.get(outcome.start.setting):.6g}"
-                    result.branches.append(_both_ways(outcome.found, name, (lo, hi), origin, progress))
-                    found_any = True
-        if not found_any:
-            break
+        if kind == "switch":
+            try:
+                left = (GROWTH_RUNS - (ShootingMap.runs - budget_from)) // RUNS_PER_POINT
+                new = switch_branch(point, name, (lo, hi), max_points=int(max(10, min(SWITCHED_POINTS, left))),
+                                    progress=progress)
+            except (OrbitNotConverged, SimulationDiverged, SimulationInputError) as exc:
+                result.notes.append(f"switching at the {point.label} at {where}: {exc}")
+                continue
+            switched += 1
+        else:
+            outcome = search(branch, point, side, max_period, result.branches)
+            result.searches.append(outcome)
+            result.notes.append(outcome.note)
+            if outcome.found is None:
+                continue
+            new = _both_ways(outcome.found, name, (lo, hi), f"simulation from {par.name} = "
+                             f"{par.get(outcome.start.setting):.6g}", progress)
+        result.branches.append(new)
+        add(new)
+    if skipped:
+        result.notes.append(f"not done ({len(skipped)}; the response's {GROWTH_RUNS:,} map runs for switchings and "
+                            f"searches, or its {MAX_BRANCHES} branches, were spent): {', '.join(skipped)}")
 
 
 def parameter_branch(setting: OrbitSetting, name: str, bounds: tuple[float, float], *,

@@ -138,8 +138,11 @@ class MapValue(NamedTuple):
 
 class ShootingMap:
     """The k-period map P_k and the half map of one `OrbitSetting` on its integrator (module docstring), with its
-    scaled residual and finite-difference Jacobian. `evaluations` counts the integrator runs. system: the setting's
-    `SystemArrays` when the caller has them (`OrbitSetting.system`)."""
+    scaled residual and finite-difference Jacobian. `evaluations` counts the integrator runs of this map, `runs`
+    (of the class) those of every map in the process: the work budget of `sim.orbits.response`. system: the
+    setting's `SystemArrays` when the caller has them (`OrbitSetting.system`)."""
+
+    runs = 0
 
     def __init__(self, setting: OrbitSetting, k: int = 1, *, system: SystemArrays | None = None) -> None:
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= MAX_PERIOD_MULTIPLE:
@@ -181,6 +184,7 @@ class ShootingMap:
         k = self.k
         state = np.array(y, dtype=np.float64)
         self.evaluations += 1
+        ShootingMap.runs += 1
         if self._prepared is not None:
             amplitudes, impacts, record = self._prepared.advance(state)
             return MapValue(state, record[k], amplitudes, impacts)
