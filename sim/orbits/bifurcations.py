@@ -486,11 +486,12 @@ def parent_residual(orbit: PeriodicOrbit, parent: str) -> np.ndarray:
 
 def switch_branch(point: BranchPoint, parameter_name: str | Parameter, bounds: tuple[float, float], *,
                   step: float | None = None, max_points: int = 1500, progress: Callable[[], None] | None = None,
-                  detect_bifurcations: bool = True, map_factory: Callable[..., ShootingMap] = ShootingMap) -> Branch:
+                  detect_bifurcations: bool = True, map_factory: Callable[..., ShootingMap] = ShootingMap,
+                  also_stop: Callable[[BranchPoint], str | None] | None = None) -> Branch:
     """The branch that bifurcates at a located symmetry breaking or period doubling `point` (module docstring),
-    continued in `parameter_name` within `bounds`; it ends where it comes back through its parent orbit.
-    SimulationInputError for another label or a period multiple beyond MAX_PERIOD_MULTIPLE; SimulationDiverged when
-    no first step leaves the parent branch."""
+    continued in `parameter_name` within `bounds`; it ends where it comes back through its parent orbit, or where
+    `also_stop` (as `continue_branch`'s stop) says. SimulationInputError for another label or a period multiple
+    beyond MAX_PERIOD_MULTIPLE; SimulationDiverged when no first step leaves the parent branch."""
     orbit = point.orbit
     end, half = orbit.jacobian
     if point.label == SYMMETRY_BREAKING and orbit.symmetric:
@@ -523,7 +524,7 @@ def switch_branch(point: BranchPoint, parameter_name: str | Parameter, bounds: t
                     last.append(value)
                     return f"rejoins the {parent_name} between {par.name} = {last[1]:.6g} and {value:.6g}"
                 last[:] = [r, value]
-                return None
+                return also_stop(p) if also_stop is not None else None
 
             branch = continue_branch(start, par, bounds, tangent=np.append(sign * v, 0.0), step=first,
                                      max_points=max_points, origin=f"{origin} at {where}", progress=progress,

@@ -10,6 +10,7 @@ registers the command and hands in what it shares (the system builder, the outpu
 from __future__ import annotations
 
 import argparse
+import math
 import time
 from pathlib import Path
 from typing import Any, Callable
@@ -53,16 +54,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"the slow flow's modal restitution r for the slow-flow start (default {DEFAULT_RESTITUTION})")
     parser.add_argument("--max-period", dest="max_period", type=_period_multiple, default=2, metavar="K",
                         help="largest period multiple k of a kT orbit found by period doubling (default 2, at most 8)")
-    parser.add_argument("--switches", type=count, default=2, metavar="N",
+    parser.add_argument("--switches", type=count, default=None, metavar="N",
                         help="branch switchings at symmetry-breaking and period-doubling points, those nearest to a "
-                             "stable orbit first (default 2; 0: the start's branch only)")
+                             "stable orbit first (default: every located one, within the response's budget; 0: the "
+                             "start's branch and the direct-simulation searches only)")
     parser.add_argument("--integrator", default=DEFAULT_INTEGRATOR, choices=tuple(INTEGRATORS),
                         help=f"time integrator of the shooting (default {DEFAULT_INTEGRATOR}; the others for checks)")
     scaled = " and ".join(name for name, record in INTEGRATORS.items() if record.dt_scale)
     parser.add_argument("--dt-scale", dest="dt_scale", type=float, default=1.0, metavar="X",
                         help=f"{scaled} step as a multiple of the paper's 2 pi/(15 omega_9) (default 1)")
     parser.add_argument("--sweep", metavar="DIR",
-                        help="an `ies sweep --out DIR` folder whose stepped-sine points are drawn on the orbits")
+                        help="an `ies sweep --out DIR` folder whose stepped-sine points are drawn on the orbits of its "
+                             "level (one of --level's), with their dynamics when it was run with --lyapunov")
     parser.add_argument("--out", required=True, metavar="DIR",
                         help="write orbits.csv, results.nc, orbits.json and orbits.png (or --plot) into DIR")
     parser.add_argument("--plot", type=figure_file, default=None, metavar="FILE",
@@ -103,6 +106,29 @@ def _eta_range(text: str) -> tuple[float, float]:
     return lo, hi
 
 
+def _sweep_for(folder: str, levels: list[float], curve: bool) -> dict:
+    """The stepped-sine points of `--sweep DIR` (`sim.orbits.figures.read_sweep`), refused in one line when there are
+    none, when they are of another level than every one of --level's (they would be drawn on nothing), or with
+    --level-curve (its axis is the level, a sweep's is eta)."""
+    from sim.orbits.figures import read_sweep
+
+    sweep = read_sweep(folder)
+    if sweep is None:
+        raise SimulationInputError(f"--sweep {folder}: no sweep.csv there; give a folder written by `ies sweep --out DIR`")
+    if curve:
+        raise SimulationInputError(f"--sweep {folder}: a stepped sine runs over eta, the level curve (--level-curve) "
+                                   "over the level; drop --sweep or --level-curve")
+    level = float(sweep["level"][0])
+    if not math.isfinite(level):
+        raise SimulationInputError(f"--sweep {folder}: its sweep.json names no level; give a folder written by "
+                                   "`ies sweep --out DIR`")
+    if not any(math.isclose(level, other, rel_tol=1e-9) for other in levels):
+        raise SimulationInputError(f"--sweep {folder} is a stepped sine at level {level:g}, not at --level "
+                                   f"{','.join(f'{v:g}' for v in levels)}: add {level:g} to --level or give a sweep of "
+                                   "one of them")
+    return sweep
+
+
 def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], tuple[Any, Any]],
         output_folder: Callable[..., Any], system_data: Callable[[Any, Any], dict]) -> int:
     """`ies orbits` (module docstring): build the system (`sim.cli.build_system`), compute every level's (or the
@@ -113,11 +139,12 @@ def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], t
 
     from sim.common.files import check_writable, dumps, report_written, write_or_fallback
     from sim.integration.integrators import warm_up
-    from sim.orbits.figures import plot_orbits, read_sweep
-    from sim.orbits.response import check_range, orbit_response
+    from sim.orbits.figures import plot_orbits
+    from sim.orbits.response import StartFailed, check_range, orbit_response
     from sim.orbits.setting import OrbitSetting
     from sim.orbits.shooting import OrbitNotConverged
-    from sim.orbits.tables import ORBITS_COLUMNS, orbit_rows, orbit_table, response_summary, write_orbit_files
+    from sim.orbits.tables import (ORBITS_COLUMNS, orbit_rows, orbit_table, response_summary, write_orbit_files,
+                                   write_start_attempts)
 
     started = time.perf_counter()
     if args.no_impactor:
@@ -129,32 +156,32 @@ def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], t
     if curve:
         check_range("eta", (args.level_curve, args.level_curve * (1 + 1e-9)))
         check_range("level", level_range)
-    sweep = None
-    if args.sweep is not None:
-        sweep = read_sweep(args.sweep)
-        if sweep is None:
-            raise SimulationInputError(f"--sweep {args.sweep}: no sweep.csv there; give a folder written by "
-                                       "`ies sweep --out DIR`")
+    sweep = _sweep_for(args.sweep, levels, curve) if args.sweep is not None else None
     if args.plot:
         check_writable(args.plot, "--plot")
     model, impactor = build_system(args)
     if not (args.dt_scale > 0):
         raise SimulationInputError(f"--dt-scale must be positive, got {args.dt_scale!r}")
+    # every setting is built (and refused) before the kernels compile: friction, a bad level, ...
+    if curve:
+        todo = [(OrbitSetting(model, impactor, level_range[0], args.level_curve, integrator=args.integrator,
+                              dt_scale=args.dt_scale), "level", level_range)]
+    else:
+        todo = [(OrbitSetting(model, impactor, level, 0.5 * sum(eta_range), integrator=args.integrator,
+                              dt_scale=args.dt_scale), "eta", eta_range) for level in levels]
     with output_folder(args.out, args.force) as folder:
         warm_up(args.integrator, law=impactor.contact_law.law.name)
         responses = []
         with tqdm(desc="orbits", unit="orbit", disable=not sys.stderr.isatty(), leave=False, file=sys.stderr) as bar:
-            if curve:
-                base = OrbitSetting(model, impactor, level_range[0], args.level_curve, integrator=args.integrator,
-                                    dt_scale=args.dt_scale)
-                todo = [(base, "level", level_range)]
-            else:
-                todo = [(OrbitSetting(model, impactor, level, 0.5 * sum(eta_range), integrator=args.integrator,
-                                      dt_scale=args.dt_scale), "eta", eta_range) for level in levels]
             for base, name, bounds in todo:
-                response = orbit_response(base, name, bounds, start=args.start, at=args.at,
-                                          max_period=args.max_period, switches=args.switches,
-                                          restitution=args.restitution, progress=bar.update)
+                try:
+                    response = orbit_response(base, name, bounds, start=args.start, at=args.at,
+                                              max_period=args.max_period, switches=args.switches,
+                                              restitution=args.restitution, progress=bar.update)
+                except StartFailed as failure:  # keep what it tried, say what else to try
+                    written = write_or_fallback(lambda where: [write_start_attempts(where, failure)], folder,
+                                                "orbits")
+                    raise OrbitNotConverged(f"{failure}; wrote {written[0]}") from None
                 responses.append(response)
         if all(r.impacts and not r.branches for r in responses):  # nothing found anywhere: say why, write nothing
             where = (f"level {responses[-1].base.level:g}" if not curve else f"eta {args.level_curve:g}")
@@ -172,7 +199,7 @@ def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], t
             cols = {name: [r[j] for r in rows if (r[0] == response.base.level if not curve else True)]
                     for j, name in enumerate(ORBITS_COLUMNS)}
             level_sweep = (sweep if sweep is not None and not curve
-                           and abs(float(sweep["level"][0]) - response.base.level) < 1e-9 else None)
+                           and math.isclose(float(sweep["level"][0]), response.base.level, rel_tol=1e-9) else None)
             title = (f"$a_\\mathrm{{base}}/a_\\mathrm{{base}}^* = {response.base.level:g}$" if not curve
                      else f"$\\eta = {response.base.eta:g}$")
             panels.append((cols, title, response.bounds, level_sweep))

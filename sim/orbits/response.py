@@ -37,7 +37,7 @@ import numpy as np
 from sim.common.errors import SimulationDiverged, SimulationInputError
 from sim.orbits.bifurcations import PERIOD_DOUBLING, SYMMETRY_BREAKING, detect, outside_count, switch_branch
 from sim.orbits.continuation import Branch, BranchPoint, continue_branch
-from sim.orbits.searches import search, stability_changes
+from sim.orbits.searches import known, search, stability_changes
 from sim.orbits.setting import OrbitSetting, parameter
 from sim.orbits.shooting import MAX_PERIOD_MULTIPLE, OrbitNotConverged, PeriodicOrbit, ShootingMap, solve_orbit
 from sim.orbits.starts import (DEFAULT_RESTITUTION, linear_orbit, linear_wall_amplitude, simulated_state,
@@ -69,6 +69,29 @@ GROWTH_RUNS = 100_000
 #: a thousand.
 SWITCHED_POINTS = 400
 RUNS_PER_POINT = 150
+
+
+@dataclass
+class StartAttempt:
+    """One Newton's method of a failed "simulation" start: the period multiple k, the simulated state it started from
+    and its last iterate (SI; None when the integrator failed at once), that iterate's residual (units of g) and why
+    it stopped."""
+
+    k: int
+    start: np.ndarray
+    last: np.ndarray | None
+    residual: float
+    why: str
+
+
+class StartFailed(OrbitNotConverged):
+    """The "simulation" start found no orbit: `attempts` (`StartAttempt`, one per k) at `setting`, for the record
+    `ies orbits` writes (`sim.orbits.tables.write_start_attempts`)."""
+
+    def __init__(self, message: str, attempts: list[StartAttempt], setting: OrbitSetting) -> None:
+        super().__init__(message)
+        self.attempts = attempts
+        self.setting = setting
 
 
 @dataclass
@@ -136,14 +159,18 @@ def _start(base: OrbitSetting, name: str, lo: float, hi: float, how: str, *, at:
             y = stepped_sine_state(setting, lo)
         else:
             y = simulated_state(setting, SIMULATION_PERIODS)
-        failures = []
+        attempts = []
         for k in range(1, max_period + 1):
             try:
                 return solve_orbit(setting, y, k=k, symmetric=False)
             except (OrbitNotConverged, SimulationDiverged) as exc:
-                failures.append(f"k = {k}: {exc}")
-        raise OrbitNotConverged(f"orbits: no periodic orbit of period <= {max_period} T near the simulated state at "
-                                f"{name} {value:g} ({failures[-1].split(': ', 2)[-1]})")
+                attempts.append(StartAttempt(k, y.copy(), getattr(exc, "state", None), getattr(exc, "residual", math.nan),
+                                             str(exc).split(";")[0].replace("orbits: ", "")))
+        best = min(attempts, key=lambda a: a.residual if math.isfinite(a.residual) else math.inf)
+        raise StartFailed(f"orbits: no periodic orbit of period <= {max_period} T near the state a stepped sine "
+                          f"reaches at {name} {value:g} (best: k = {best.k}, residual {best.residual:.2e} g); the response "
+                          "there may not settle on a periodic orbit (ies trace --lyapunov tells); try --start slow-flow, "
+                          "another --at, or a larger --max-period", attempts, setting)
     grid = [at] if at is not None else list(np.linspace(lo, hi, START_GRID))
     grid = [v for v in grid if slow_flow_candidates(par.set(base, float(v)), restitution)]
     if len(grid) > START_TRIES:  # spread over where the slow flow has an orbit, from the low end
@@ -200,12 +227,33 @@ def orbit_response(base: OrbitSetting, name: str, bounds: tuple[float, float], *
     return result
 
 
+def _joins(name: str, others: list[Branch] | None) -> Callable[[BranchPoint], str | None]:
+    """A stop for `continue_branch`: the branch ends one point after the first that lies on one of `others`
+    (`sim.orbits.searches.known`), that point kept. Call `.reset()` before another continuation."""
+    joined: list[str] = []
+
+    def joins(point: BranchPoint) -> str | None:
+        if joined:
+            return joined.pop()
+        other = known(point.orbit, others) if others else None
+        if other is not None:
+            joined.append(f"joins the branch {other.origin} at {name} = {parameter(name).get(point.orbit.setting):.6g}")
+        return None
+
+    joins.reset = joined.clear  # type: ignore[attr-defined]
+    return joins
+
+
 def _both_ways(orbit: PeriodicOrbit, name: str, bounds: tuple[float, float], origin: str,
-               progress: Callable[[], None] | None) -> Branch:
-    """The branch through `orbit` continued up and then down over `bounds` (once when it closes on itself)."""
-    branch = continue_branch(orbit, name, bounds, direction=1.0, origin=origin, detect=detect, progress=progress)
+               progress: Callable[[], None] | None, others: list[Branch] | None = None) -> Branch:
+    """The branch through `orbit` continued up and then down over `bounds` (once when it closes on itself), each way
+    up to where it runs onto one of `others` (`_joins`)."""
+    joins = _joins(name, others)
+    branch = continue_branch(orbit, name, bounds, direction=1.0, origin=origin, detect=detect, progress=progress,
+                             stop=joins)
     if not branch.stop.startswith("closed loop"):
-        back = continue_branch(orbit, name, bounds, direction=-1.0, detect=detect, progress=progress)
+        joins.reset()
+        back = continue_branch(orbit, name, bounds, direction=-1.0, detect=detect, progress=progress, stop=joins)
         branch.points = back.points[:0:-1] + branch.points
         branch.unlocated = back.unlocated + branch.unlocated
         branch.stop = f"{back.stop} / {branch.stop}"
@@ -258,8 +306,11 @@ def _grow(result: OrbitResponse, *, max_period: int, switches: int | None, searc
         _, _, kind, branch, point, side = tasks.pop(0)
         where = f"{name} {par.get(point.orbit.setting):.5g}"
         if kind == "switch":
-            if _reached(point, result.branches):
-                continue
+            k = point.orbit.k * (2 if point.label == PERIOD_DOUBLING else 1)
+            power = 2 if point.label == PERIOD_DOUBLING else 1
+            if _reached(point, result.branches) or known(point.orbit, result.branches, k=k, exclude=(branch,),
+                                                         max_multiplier=point.orbit.max_multiplier ** power):
+                continue  # the branch it would give is there already
             if switches is not None and switched >= switches:
                 result.notes.append(f"not switched at the {point.label} at {where} (--switches {switches})")
                 continue
@@ -275,7 +326,8 @@ def _grow(result: OrbitResponse, *, max_period: int, switches: int | None, searc
             try:
                 left = (GROWTH_RUNS - (ShootingMap.runs - budget_from)) // RUNS_PER_POINT
                 new = switch_branch(point, name, (lo, hi), max_points=int(max(10, min(SWITCHED_POINTS, left))),
-                                    progress=progress)
+                                    progress=progress,
+                                    also_stop=_joins(name, [b for b in result.branches if b is not branch]))
             except (OrbitNotConverged, SimulationDiverged, SimulationInputError) as exc:
                 result.notes.append(f"switching at the {point.label} at {where}: {exc}")
                 continue
@@ -287,7 +339,7 @@ def _grow(result: OrbitResponse, *, max_period: int, switches: int | None, searc
             if outcome.found is None:
                 continue
             new = _both_ways(outcome.found, name, (lo, hi), f"simulation from {par.name} = "
-                             f"{par.get(outcome.start.setting):.6g}", progress)
+                             f"{par.get(outcome.start.setting):.6g}", progress, others=list(result.branches))
         result.branches.append(new)
         add(new)
     if skipped:

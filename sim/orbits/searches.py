@@ -7,9 +7,9 @@ parameter's scale: 2e-3 in eta) into the unstable side is perturbed along the ei
 (SEARCH_PERTURBATION of g, scaled units) and simulated for SEARCH_PERIODS periods on the setting's integrator (the
 response a stepped sine would settle on there); Newton's method (`sim.orbits.shooting.solve_orbit`, not restricted
 to symmetric orbits) then looks for a kT orbit from the end state, k = 1 .. max_period. What it finds is reduced to
-its least period, dropped when it lies on a known branch (same least period and amplitude within KNOWN_AMPLITUDE at
-that parameter value, mirror images alike), and otherwise continued both ways over the range as a branch of its own
-(`sim.orbits.response`). A search that finds nothing says so in one note (the end state's residual), so the shading
+its least period, dropped when it lies on a known branch (`known`: same least period, amplitude and largest multiplier
+at that parameter value, mirror images alike), and otherwise continued both ways over the range as a branch of its
+own, up to where it runs onto a known branch (`sim.orbits.response`). A search that finds nothing says so in one note (the end state's residual), so the shading
 is read as "no stable orbit of period <= k T found by continuation and these searches".
 
 Why the unstable side, perturbed: at a symmetry breaking the asymmetric orbits a supercritical pitchfork gives are
@@ -20,6 +20,7 @@ the switched branch) and nothing else periodic of period <= 2 T.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,8 +37,10 @@ SEARCH_OFFSET = 1.0
 SEARCH_PERTURBATION = 1e-3
 #: Excitation periods simulated before Newton's method (the stepped sine's 3 s wait at the rig's 117 Hz: 352).
 SEARCH_PERIODS = 400
-#: An orbit found lies on a known branch when its amplitude (a/a_noabs*) is within this of the branch's there.
+#: An orbit lies on a known branch when its amplitude (a/a_noabs*) is within KNOWN_AMPLITUDE of the branch's there
+#: and log |mu|max within KNOWN_MULTIPLIER (`known`).
 KNOWN_AMPLITUDE = 1e-4
+KNOWN_MULTIPLIER = 0.05
 #: A kT orbit is one of period d T (d dividing k) when its d-period residual is below this (units of g).
 PERIOD_RESIDUAL = 1e-7
 
@@ -101,23 +104,31 @@ def least_period(orbit: PeriodicOrbit) -> PeriodicOrbit:
     return orbit
 
 
-def known(orbit: PeriodicOrbit, branches: list[Branch]) -> Branch | None:
-    """The branch on which an orbit (or its mirror image, of the same amplitude) lies: same least period, and an
-    amplitude within KNOWN_AMPLITUDE of the branch's, interpolated at the orbit's parameter value between two
-    consecutive points around it; None if there is none."""
+def known(orbit: PeriodicOrbit, branches: list[Branch], *, k: int | None = None, amplitude: float | None = None,
+          max_multiplier: float | None = None, exclude: tuple[Branch, ...] = ()) -> Branch | None:
+    """The branch (of `branches`, less `exclude`) on which an orbit lies, or None: one of period k T (default the
+    orbit's) on which, between two consecutive points around the orbit's parameter value, the interpolated amplitude
+    is within KNOWN_AMPLITUDE of the orbit's and log |mu|max within KNOWN_MULTIPLIER (two different orbits rarely
+    agree in both where their curves cross; mirror images agree in both, and count as known). amplitude,
+    max_multiplier: the values to compare instead of the orbit's (a switched branch's at its switching point)."""
+    k = orbit.k if k is None else k
+    amplitude = orbit.amplitude if amplitude is None else amplitude
+    log_mu = math.log(max(orbit.max_multiplier if max_multiplier is None else max_multiplier, 1e-300))
     for branch in branches:
-        if branch.k != orbit.k or not branch.points:
+        if branch.k != k or not branch.points or any(branch is other for other in exclude):
             continue
-        values = branch.values()
         value = branch.parameter.get(orbit.setting)
+        values = branch.values()
         amplitudes = np.array([p.orbit.amplitude for p in branch.points])
-        for i in range(len(values) - 1):
-            a, b = values[i], values[i + 1]
-            if min(a, b) <= value <= max(a, b):
-                w = 0.0 if a == b else (value - a) / (b - a)
-                if abs(amplitudes[i] + w * (amplitudes[i + 1] - amplitudes[i]) - orbit.amplitude) < KNOWN_AMPLITUDE:
-                    return branch
-        if len(values) == 1 and abs(values[0] - value) < 1e-12 and abs(amplitudes[0] - orbit.amplitude) < KNOWN_AMPLITUDE:
+        mus = np.log(np.maximum([p.orbit.max_multiplier for p in branch.points], 1e-300))
+        if values.size == 1:
+            values, amplitudes, mus = (np.repeat(a, 2) for a in (values, amplitudes, mus))
+        a, b = values[:-1], values[1:]
+        around = (np.minimum(a, b) <= value) & (value <= np.maximum(a, b))
+        w = np.divide(value - a, b - a, out=np.zeros_like(a), where=b != a)
+        close = (np.abs(amplitudes[:-1] + w * np.diff(amplitudes) - amplitude) < KNOWN_AMPLITUDE) & (
+            np.abs(mus[:-1] + w * np.diff(mus) - log_mu) < KNOWN_MULTIPLIER)
+        if np.any(around & close):
             return branch
     return None
 
@@ -157,5 +168,5 @@ def search(branch: Branch, point: BranchPoint, side: int, max_period: int,
                                               f"state {SEARCH_PERIODS} periods on ({failures[-1] if failures else ''})")
 
 
-__all__ = ["KNOWN_AMPLITUDE", "SEARCH_OFFSET", "SEARCH_PERIODS", "SEARCH_PERTURBATION", "Search", "known",
+__all__ = ["KNOWN_AMPLITUDE", "KNOWN_MULTIPLIER", "SEARCH_OFFSET", "SEARCH_PERIODS", "SEARCH_PERTURBATION", "Search", "known",
            "least_period", "search", "stability_changes"]

@@ -55,8 +55,8 @@ class OrbitSetting:
             if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
                 raise SimulationInputError(f"orbits: {name} must be a positive number, got {value!r}")
         if self.impactor.friction > 0:
-            raise SimulationInputError("orbits: dry friction (Appendix C) makes the state include the slider; the "
-                                       "orbits are of the frictionless model (drop --mu)")
+            raise SimulationInputError("orbits: dry friction (--friction, Appendix C) makes the slider part of the "
+                                       "state; the orbits are of the frictionless model: drop --friction")
 
     @property
     def Omega(self) -> float:

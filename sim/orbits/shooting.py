@@ -123,7 +123,13 @@ def flight_gaps(y: np.ndarray, t0: float, Omega: float, a_base: float, sys: Syst
 
 
 class OrbitNotConverged(SimulationDiverged):
-    """Newton's method did not reach a periodic orbit from the start given (exit code 3 on the command line)."""
+    """Newton's method did not reach a periodic orbit from the start given (exit code 3 on the command line);
+    `state` and `residual`: its last iterate (SI) and that iterate's residual (units of g), when it got that far."""
+
+    def __init__(self, message: str, state: np.ndarray | None = None, residual: float = math.nan) -> None:
+        super().__init__(message)
+        self.state = state
+        self.residual = residual
 
 
 class MapValue(NamedTuple):
@@ -452,10 +458,10 @@ def solve_orbit(setting: OrbitSetting, guess: np.ndarray, *, k: int = 1, symmetr
             raise OrbitNotConverged(f"orbits: Newton's method stalled at residual {norm:.2e} g (tolerance "
                                     f"{tolerance:.0e}) at eta {setting.eta:g}, level {setting.level:g}; start closer: "
                                     "--start slow-flow (continuation from damped higher modes), a state simulated "
-                                    "at this point, or a neighbouring orbit")
+                                    "at this point, or a neighbouring orbit", y, norm)
         y, norm, r, value, jacobian = trial, t_norm, t_r, t_value, None
     else:
         raise OrbitNotConverged(f"orbits: no convergence in {max_iterations} Newton steps (residual {norm:.2e} g) at "
                                 f"eta {setting.eta:g}, level {setting.level:g}; start closer (--start slow-flow, a "
-                                "simulated state) or lower the level")
+                                "simulated state) or lower the level", y, norm)
     return make_orbit(shooting, y, symmetric, value, jacobian)
