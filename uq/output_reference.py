@@ -9,7 +9,7 @@ from pathlib import Path
 from sim.analysis.cli import IMPACTS_JSON, MODAL_FIT_JSON
 from sim.analysis.trace import TRACE_CSV, TRACE_JSON
 from sim.common.outputs import OutputFile, describe
-from sim.orbits.tables import ORBITS_CSV
+from sim.orbits.tables import ORBITS_CSV, START_ATTEMPTS_JSON
 from sim.stepped_sine.tables import OVERVIEW_CSV, OVERVIEW_JSON, SWEEP_CSV, SWEEP_JSON
 from uq.design.results import DESIGN_CSV, DESIGN_JSON, DESIGN_LEVELS_CSV
 from uq.methods import kinds
@@ -45,7 +45,7 @@ SECTIONS: tuple[tuple[str, tuple[OutputFile, ...]], ...] = (
                                                               RESULTS_NC)),
     ("Several response studies side by side (`ies compare`)", (COMPARE_CSV,)),
     ("Designs (`ies design`)", (DESIGN_CSV, DESIGN_LEVELS_CSV, DESIGN_JSON)),
-    ("Periodic orbits (`ies orbits`)", (ORBITS_CSV,)),
+    ("Periodic orbits (`ies orbits`)", (ORBITS_CSV, START_ATTEMPTS_JSON)),
 )
 
 INTRO = """# Output reference

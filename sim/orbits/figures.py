@@ -77,6 +77,9 @@ def draw_orbits(ax: Any, columns: Mapping[str, np.ndarray], *, parameter: str = 
     if impacting.any():  # the line styles first: the legend lists the labelled artists in the order drawn
         ax.plot([], [], ls="-", color="k", lw=1.4, label="stable orbits (solid)")
         ax.plot([], [], ls="--", color="k", lw=0.9, label="unstable orbits (dashed)")
+    kinds = np.array([f"{branch_kind(str(o))} ({int(k)} T)" for o, k in zip(np.asarray(columns["origin"]),
+                                                                          np.asarray(columns["period_multiple"]))])
+    stable_all = np.asarray(columns["stable"], dtype=int) == 1
     for b in np.unique(branch_ids):
         sel = branch_ids == b
         x, y = x_all[sel], amp[sel]
@@ -102,8 +105,8 @@ def draw_orbits(ax: Any, columns: Mapping[str, np.ndarray], *, parameter: str = 
             ax.plot(x[seg], y[seg], ls="-" if stable[start] else "--", color=c, lw=1.4 if stable[start] else 0.9)
         if shown.sum() == 1:  # one orbit: its marker, in the legend too
             ax.plot(x[shown], y[shown], ls="none", marker=".", ms=6, color=c, label=name if first else None)
-        elif first:
-            ax.plot([], [], ls="-", color=c, lw=1.4, label=name)
+        elif first:  # solid when some orbit of this kind is stable, else dashed
+            ax.plot([], [], ls="-" if stable_all[kinds == name].any() else "--", color=c, lw=1.4, label=name)
     labels = np.asarray(columns["bifurcation"]).astype(str)
     for label, marker in MARKERS.items():
         sel = (labels == label) & (x_all >= lo) & (x_all <= hi)

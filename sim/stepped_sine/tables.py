@@ -44,6 +44,9 @@ SWEEP_CSV = OutputFile("sweep.csv", "ies sweep --out DIR", "One row per eta of t
     Column("cv", "-", "std/mean of the per-period amplitudes over the hold, averaged (the regime measure)"),
     Column("impacts_per_period", "-", "contact onsets at either wall per excitation period, averaged"),
     Column("regime", "", "APR (cv <= 0.1), SMR (cv > 0.1) or linear (no contact)"),
+    Column("lyapunov_per_period", "-", "with --lyapunov: the largest Lyapunov exponent over the hold, natural log per "
+           "excitation period, averaged over the samples (`sim.stepped_sine.dynamics`); NaN without"),
+    Column("dynamics", "", "with --lyapunov: periodic, quasi-periodic or chaotic (most of the samples); empty without"),
     *SCATTERING))
 #: sweep.csv: one row per eta of the grid (`SweepResult` arrays)
 SWEEP_COLUMNS = SWEEP_CSV.names
@@ -73,6 +76,8 @@ SWEEP_JSON = OutputFile("sweep.json", "ies sweep --out DIR, also --json", "The a
     Column("a_noabs", "m", "a_noabs*, the linear resonant amplitude at this excitation (nominal D*)"),
     Column("mean_std, max_std", "a/a_noabs*", "standard deviation over the samples, per eta"),
     Column("regime_per_eta", "", "the `regime` column"),
+    Column("lyapunov_samples", "-", "with --lyapunov: the exponents of every visit of each eta (visits x eta; NaN "
+           "where an eta has fewer visits)"),
     Column("resonant_mean, resonant_max", "a/a_noabs*", "the largest mean and max over eta"),
     Column("eta_resonant_mean, eta_resonant_max", "-", "where they are reached"),
     Column("regime", "", "the regime at `eta_resonant_mean`"),
@@ -111,7 +116,10 @@ def _scattering_column(column: str) -> str:
 def sweep_rows(result: SweepResult) -> list[list[Any]]:
     """The rows of sweep.csv (SWEEP_COLUMNS) of one frequency response."""
     n = result.eta.size
-    columns = [result.regime_per_eta if name == "regime" else
+    natures = {"lyapunov_per_period": (result.lyapunov_per_period if result.lyapunov_per_period is not None
+                                       else [float("nan")] * n),
+               "dynamics": result.dynamics if result.dynamics is not None else [""] * n}
+    columns = [result.regime_per_eta if name == "regime" else natures[name] if name in natures else
                result.scattering.get(_scattering_column(name), [float("nan")] * n) if name in SCATTERING_COLUMNS else
                getattr(result, name) for name in SWEEP_COLUMNS]
     return [list(row) for row in zip(*columns)]
