@@ -38,8 +38,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from sim.orbits.starts import DEFAULT_RESTITUTION
 
     parser.add_argument("--level", required=True, metavar="L1,L2,..|LO:HI",
-                        help="excitation levels a_base/a_base* (-), e.g. 7.4 or 5,7.4,9; with --level-curve the range "
-                             "LO:HI of the level")
+                        help="excitation levels a_base/a_base* (-) or base amplitudes with their unit, e.g. 7.4, "
+                             "5,7.4,9 or 3.3um; with --level-curve the range LO:HI of the level")
     parser.add_argument("--eta", default="0.95:1.0", metavar="LO:HI",
                         help="range of eta = Omega/omega_1 (default 0.95:1.0); with --level-curve ignored")
     parser.add_argument("--level-curve", dest="level_curve", type=float, default=None, metavar="ETA",
@@ -75,24 +75,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print orbits.json's object instead of the text summary")
 
 
-def _levels(text: str, curve: bool) -> tuple[list[float], tuple[float, float] | None]:
-    """(levels, level range): a list of levels, or with --level-curve the range LO:HI."""
-    from sim.stepped_sine.protocol import check_level
-
+def _levels(text: str, curve: bool, value: Callable[[str], float]) -> tuple[list[float], tuple[float, float] | None]:
+    """(levels, level range): a list of levels, or with --level-curve the range LO:HI; each a level a_base/a_base* or
+    a base amplitude with its unit (3.3um), read by `value` (`sim.cli.level_value`)."""
     if curve:
         parts = text.split(":")
-        try:
-            lo, hi = (float(p) for p in parts)
-        except ValueError:
-            raise SimulationInputError(f"--level with --level-curve must be a range LO:HI like 5:9, got {text!r}") from None
-        return [], (check_level(lo), check_level(hi))
-    try:
-        values = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise SimulationInputError(f"--level must be numbers like 7.4 or 5,7.4,9, got {text!r}") from None
+        if len(parts) != 2:
+            raise SimulationInputError(f"--level with --level-curve must be a range LO:HI like 5:9, got {text!r}")
+        return [], (value(parts[0]), value(parts[1]))
+    values = [value(v) for v in text.split(",") if v.strip()]
     if not values:
         raise SimulationInputError("--level is empty; give at least one excitation level, e.g. 7.4")
-    return [check_level(v) for v in values], None
+    return values, None
 
 
 def _eta_range(text: str) -> tuple[float, float]:
@@ -130,9 +124,13 @@ def _sweep_for(folder: str, levels: list[float], curve: bool) -> dict:
 
 
 def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], tuple[Any, Any]],
-        output_folder: Callable[..., Any], system_data: Callable[[Any, Any], dict]) -> int:
-    """`ies orbits` (module docstring): build the system (`sim.cli.build_system`), compute every level's (or the
-    eta's) orbits, then write the files into the output folder (`sim.cli.output_folder`) and print the summary."""
+        output_folder: Callable[..., Any], system_data: Callable[..., dict], *,
+        nominal_of: Callable[[argparse.Namespace, Any], Any], level_value: Callable[[str], float],
+        level_of: Callable[[float, Any, Any], float]) -> int:
+    """`ies orbits` (module docstring): build the system (`sim.cli.build_system`) and its normalisation
+    (`sim.cli.nominal_of`: the host's own D_1*, --g-star), read the levels (`sim.cli.level_value`, `level_of`: a level
+    or a base amplitude with its unit), compute every level's (or the eta's) orbits, then write the files into the
+    output folder (`sim.cli.output_folder`) and print the summary."""
     import sys
 
     from tqdm import tqdm
@@ -151,24 +149,27 @@ def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], t
         raise SimulationInputError("ies orbits needs the sphere: without it the host is linear and its only orbit is "
                                    "the analytic frequency response (ies sweep --no-impactor)")
     curve = args.level_curve is not None
-    levels, level_range = _levels(args.level, curve)
+    levels, level_range = _levels(args.level, curve, level_value)
     eta_range = check_range("eta", _eta_range(args.eta)) if not curve else None
-    if curve:
-        check_range("eta", (args.level_curve, args.level_curve * (1 + 1e-9)))
-        check_range("level", level_range)
-    sweep = _sweep_for(args.sweep, levels, curve) if args.sweep is not None else None
     if args.plot:
         check_writable(args.plot, "--plot")
     model, impactor = build_system(args)
+    nominal = nominal_of(args, model)
+    levels = [level_of(v, model, nominal) for v in levels]
+    if curve:
+        level_range = tuple(level_of(v, model, nominal) for v in level_range)
+        check_range("eta", (args.level_curve, args.level_curve * (1 + 1e-9)))
+        check_range("level", level_range)
+    sweep = _sweep_for(args.sweep, levels, curve) if args.sweep is not None else None
     if not (args.dt_scale > 0):
         raise SimulationInputError(f"--dt-scale must be positive, got {args.dt_scale!r}")
     # every setting is built (and refused) before the kernels compile: friction, a bad level, ...
     if curve:
         todo = [(OrbitSetting(model, impactor, level_range[0], args.level_curve, integrator=args.integrator,
-                              dt_scale=args.dt_scale), "level", level_range)]
+                              dt_scale=args.dt_scale, nominal=nominal), "level", level_range)]
     else:
         todo = [(OrbitSetting(model, impactor, level, 0.5 * sum(eta_range), integrator=args.integrator,
-                              dt_scale=args.dt_scale), "eta", eta_range) for level in levels]
+                              dt_scale=args.dt_scale, nominal=nominal), "eta", eta_range) for level in levels]
     with output_folder(args.out, args.force) as folder:
         warm_up(args.integrator, law=impactor.contact_law.law.name)
         responses = []
@@ -191,7 +192,7 @@ def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], t
                     "levels": levels if not curve else None, "level_range": level_range,
                     "eta_range": eta_range, "level_curve_eta": args.level_curve, "start": args.start,
                     "max_period": args.max_period, "switches": args.switches, "restitution": args.restitution,
-                    "integrator": args.integrator, "dt_scale": args.dt_scale, **system_data(model, impactor),
+                    "integrator": args.integrator, "dt_scale": args.dt_scale, **system_data(model, impactor, nominal),
                     "wall_time_s": time.perf_counter() - started}
         rows = orbit_rows(responses)
         panels = []
