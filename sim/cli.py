@@ -561,9 +561,9 @@ def sweep_command(args: argparse.Namespace) -> int:
              + ("  lyapunov/T  dynamics" if result.dynamics is not None else "")]
     for i, eta in enumerate(result.eta):
         lines.append(f"{eta:7.4f} {result.mean[i]:8.4f} {result.max[i]:8.4f} {result.cv[i]:6.3f} "
-                     f"{result.impacts_per_period[i]:6.2f}  {result.regime_per_eta[i]:<6}"
-                     + (f" {result.lyapunov_per_period[i]:11.4g}  {result.dynamics[i]}" if result.dynamics is not None
-                        else ""))
+                     f"{result.impacts_per_period[i]:6.2f}  {result.regime_per_eta[i]}"
+                     + (f"{'':<{6 - len(result.regime_per_eta[i])}} {result.lyapunov_per_period[i]:11.4g}  "
+                        f"{result.dynamics[i]}" if result.dynamics is not None else ""))
     lines.append(f"resonant mean {result.resonant_mean:.4f} at eta {result.eta_resonant_mean:.4f} ({result.regime}); "
                  f"resonant max {result.resonant_max:.4f} at eta {result.eta_resonant_max:.4f}")
     return report(args, data, written, lambda path: plot_sweep(data, path, sweep_title(data)), "\n".join(lines))
