@@ -30,18 +30,26 @@ matters on nearly conservative hosts: on the rig's first mode alone the complex 
 multiplier nearest to the circle there is complex a hair before the crossing, and only the count (one multiplier
 out) tells a symmetry breaking from a Neimark-Sacker point.
 
-Location. A crossing is located by Brent's method (scipy's brentq) on the arclength s from a (each trial a
-pseudo-arclength step from a along its tangent) of log |m_c| - log OUTSIDE, m_c the multiplier that crosses (the
-c-th largest in modulus, c the smaller count: a continuous function of s with a change of sign on [a, b]), until
-|mu| lies within MU_TOLERANCE of 1 (|mu| = |lambda|^2 on a symmetric branch). Several crossings in one interval
-are located one after the other. A grazing is located by bisection and the secant on the smallest free-flight gap
-of the orbits without the new impact (`sim.orbits.shooting.ShootingMap.clearance`: linear in s near a grazing),
-until that gap is below GRAZING_TOLERANCE g; the crossings on either side of it are then located apart. A point
-that is not located within LOCATION_STEPS (GRAZING_STEPS) trials, or whose multiplier misses the tolerance, is
-not labelled: the branch keeps one line for it in `Branch.unlocated`, and the figure draws no marker. A located
-point is inserted into the branch with its label, its `location_error` (|mu| - 1, or the gap over g) and a note:
-"loses stability" / "gains stability" when a stable orbit becomes unstable or the reverse (crossings of already
-unstable orbits are labelled too: they change the unstable manifold, not the stability).
+Location. A crossing is located by Brent's method (scipy's brentq) on the arclength s from a, each trial a
+pseudo-arclength step from a along its tangent, until |mu| of the crossing multiplier lies within MU_TOLERANCE of 1
+(|mu| = |lambda|^2 on a symmetric branch). A real crossing at +-1 is located on det(J -+ I)^(1/n) (J the matrix of
+the classified multipliers), a complex pair on log |m| - log OUTSIDE of its modulus: both change sign over [a, b]
+and are continuous in s. The determinant, because the multiplier itself is not smooth where it matters: on a lightly
+damped host (the rig's first mode alone) the pair collides on the real axis at |lambda| = 0.9998 and one real
+multiplier reaches -1 some 3e-9 of arclength later, while near the collision the multipliers move by the square root
+of the Jacobian's error. Several crossings in one interval are located one after the other. A grazing is located by
+bisection and the secant on the smallest free-flight gap of the orbits without the new impact
+(`sim.orbits.shooting.ShootingMap.clearance`: linear in s near a grazing), until that gap is below GRAZING_TOLERANCE
+g; the crossings on either side of it are then located apart. The multipliers may jump at a grazing (the Hertz
+contact's force is C^1, but near zero approach speed the map's derivative changes within 1e-9 g): the orbits just
+beyond it whose Jacobians had to straddle it (`PeriodicOrbit.at_grazing`) or whose |mu|max moves JUMP_RATE times as
+fast as before it make up its jump (`_absorb_jump`), and a change of stability inside the jump is the grazing's
+(its note: "loses stability at the grazing", with |mu|max on either side), never labelled otherwise. A change that
+is not located within LOCATION_STEPS (GRAZING_STEPS) trials, or whose multiplier misses the tolerance, is not
+labelled: the branch keeps one line for it in `Branch.unlocated`, and the figure draws no marker. A located point is
+inserted into the branch with its label, its `location_error` (| |mu| - 1 |, or the gap over g) and a note: "loses
+stability" / "gains stability" when a stable orbit becomes unstable or the reverse (crossings of already unstable
+orbits are labelled too: they change the unstable manifold, not the stability).
 
 Branch switching (`switch_branch`): at a located symmetry breaking the new branch is a fixed point of P_k (not of
 G) through the point, tangent to the eigenvector v of DG at lambda = -1; at a period doubling one of P_{2k},
@@ -133,12 +141,6 @@ def outside_count(orbit: PeriodicOrbit) -> int:
     return int(np.sum(np.abs(relevant_multipliers(orbit)) > OUTSIDE))
 
 
-def nearest_to_circle(orbit: PeriodicOrbit) -> complex:
-    """The multiplier (`relevant_multipliers`) nearest to the unit circle in |log |m||."""
-    m = relevant_multipliers(orbit)
-    return complex(m[np.argmin(np.abs(np.log(np.abs(m) + 1e-300)))])
-
-
 def _by_modulus(orbit: PeriodicOrbit) -> np.ndarray:
     """The relevant multipliers by decreasing modulus."""
     m = relevant_multipliers(orbit)
@@ -152,11 +154,6 @@ def _power(orbit: PeriodicOrbit) -> int:
 
 def _impacts(point: BranchPoint) -> int:
     return int(np.sum(point.orbit.impacts))
-
-
-def _stability_note(before: PeriodicOrbit, after: PeriodicOrbit) -> str:
-    """LOSES / GAINS when the stability differs between the orbits before and after a point, else ""."""
-    return LOSES if before.stable and not after.stable else GAINS if after.stable and not before.stable else ""
 
 
 @dataclass
@@ -536,23 +533,6 @@ def switch_branch(point: BranchPoint, parameter_name: str | Parameter, bounds: t
     raise SimulationDiverged(f"orbits: every first step off the {origin} at {where} fell back onto the parent branch")
 
 
-def loses_stability(branch: Branch) -> list[BranchPoint]:
-    """The located points of a branch where a stable orbit becomes unstable (or the reverse), in branch order."""
-    return [p for p in branch.points if p.note.startswith((LOSES, GAINS)) or f"; {LOSES}" in p.note
-            or f"; {GAINS}" in p.note]
-
-
-def crossing_label(orbit: PeriodicOrbit, multiplier: complex) -> str:
-    """The label of one multiplier at the unit circle taken alone (no path): a real one at +1 (a branch point) or -1
-    (symmetry breaking on a symmetric orbit, else period doubling), a complex one Neimark-Sacker. `detect` labels
-    by the path instead (module docstring); this names a single multiplier, e.g. in a report."""
-    if abs(multiplier.imag) > REAL * abs(multiplier):
-        return NEIMARK_SACKER
-    if multiplier.real > 0:
-        return BRANCH_POINT
-    return SYMMETRY_BREAKING if orbit.symmetric else PERIOD_DOUBLING
-
-
-__all__ = ["BRANCH_POINT", "FOLD", "GAINS", "GRAZING", "LABELS", "LOSES", "NEIMARK_SACKER", "PERIOD_DOUBLING",
-           "SWITCHING", "SYMMETRY_BREAKING", "crossing_label", "detect", "loses_stability", "nearest_to_circle",
-           "outside_count", "parent_residual", "relevant_multipliers", "switch_branch"]
+__all__ = ["BRANCH_POINT", "FOLD", "GAINS", "GRAZING", "IN_JUMP", "LABELS", "LOSES", "NEIMARK_SACKER", "PERIOD_DOUBLING",
+           "SWITCHING", "SYMMETRY_BREAKING", "detect", "outside_count", "parent_residual", "relevant_multipliers",
+           "switch_branch"]

@@ -198,7 +198,8 @@ class Continuer:
         lam = self.coordinate(u)
         shooting = self.shooting(lam)
         before = shooting.evaluations
-        end, half = shooting.jacobian(u[:-1] * self.scale, base=None if base is None else base[1])
+        end, half = shooting.jacobian(u[:-1] * self.scale, base=None if base is None else base[1],
+                                      one_side=base is None)  # the corrector's iterations: plain differences
         self.evaluations += shooting.evaluations - before
         du = np.zeros_like(u)
         du[-1] = LAMBDA_STEP

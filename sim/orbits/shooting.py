@@ -204,19 +204,21 @@ class ShootingMap:
         image = -value.half if symmetric else value.end
         return (image - y) / self.scale, value
 
-    def jacobian(self, y: np.ndarray, step: float | None = None,
-                 base: MapValue | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def jacobian(self, y: np.ndarray, step: float | None = None, base: MapValue | None = None, *,
+                 one_side: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """(DP_k, DF_half) in scaled variables, each (size, size): by central differences at `step` (default the
         map's `fd_step`; module docstring), or by forward differences from `base` = the map's value at y when given
-        (half the runs, error O(step) instead of O(step^2): for Newton's iterations, not for multipliers). A difference
-        whose runs hit the walls a different number of times straddles a grazing: its step shrinks tenfold at a time
-        (to SMALLEST_STEP, then one-sided, on the side of y's own impacts), and `shrunk` says so afterwards: such a
-        Jacobian is that of one side of the grazing, and less accurate (the map's noise over a small step)."""
+        (half the runs, error O(step) instead of O(step^2): for Newton's iterations, not for multipliers). With
+        `one_side` (for multipliers), a difference whose runs hit the walls a different number of times than y's
+        straddles a grazing: its step shrinks tenfold at a time (to SMALLEST_STEP, then one-sided, on the side of y's
+        own impacts), and `shrunk` says so afterwards: such a Jacobian is that of one side of the grazing, and less
+        accurate (the map's noise over a small step). Newton's iterations far from an orbit want the plain
+        differences (one_side False): there the steps would shrink to noise for nothing."""
         step = self.fd_step if step is None else step
         n = self.size
         end = np.empty((n, n))
         half = np.empty((n, n))
-        at_y = base if base is not None else self(y)  # whose impacts both runs of a difference must have
+        at_y = (base if base is not None else self(y)) if one_side else None  # whose impacts both runs must have
         self.shrunk = False
         for i in range(n):
             h = FORWARD_STEP if base is not None else step
@@ -225,12 +227,13 @@ class ShootingMap:
                 delta[i] = h * self.scale[i]
                 plus = self(y + delta)
                 minus = self(y - delta) if base is None else base
-                if (np.array_equal(plus.impacts, at_y.impacts) and np.array_equal(minus.impacts, at_y.impacts)
-                        or h <= SMALLEST_STEP):
+                if (at_y is None or np.array_equal(plus.impacts, at_y.impacts)
+                        and np.array_equal(minus.impacts, at_y.impacts) or h <= SMALLEST_STEP):
                     break
                 h /= 10.0  # the differences straddle a grazing: closer to y, on one side of it
                 self.shrunk = True
-            if np.array_equal(plus.impacts, at_y.impacts) and np.array_equal(minus.impacts, at_y.impacts):
+            if at_y is None or np.array_equal(plus.impacts, at_y.impacts) and np.array_equal(minus.impacts,
+                                                                                          at_y.impacts):
                 width = h if base is not None else 2.0 * h
                 end[:, i] = (plus.end - minus.end) / width / self.scale
                 half[:, i] = (plus.half - minus.half) / width / self.scale
@@ -438,12 +441,10 @@ def solve_orbit(setting: OrbitSetting, guess: np.ndarray, *, k: int = 1, symmetr
     if r is None:
         raise OrbitNotConverged("orbits: the integrator fails from the start state itself; start closer to the "
                                 "orbit (a simulated state, --start slow-flow) or at a lower level")
-    jacobian = None
     for _ in range(max_iterations):
         if norm < tolerance:
             break
-        jacobian = shooting.jacobian(y)
-        A = newton_matrix(*jacobian, symmetric)
+        A = newton_matrix(*shooting.jacobian(y, one_side=False), symmetric)
         step = np.linalg.lstsq(A, -r, rcond=1e-12)[0] * shooting.scale
         damping = 1.0
         while damping >= 1.0 / 1024:
@@ -459,9 +460,9 @@ def solve_orbit(setting: OrbitSetting, guess: np.ndarray, *, k: int = 1, symmetr
                                     f"{tolerance:.0e}) at eta {setting.eta:g}, level {setting.level:g}; start closer: "
                                     "--start slow-flow (continuation from damped higher modes), a state simulated "
                                     "at this point, or a neighbouring orbit", y, norm)
-        y, norm, r, value, jacobian = trial, t_norm, t_r, t_value, None
+        y, norm, r, value = trial, t_norm, t_r, t_value
     else:
         raise OrbitNotConverged(f"orbits: no convergence in {max_iterations} Newton steps (residual {norm:.2e} g) at "
                                 f"eta {setting.eta:g}, level {setting.level:g}; start closer (--start slow-flow, a "
                                 "simulated state) or lower the level", y, norm)
-    return make_orbit(shooting, y, symmetric, value, jacobian)
+    return make_orbit(shooting, y, symmetric, value)  # its multipliers from differences on one side of a grazing
