@@ -153,7 +153,8 @@ def largest_lyapunov(run_period: Callable[[np.ndarray], tuple[float, int]], y0: 
     target = max(RELATIVE_ERROR * abs(exponent), ABSOLUTE_ERROR)
     needed = transient + int(math.ceil(tail.size * (se / target) ** 2)) if se > target else periods
     running = np.cumsum(tail) / np.arange(1, tail.size + 1)
-    return Lyapunov(exponent, se, periods, transient, growth, running, se <= target, int(needed), host_only)
+    return Lyapunov(per_period=exponent, standard_error=se, periods=periods, transient=transient, growth=growth,
+                    running=running, converged=se <= target, periods_needed=int(needed), host_only=host_only)
 
 
 def slope(growth: np.ndarray) -> float:

@@ -96,7 +96,8 @@ def test_a_record_too_short_is_refused_naming_the_length_needed():
 def test_classify_and_periodicity_on_constructed_cases():
     """Each branch of the classification, and the least period of states that repeat after 1, 3 or never."""
     def lyapunov(value, error):
-        return Lyapunov(value, error, 100, 25, np.zeros(100), np.zeros(75), True, 100)
+        return Lyapunov(per_period=value, standard_error=error, periods=100, transient=25, growth=np.zeros(100),
+                        running=np.zeros(75), converged=True, periods_needed=100)
 
     assert classify(lyapunov(0.5, 0.01), None, 2.0) == CHAOTIC
     assert classify(lyapunov(0.005, 0.0001), None, 2.0) == QUASI_PERIODIC  # below CHAOS_FLOOR: zero for a torus
