@@ -176,6 +176,8 @@ def plot_orbits(panels: Sequence[tuple[Mapping[str, np.ndarray], str, tuple[floa
             draw_orbits(ax, columns, parameter=parameter, bounds=bounds, sweep=sweep, max_period=max_period,
                         title=panel_title)
             legend_beside(ax)
+        # one y range for the shared scale, from 0 to the highest data of any panel (a sweep's points included)
+        axes[0, 0].set_ylim(0.0, 1.05 * max(ax.dataLim.y1 for ax in axes[:, 0]))
         if title:
             fig.suptitle(title, fontsize=10)
         save_figure(fig, path)
