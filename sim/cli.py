@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any, Iterator, Sequence
 
 from sim.analysis import cli as signal_cli
+from sim.measured import cli as measured_cli
 from sim.common.errors import SimulationInputError
 from sim.common.options import figure_file, positive_int
 
@@ -749,7 +750,8 @@ COMMANDS = (("modes", MODES_HELP, add_modes_arguments, modes_command),
             ("orbits", ORBITS_HELP, add_orbits_arguments, orbits_command),
             ("impacts", signal_cli.IMPACTS_HELP, signal_cli.add_impacts_arguments, signal_cli.impacts_command),
             ("modal-fit", signal_cli.MODAL_FIT_HELP, signal_cli.add_modal_fit_arguments, signal_cli.modal_fit_command),
-            ("cache", CACHE_HELP, add_cache_arguments, cache_command))
+            ("cache", CACHE_HELP, add_cache_arguments, cache_command),
+            *measured_cli.commands(output_folder))
 
 
 def add_commands(subparsers: Any) -> None:
