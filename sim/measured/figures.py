@@ -55,16 +55,16 @@ def draw_frf(path: str | Path, frequencies_hz: np.ndarray, measured: dict[str, n
         f = frequencies_hz[keep]
         for i, name in enumerate(measured):
             axes[0].semilogy(f, np.abs(measured[name][keep]), color="k", lw=0.8, ls=styles[i % 4], label=f"measured, {name}")
-            axes[1].plot(f, np.degrees(np.angle(measured[name][keep])), color="k", lw=0.8, ls=styles[i % 4])
+            axes[1].plot(f, phase_deg(measured[name][keep]), color="k", lw=0.8, ls=styles[i % 4])
             if name in other:
                 axes[0].semilogy(f, np.abs(other[name][keep]), color="0.55", lw=1.4, ls=styles[i % 4],
                                  label=f"{other_label}, {name}")
-                axes[1].plot(f, np.degrees(np.angle(other[name][keep])), color="0.55", lw=1.4, ls=styles[i % 4])
+                axes[1].plot(f, phase_deg(other[name][keep]), color="0.55", lw=1.4, ls=styles[i % 4])
             if name in coherence:
                 axes[2].plot(f, coherence[name][keep], color="k", lw=0.8, ls=styles[i % 4])
         axes[0].set_ylabel("|H| (m/N)")
         axes[1].set_ylabel("phase (deg)")
-        axes[1].set_yticks([-180, 0, 180])
+        axes[1].set_yticks([-360, -180, 0])
         axes[2].set_ylabel(r"coherence $\gamma^2$")
         axes[2].set_ylim(0, 1.05)
         axes[2].set_xlabel("frequency (Hz)")
@@ -72,6 +72,12 @@ def draw_frf(path: str | Path, frequencies_hz: np.ndarray, measured: dict[str, n
         return save_figure(fig, path)
     finally:
         plt.close(fig)
+
+
+def phase_deg(H: np.ndarray) -> np.ndarray:
+    """Phase of H in degrees in (-360, 0]: a receptance's phase (0 to -180 deg at a driving point) without the jumps
+    between +180 and -180."""
+    return np.mod(np.degrees(np.angle(H)), -360.0)
 
 
 def draw_linearity(path: str | Path, levels, mode, half_powers, interval) -> Path:
@@ -85,12 +91,13 @@ def draw_linearity(path: str | Path, levels, mode, half_powers, interval) -> Pat
         a_max = max(float(lv.amplitude.max()) for lv in levels)
         for i, lv in enumerate(levels):
             a.plot(lv.frequencies_hz, 1e3 * lv.amplitude, ls="none", marker=markers[i % 10], ms=3, mfc="none", color="k",
-                   label=f"a_base = {1e9 * lv.a_base:.3g} nm")
+                   label=f"a_base = {1e6 * lv.a_base:.3g} $\\mu$m")
             fine = np.linspace(lv.frequencies_hz[0], lv.frequencies_hz[-1], 300)
-            synth = [mode.responses(2 * np.pi * f, lv.a_base, 3 * a_max) for f in fine]
+            synth = [mode.responses(2 * np.pi * f, lv.a_base, 1.1 * a_max) for f in fine]
             top = np.array([r.max() if r.size else np.nan for r in synth])
             a.plot(fine, 1e3 * top, color="0.5", lw=0.9, label="synthesized" if i == 0 else None)
-        amp = np.linspace(0.02 * a_max, 1.05 * a_max, 200)
+        a_min = min(float(lv.amplitude.max()) for lv in levels)
+        amp = np.linspace(0.5 * a_min, 1.05 * a_max, 200)
         a.plot(mode.omega(amp) / (2 * np.pi), 1e3 * amp, color="k", ls="--", lw=0.9, label="backbone")
         a.set_xlabel("frequency (Hz)")
         a.set_ylabel("tip amplitude a (mm)")

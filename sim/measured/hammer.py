@@ -40,7 +40,7 @@ THRESHOLD_NOISE = 10.0
 #: ... and this fraction of the record's largest force
 THRESHOLD_PEAK = 0.05
 #: samples at the peak value that mark a clipped (overloaded) force
-CLIP_SAMPLES = 3
+CLIP_SAMPLES = 2
 #: the force window ends this long after the pulse, with a half-cosine taper of the same length (s)
 FORCE_WINDOW_TAIL_S = 1e-3
 #: quantity of a response -> power of (i omega) that turns it into displacement
@@ -186,8 +186,8 @@ def frf_estimate(records: list[HammerRecord], settings: HammerSettings = HammerS
         n = record.force.size
         for i, hit in enumerate(hits):
             room = (hits[i + 1].start if i + 1 < len(hits) else n + pre) - hit.start
-            if i + 1 == len(hits) and room < 0.5 * median:
-                cut.append((record, i))
+            if i + 1 == len(hits) and spacings and room < 0.5 * median:
+                cut.append((id(record), i))
                 continue
             blocks.append(room)
     block = (settings.block or int(min(blocks))) if blocks else 0
@@ -204,7 +204,7 @@ def frf_estimate(records: list[HammerRecord], settings: HammerSettings = HammerS
     kept, all_hits = 0, []
     for record, hits, pulses in found:
         for i, (hit, (_, end)) in enumerate(zip(hits, pulses)):
-            if (record, i) in cut:
+            if (id(record), i) in cut:
                 all_hits.append(Hit(hit.source, hit.start, hit.peak_N, hit.double, False, "the record ends too soon after it"))
                 continue
             all_hits.append(hit)

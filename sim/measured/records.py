@@ -246,6 +246,10 @@ def read_uff(path: str | os.PathLike) -> HammerRecord | MeasuredFrf:
 
 
 def _uff_name(s: dict, index: int) -> str:
+    """A response's name: its entity name (what `write_uff_frf` writes), else node and direction."""
+    name = str(s.get("rsp_ent_name", "") or "").strip()
+    if name and name.upper() != "NONE":
+        return name
     node, direction = s.get("rsp_node"), s.get("rsp_dir")
     return f"node{node}_dir{direction}" if node is not None else f"response{index + 1}"
 
