@@ -13,12 +13,13 @@ mode 2 (CLAMP_MODE: the secondary peak of Fig. A.1) can be added.
 Shaker test (Appendix B): the host alone under stepped-sine base excitation at several levels, mode 1 with a friction
 element at the clamp: an Iwan element (IWAN_ELEMENTS Jenkins elements in parallel, each a spring in series with a
 Coulomb slider) acting on mode 1's modal coordinate, with stiffness share kappa (their springs add kappa omega_1^2 in
-stick, the linear model's omega_1 being the stuck frequency) and slip amplitudes log-spaced over `slip_m` (tip
-amplitudes, m). Each frequency step is integrated in time (velocity Verlet, the sliders moved at each new position,
-STEPS_PER_PERIOD steps per period) from the describing function's steady state over SETTLE_PERIODS periods; the last
-AVERAGE_PERIODS give the fundamental harmonic. Modes 2.. add their
-linear response. The known amplitude-dependent frequency and damping of this element (its describing function:
-`iwan_backbone`) is what `ies linearity` must find.
+stick, the linear model's omega_1 being the stuck frequency) and slip tip amplitudes log-spaced over IWAN_SLIP_M (m).
+Each frequency step is integrated in time (the linear part exactly per step with the forces linear in it, the
+friction at the step's end by one predictor-corrector pass, STEPS_PER_PERIOD steps per period) from the describing
+function's steady state (the sliders set by driving them through that cycle's extremes) over SETTLE_PERIODS periods;
+the last AVERAGE_PERIODS give the fundamental harmonic. Modes 2.. add their linear response. The known
+amplitude-dependent frequency and damping of this element (its describing function, `iwan_backbone`) is what
+`ies linearity` must find (tests/sim/measured/test_linearity.py).
 """
 from __future__ import annotations
 
@@ -170,20 +171,25 @@ def shaker_levels(iwan: Iwan, D_lin: float, gamma: float, frequencies_hz: np.nda
         sliders = np.where(np.abs(stretch) > xs, position[None, :] - np.sign(stretch) * xs, sliders)
         return k * np.sum(position[None, :] - sliders, axis=0), sliders
 
-    dt = 2 * np.pi / Omega / STEPS_PER_PERIOD
-    f_now, z = friction(s, z)
-    acc = force - c * v - w_m2 * s - f_now
+    # the sliders as on the describing function's cycle: driven through its extremes to the start (Masing)
+    X = np.abs(S)
+    for position in (X, -X, np.where(v < 0, X, -X), s):
+        f_now, z = friction(position, z)
+    # the linear part exact over a step, the forces linear in it (first-order hold): x' = Phi x + G0 u_k + G1 u_k+1
+    Phi, G0, G1 = _first_order_hold(w_m2, c, 1.0 / (steps * STEPS_PER_PERIOD))
+    Phi, G0, G1 = (np.concatenate([m] * len(a_bases)) for m in (Phi, G0, G1))
+    x = np.stack([s, v], axis=1)
     coef = np.zeros(Omega.size, complex)
+    delta = 2 * np.pi / STEPS_PER_PERIOD
     for step in range(1, (SETTLE_PERIODS + AVERAGE_PERIODS) * STEPS_PER_PERIOD + 1):
-        # velocity Verlet, the sliders moved at each new position, the viscous term implicit
-        v_half = v + 0.5 * dt * acc
-        s = s + dt * v_half
-        phase = step * 2 * np.pi / STEPS_PER_PERIOD
-        f_now, z = friction(s, z)
-        acc = (force * np.cos(phase) - w_m2 * s - f_now - c * v_half) / (1 + 0.5 * dt * c)
-        v = v_half + 0.5 * dt * acc
+        phase = step * delta
+        base = np.einsum("nij,nj->ni", Phi, x) + G0 * (force * np.cos(phase - delta) - f_now)[:, None]
+        guess = base + G1 * (force * np.cos(phase) - f_now)[:, None]  # predictor: the friction held
+        f_guess, _ = friction(guess[:, 0], z)
+        x = base + G1 * (force * np.cos(phase) - f_guess)[:, None]  # corrector: the friction at the predicted end
+        f_now, z = friction(x[:, 0], z)
         if step > SETTLE_PERIODS * STEPS_PER_PERIOD:
-            coef += s * np.exp(-1j * phase)
+            coef += x[:, 0] * np.exp(-1j * phase)
     tip = iwan.phi_tip * 2 * coef / (AVERAGE_PERIODS * STEPS_PER_PERIOD)
     tip = tip.reshape(start.shape)
     if background is not None:
@@ -204,6 +210,21 @@ IWAN_SLIP_M = (0.2e-3, 3e-3)
 #: the stepped sine: eta range around f_1 and steps
 SHAKER_ETA = (0.992, 1.004)
 SHAKER_STEPS = 49
+
+
+def _first_order_hold(w2: float, c: float, dt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(Phi, G0, G1) per step length dt (s) of s'' + c s' + w2 s = u with u linear over the step: the exact
+    x_k+1 = Phi x_k + G0 u_k + G1 u_k+1, x = (s, s'), from the exponential of the augmented matrix."""
+    import scipy.linalg
+
+    A = np.array([[0.0, 1.0], [-w2, -c]])
+    out = []
+    for h in np.atleast_1d(dt):
+        M = np.zeros((4, 4))
+        M[:2, :2], M[1, 2], M[2, 3] = A, 1.0, 1.0 / h
+        E = scipy.linalg.expm(M * h)
+        out.append((E[:2, :2], E[:2, 2] - E[:2, 3], E[:2, 3]))
+    return tuple(np.array(m) for m in zip(*out))
 
 
 def rig_truth() -> dict:
