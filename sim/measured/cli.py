@@ -66,6 +66,9 @@ def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--modes", type=positive_int, metavar="N", help="keep the N modes with the highest peaks")
     parser.add_argument("--max-order", dest="max_order", type=positive_int, default=20, metavar="N",
                         help="highest LSCF order of each sub-band (default 20)")
+    parser.add_argument("--method", choices=("lscf", "sdypy"), default="lscf",
+                        help="pole estimator: lscf (the workbench's) or sdypy (sdypy-EMA's LSCF; pip install "
+                             "'.[measured]'); both with the same stabilization, choice of poles and LSFD")
     parser.add_argument("--estimator", choices=("Hv", "H1", "H2"), default="Hv",
                         help="FRF estimator of hammer records (default Hv, the paper's)")
     parser.add_argument("--block", type=positive_int, metavar="N", help="samples per hit (default: the shortest spacing)")
@@ -113,14 +116,14 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
                                                      min(0.78 * fs / 2, float(frequencies[-1])))
     matrix = np.array([frf[name] for name in names])
     result = identify(frequencies, matrix, names, band, modes=args.modes, max_order=args.max_order,
-                      window_decay=decay, source=source)
+                      window_decay=decay, source=source, method=args.method)
     summary = {
         "frequencies_hz": result.frequencies_hz, "damping_ratios": result.damping_ratios,
         "modal_constants_per_kg": {n: result.modal_constants[o].real for o, n in enumerate(names)},
         "complexity": {n: result.complexity[o] for o, n in enumerate(names)},
         "band_hz": [band.lo, band.hi], "estimator": estimator, "inputs": list(args.files),
         "window_decay_per_s": decay, "block_samples": estimate.block if records else None,
-        "hits": [h.describe(fs) for h in hits], "max_order": args.max_order,
+        "hits": [h.describe(fs) for h in hits], "max_order": args.max_order, "method": args.method,
         "units": {"frequencies_hz": "Hz", "damping_ratios": "1", "modal_constants_per_kg": "1/kg (displacement per force)",
                   "window_decay_per_s": "1/s (added by the exponential window, taken out of the damping)"},
     }

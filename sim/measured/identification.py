@@ -263,17 +263,52 @@ def sub_bands(band: Band) -> list[tuple[Band, Band]]:
     return pairs
 
 
+def sdypy_poles(frequencies_hz: np.ndarray, frfs: np.ndarray, band: Band, max_order: int = MAX_ORDER
+                ) -> list[np.ndarray]:
+    """The poles (rad/s, in the band and decaying) of sdypy-EMA's LSCF (real coefficients over 0..f_hi, the lines
+    below f_lo set to zero; orders 2, 4, .. 2 max_order: max_order complex pairs) in the form of `lscf_poles`: the
+    field's implementation, chosen with `ies identify --method sdypy` (needs pip install '.[measured]')."""
+    import warnings
+
+    try:
+        from sdypy import EMA
+    except ImportError:
+        raise SimulationInputError("--method sdypy needs sdypy-EMA: pip install '.[measured]'") from None
+    upto = frequencies_hz <= band.hi
+    with warnings.catch_warnings():  # sdypy warns of a band edge between two lines; it takes the nearest
+        warnings.simplefilter("ignore")
+        model = EMA.Model(frf=frfs[:, upto], freq=frequencies_hz[upto], lower=band.lo, upper=band.hi,
+                          pol_order_high=max_order, frf_form="receptance")
+        model.get_poles(method="lscf", show_progress=False)
+    out = []
+    for f, zeta in zip(model.pole_freq, model.pole_xi):
+        f, zeta = np.asarray(f, float), np.asarray(zeta, float)
+        keep = np.isfinite(f) & np.isfinite(zeta) & (f >= band.lo) & (f <= band.hi) & (zeta > 0) & (zeta < 1)
+        w = 2 * np.pi * f[keep]
+        out.append(np.sort_complex(-zeta[keep] * w + 1j * w * np.sqrt(1 - zeta[keep] ** 2)))
+    return out
+
+
+#: the pole estimators of `ies identify --method`: name -> (poles of every order in `lscf_poles`' form, whether it fits
+#: sub-bands, its orders per default order); sdypy-EMA's real-coefficient LSCF spans 0..f_hi and fits the whole band
+#: at twice the order
+METHODS = {"lscf": (lscf_poles, True, 1), "sdypy": (sdypy_poles, False, 2)}
+
+
 def band_diagram(frequencies_hz: np.ndarray, frfs: np.ndarray, band: Band, max_order: int, window_decay: float,
-                 source: str) -> StabilizationDiagram:
-    """The stabilization diagram of `band`: LSCF of each sub-band up to max_order (lower where a sub-band holds fewer
-    than 4 lines per order), each keeping the poles of its middle part (module docstring)."""
+                 source: str, method: str = "lscf") -> StabilizationDiagram:
+    """The stabilization diagram of `band`: the poles of `method` (METHODS) of each sub-band up to max_order (lower
+    where a sub-band holds fewer than 4 lines per order), each keeping the poles of its middle part (module
+    docstring)."""
+    poles_of, banded, factor = METHODS[method]
     parts = []
-    for fitted, kept in sub_bands(band):
+    max_order *= factor
+    for fitted, kept in sub_bands(band) if banded else [(band, band)]:
         lines = int(np.sum((frequencies_hz >= fitted.lo) & (frequencies_hz <= fitted.hi)))
         order = min(max_order, lines // 4)
         if order < 4:
             continue
-        d = stabilization(lscf_poles(frequencies_hz, frfs, fitted, order), window_decay)
+        d = stabilization(poles_of(frequencies_hz, frfs, fitted, order), window_decay)
         inside = (d.frequency_hz >= kept.lo) & (d.frequency_hz < kept.hi)
         parts.append((d.order[inside], d.frequency_hz[inside], d.damping_ratio[inside], d.status[inside]))
     if not parts:
@@ -283,9 +318,10 @@ def band_diagram(frequencies_hz: np.ndarray, frfs: np.ndarray, band: Band, max_o
 
 
 def identify(frequencies_hz: np.ndarray, frfs: np.ndarray, names: list[str], band: Band, *, modes: int | None = None,
-             max_order: int = MAX_ORDER, window_decay: float = 0.0, source: str = "the FRFs") -> Identification:
+             max_order: int = MAX_ORDER, window_decay: float = 0.0, source: str = "the FRFs",
+             method: str = "lscf") -> Identification:
     """Modal parameters of FRFs of displacement per force (n_outputs, n_lines; m/N) at frequencies_hz (Hz) in `band`:
-    LSCF up to max_order in sub-bands, the stable poles chosen automatically (the `modes` with the highest peaks when
+    LSCF (`method`: ours, or sdypy-EMA's) up to max_order in sub-bands, the stable poles chosen automatically (the `modes` with the highest peaks when
     given), damping with the exponential window's decay rate window_decay (1/s) taken out, LSFD for the modal constants
     over the whole band (module docstring). One line for a band outside the data or with too few lines, without a
     stable pole, and when fewer modes than `modes` are stable."""
@@ -294,7 +330,7 @@ def identify(frequencies_hz: np.ndarray, frfs: np.ndarray, names: list[str], ban
     if band.hi <= frequencies_hz[0] or band.lo >= frequencies_hz[-1]:
         raise SimulationInputError(f"{source}: the band {band.lo:g}-{band.hi:g} Hz lies outside the measured "
                                    f"{frequencies_hz[0]:g}-{frequencies_hz[-1]:g} Hz; give --band inside it")
-    diagram = band_diagram(frequencies_hz, frfs, band, max_order, window_decay, source)
+    diagram = band_diagram(frequencies_hz, frfs, band, max_order, window_decay, source, method)
     natural, damping = stable_modes(diagram)
     if natural.size == 0:
         raise SimulationInputError(f"{source}: no stable pole in {band.lo:g}-{band.hi:g} Hz (no mode, or the FRF is "
