@@ -81,7 +81,14 @@ def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--force", action="store_true", help="write into a non-empty --out folder")
 
 
-MODES_COLUMNS = ("mode", "frequency_hz", "damping_ratio")
+def expand(table: Any, names: list[str]) -> list[str]:
+    """The CSV header of a table of `sim.measured.tables`, each "<NAME>" column once per response name (a row naming
+    two columns, "a, b", gives both)."""
+    out = []
+    for column in table.columns:
+        for name in (c.strip() for c in column.name.split(",")):
+            out += [name.replace("<NAME>", n) for n in names] if "<NAME>" in name else [name]
+    return out
 
 
 def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]) -> int:
@@ -93,6 +100,7 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
     from sim.measured.hammer import HammerSettings, frf_estimate
     from sim.measured.identification import Band, identify
     from sim.measured.records import read_hammer_inputs
+    from sim.measured.tables import FRF_CSV, MODES_CSV, POLES_CSV
 
     band_given = _span(args.band, FREQUENCY_UNITS, "Hz", "--band", "50:6400") if args.band else None
     settings = HammerSettings(block=args.block, exp_window_end=args.exp_window,
@@ -130,16 +138,15 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
     with output_folder(args.out, args.force) as folder:
         rows = [[j + 1, result.frequencies_hz[j], result.damping_ratios[j],
                  *(result.modal_constants[o, j].real for o in range(len(names)))] for j in range(result.frequencies_hz.size)]
-        written = [write_csv(folder / "modes.csv", [*MODES_COLUMNS, *(f"modal_constant_{n}_per_kg" for n in names)], rows)]
-        columns = ["frequency_Hz"]
-        for n in names:
-            columns += [f"{n}_real_m_N", f"{n}_imag_m_N"] + ([f"{n}_coherence"] if n in coherence else [])
+        written = [write_csv(folder / "modes.csv", expand(MODES_CSV, names), rows)]
+        columns = ["frequency_Hz"] + [c for n in names for c in expand(FRF_CSV, [n])[1:]
+                                       if n in coherence or not c.endswith("_coherence")]
         data = [frequencies]
         for n in names:
             data += [frf[n].real, frf[n].imag] + ([coherence[n]] if n in coherence else [])
         written.append(write_csv(folder / "frf.csv", columns, np.column_stack(data)))
         d = result.diagram
-        written.append(write_csv(folder / "poles.csv", ["order", "frequency_hz", "damping_ratio", "status"],
+        written.append(write_csv(folder / "poles.csv", list(POLES_CSV.names),
                                  zip(d.order, d.frequency_hz, d.damping_ratio, d.status)))
         written.append(write_csv_json(folder / "identification.json", summary))
         magnitude = np.sum(np.abs(matrix), axis=0)
@@ -331,6 +338,7 @@ def linearity_command(args: argparse.Namespace, output_folder: Callable[..., Any
     from sim.hosts.modal_file import load_modal_model, load_provenance, save_modal_model
     from sim.measured.figures import draw_linearity
     from sim.measured.linearity import damping_interval, fit_nonlinear_mode, half_power, read_level
+    from sim.measured.tables import BACKBONE_CSV, LEVELS_CSV
 
     a_lo, a_hi = _span(args.span, LENGTH_UNITS, "m", "--range", "0.58mm:0.95mm")
     if (args.write or args.in_place or args.set_nominal) and not args.model:
@@ -375,10 +383,9 @@ def linearity_command(args: argparse.Namespace, output_folder: Callable[..., Any
         sys.stderr.write(f"warning: the range {1e3 * a_lo:g}-{1e3 * a_hi:g} mm reaches beyond the measured peak amplitudes "
                          f"({1e3 * measured[0]:.3g}-{1e3 * measured[1]:.3g} mm): the interval is extrapolated\n")
     with output_folder(args.out, args.force) as folder:
-        written = [write_csv(folder / "levels.csv", ["a_base_m", "resonance_hz", "half_power_damping_ratio",
-                                                     "peak_amplitude_m"],
+        written = [write_csv(folder / "levels.csv", list(LEVELS_CSV.names),
                              [[lv.a_base, h.frequency_hz, h.damping_ratio, h.peak_amplitude] for lv, h in zip(levels, halves)]),
-                   write_csv(folder / "backbone.csv", ["amplitude_m", "frequency_hz", "damping_ratio"],
+                   write_csv(folder / "backbone.csv", list(BACKBONE_CSV.names),
                              zip(amp, mode.omega(amp) / (2 * np.pi), mode.damping(amp))),
                    write_csv_json(folder / "linearity.json", summary),
                    draw_linearity(folder / "linearity.png", levels, mode, halves, interval)]

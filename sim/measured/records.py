@@ -98,6 +98,25 @@ def _table(path: Path, kind: str, example: str) -> tuple[list[str], np.ndarray]:
     if any(not cell for cell in header):
         raise SimulationInputError(f"{path}: column {header.index('') + 1} has no name; name every column with its unit, "
                                    f"e.g. '{example}'")
+    if len(lines) < 9:
+        raise SimulationInputError(f"{path}: {len(lines) - 1} data row(s); a {kind} needs at least 8")
+    try:  # numpy's C reader first; the row by row reader below names a bad row
+        data = np.loadtxt(io.StringIO("\n".join(lines[1:])), delimiter=",", ndmin=2)
+        if data.shape[1] != len(header):
+            raise ValueError
+    except ValueError:
+        data = _rows(path, header, lines)
+    bad = np.argwhere(~np.isfinite(data))
+    if bad.size:
+        row, col = bad[0]
+        raise SimulationInputError(f"{path}: column '{header[col]}' is {data[row, col]} at data row {row + 1}; every value "
+                                   "must be a finite number (remove or interpolate it)")
+    return header, data
+
+
+def _rows(path: Path, header: list[str], lines: list[str]) -> np.ndarray:
+    """The numbers of the data lines, row by row, naming the first row of another length or with a value that is not
+    a number."""
     rows = []
     for number, line in enumerate(lines[1:], start=2):
         cells = line.split(",")
@@ -107,15 +126,7 @@ def _table(path: Path, kind: str, example: str) -> tuple[list[str], np.ndarray]:
             rows.append([float(c) for c in cells])
         except ValueError:
             raise SimulationInputError(f"{path}: row {number} has a value that is not a number ({line.strip()[:60]!r})") from None
-    data = np.array(rows, float).reshape(-1, len(header))
-    if data.shape[0] < 8:
-        raise SimulationInputError(f"{path}: {data.shape[0]} data row(s); a {kind} needs at least 8")
-    bad = np.argwhere(~np.isfinite(data))
-    if bad.size:
-        row, col = bad[0]
-        raise SimulationInputError(f"{path}: column '{header[col]}' is {data[row, col]} at data row {row + 1}; every value "
-                                   "must be a finite number (remove or interpolate it)")
-    return header, data
+    return np.array(rows, float).reshape(-1, len(header))
 
 
 def _increasing(path: Path, axis: np.ndarray, name: str, what: str) -> None:
