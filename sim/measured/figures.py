@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from sim.common.figure_style import legend_below
-from sim.common.files import pyplot, save_figure
+from sim.common import files
+from sim.common.files import pyplot
 
 STATUS = ((0, "new pole", dict(marker=".", color="0.7", s=6)), (1, "stable in frequency", dict(marker="+", color="0.4", s=14)),
           (2, "stable in frequency and damping", dict(marker="o", facecolors="none", edgecolors="k", s=14)))
@@ -35,7 +36,7 @@ def draw_stabilization(path: str | Path, identification, frf_magnitude: np.ndarr
         right.semilogy(f[inside], frf_magnitude[inside], color="0.5", lw=0.6)
         right.set_ylabel("|H| (m/N)")
         legend_below(ax, ncols=2)
-        return save_figure(fig, path)
+        return files.save_figure(fig, path)
     finally:
         plt.close(fig)
 
@@ -69,7 +70,7 @@ def draw_frf(path: str | Path, frequencies_hz: np.ndarray, measured: dict[str, n
         axes[2].set_ylim(0, 1.05)
         axes[2].set_xlabel("frequency (Hz)")
         legend_below(axes[2], ncols=2)
-        return save_figure(fig, path)
+        return files.save_figure(fig, path)
     finally:
         plt.close(fig)
 
@@ -113,6 +114,6 @@ def draw_linearity(path: str | Path, levels, mode, half_powers, interval) -> Pat
         b.set_xlabel("tip amplitude a (mm)")
         b.set_ylabel("damping ratio D (%)")
         legend_below(b)
-        return save_figure(fig, path)
+        return files.save_figure(fig, path)
     finally:
         plt.close(fig)
