@@ -62,7 +62,8 @@ def add_identify_arguments(parser: argparse.ArgumentParser) -> None:
                         help="write modes.csv, frf.csv, poles.csv, identification.json, stabilization.png, frf.png "
                              "(default ies-out/identify)")
     parser.add_argument("--band", metavar="LO:HI", help="frequency band of the identification, e.g. 50:6400 or "
-                                                        "50Hz:6.4kHz (default: 20 Hz to 78 %% of the Nyquist frequency)")
+                                                        "50Hz:6.4kHz (default: 20 Hz to 78 %% of the Nyquist frequency, "
+                                                        "for FRF files of their last line)")
     parser.add_argument("--modes", type=positive_int, metavar="N", help="keep the N modes with the highest peaks")
     parser.add_argument("--max-order", dest="max_order", type=positive_int, default=20, metavar="N",
                         help="highest LSCF order of each sub-band (default 20)")
@@ -119,7 +120,7 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
         if len(frfs) > 1:
             raise SimulationInputError(f"{args.files[1]}: give measured FRFs in one file (several responses as columns)")
         frequencies, frf, coherence, names = frfs[0].frequencies_hz, frfs[0].frf, frfs[0].coherence, list(frfs[0].frf)
-        fs = 2 * frequencies[-1] / 0.78 * 0.78
+        fs = 2 * float(frequencies[-1])  # the last line taken as the analyser's Nyquist frequency
     band = Band(*band_given) if band_given else Band(max(20.0, 4 * float(frequencies[0])),
                                                      min(0.78 * fs / 2, float(frequencies[-1])))
     matrix = np.array([frf[name] for name in names])
@@ -232,8 +233,6 @@ def _model_and_E0(args: argparse.Namespace) -> tuple[Any, float | None, str]:
 
 def update_command(args: argparse.Namespace) -> int:
     """`ies update`: pair, scale, damp, write."""
-    import numpy as np
-
     from sim.common.files import check_writable, dumps, report_written, to_jsonable
     from sim.common.units import Quantity, parse_quantity
     from sim.hosts.modal_file import save_modal_model
@@ -294,7 +293,6 @@ def update_command(args: argparse.Namespace) -> int:
         if result.note:
             sys.stdout.write(result.note + "\n")
     report_written(written, json_mode=args.json)
-    del np
     return 0
 
 

@@ -246,7 +246,8 @@ def frf_estimate(records: list[HammerRecord], settings: HammerSettings = HammerS
         gamma2 = np.abs(gfx) ** 2 / (gff * gxx)
         H1[name], H2[name], coherence[name] = h1, h2, gamma2
         Hv[name] = h1 / np.sqrt(gamma2)
-    return FrfEstimate(frequencies, H1, H2, Hv, coherence, all_hits, 0.0 if math.isinf(tau) else 1.0 / tau, fs, block)
+    return FrfEstimate(frequencies, H1, H2, Hv, coherence, hits=all_hits, window_decay=0.0 if math.isinf(tau) else 1.0 / tau,
+                       fs=fs, block=block)
 
 
 def remove_window_damping(poles: np.ndarray, window_decay: float) -> np.ndarray:

@@ -27,8 +27,9 @@ Stabilization and choice of poles: a pole of order n is stable in frequency when
 within STABLE_FREQUENCY (relative), stable when its damping ratio also agrees within STABLE_DAMPING. Stable poles of all
 orders are grouped by frequency (gaps below CLUSTER_GAP); a group seen at MIN_SHARE of the orders (at least 3) is a
 physical mode, whose frequency and damping are the medians over the group's poles of the upper half of its orders.
-With `modes` given, the modes with the highest peaks in the synthesized FRF (|A_o| / (2 D omega^2), summed over the
-outputs) are kept.
+With `modes` given, the modes with the highest peaks of the synthesized accelerance (|A_o| / (2 D), summed over the
+outputs) are kept: the accelerometer's view, in which a weak mode of the clamping near mode 2 stays below mode 4,
+whereas in the displacement FRF (peaks |A| / (2 D omega^2)) it may not.
 
 LSFD: the real-mode form H_o(omega) = sum_j A_oj / (omega_j^2 - omega^2 + 2 i D_j omega_j omega) - LR_o / omega^2 + UR_o
 with complex unknowns A_oj (the modal constants, 1/kg for displacement per force; for a driving point A_j = phi_j^2 of
@@ -341,9 +342,10 @@ def identify(frequencies_hz: np.ndarray, frfs: np.ndarray, names: list[str], ban
                                    "raise --max-order or ask fewer modes")
     constants, lower, upper, synthesized = lsfd(frequencies_hz, frfs, band, natural, damping)
     if modes is not None and natural.size > modes:
-        peaks = np.sum(np.abs(constants), axis=0) / (2 * damping * (2 * np.pi * natural) ** 2)
+        peaks = np.sum(np.abs(constants), axis=0) / (2 * damping)  # the accelerance's peaks (module docstring)
         keep = np.sort(np.argsort(peaks)[::-1][:modes])
         natural, damping = natural[keep], damping[keep]
         constants, lower, upper, synthesized = lsfd(frequencies_hz, frfs, band, natural, damping)
     return Identification(natural, damping, constants, list(names), diagram, band, frequencies_hz,
-                          {name: synthesized[o] for o, name in enumerate(names)}, lower, upper)
+                          synthesized={name: synthesized[o] for o, name in enumerate(names)}, lower_residual=lower,
+                          upper_residual=upper)
