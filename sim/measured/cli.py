@@ -271,8 +271,9 @@ def update_command(args: argparse.Namespace) -> int:
         from sim.measured.update import model_frf
 
         name = next(iter(frf.frf))
-        written.append(draw_frf(args.plot, frf.frequencies_hz, {name: frf.frf[name]},
-                                {name: model_frf(result.model, frf.frequencies_hz)}, frf.coherence, "updated model"))
+        f = frf.frequencies_hz
+        written.append(draw_frf(args.plot, f, {name: frf.frf[name]}, {name: model_frf(result.model, f)}, frf.coherence,
+                                "updated model", (max(20.0, 4 * float(f[0])), 0.78 * float(f[-1]))))
     summary = {"E_Pa": result.E, "E_0_Pa": E0, "stiffness_scale": result.scale, "pairs": rows,
                "frequency_errors": result.errors, "frequencies_hz": result.model.frequencies_hz,
                "damping_ratios": result.model.damping_ratios, "note": result.note}

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.common.figure_style import legend_below
+from sim.common.figure_style import LEGEND_PT, legend_below
 from sim.common import files
 from sim.common.files import pyplot
 
@@ -69,7 +69,8 @@ def draw_frf(path: str | Path, frequencies_hz: np.ndarray, measured: dict[str, n
         axes[2].set_ylabel(r"coherence $\gamma^2$")
         axes[2].set_ylim(0, 1.05)
         axes[2].set_xlabel("frequency (Hz)")
-        legend_below(axes[2], ncols=2)
+        handles, labels = axes[0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="outside lower center", ncols=2, fontsize=LEGEND_PT, frameon=False)
         return files.save_figure(fig, path)
     finally:
         plt.close(fig)

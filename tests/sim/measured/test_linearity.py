@@ -65,3 +65,24 @@ def test_a_range_the_fit_cannot_reach_is_one_line():
         from sim.measured.linearity import NonlinearMode
 
         damping_interval(NonlinearMode(700.0, (0.0,), 1e-3, (0.0,), 1.0, 1e-3), 1e-3, 0.5e-3, (0.1e-3, 1e-3))
+
+
+def test_time_records_per_step_give_the_steady_amplitudes(tmp_path):
+    """A stepped sine recorded in time (base and tip accelerations, absolute): the fundamental harmonics of each step's
+    last periods give a_base and the tip's amplitude relative to the base."""
+    from sim.measured.linearity import read_level
+
+    fs, a_base, rows = 8192.0, 5e-7, []
+    for f in (116.0, 117.4, 118.0):
+        t = np.arange(int(fs * 0.5)) / fs + (len(rows) and rows[-1][0] + 1 / fs)
+        w = 2 * np.pi * f
+        relative = 2e-4 * f / 117.4 * np.cos(w * t - 0.3)  # the tip's motion relative to the base (m)
+        base_acc = -(w**2) * a_base * np.cos(w * t)
+        tip_acc = base_acc - w**2 * relative
+        rows += list(zip(t, np.full(t.size, f), base_acc, tip_acc))
+    path = tmp_path / "steps.csv"
+    path.write_text("time_s,frequency_Hz,base_m_s2,tip_m_s2\n" + "\n".join(",".join(repr(float(v)) for v in r)
+                                                                           for r in rows) + "\n")
+    level = read_level(path)
+    assert level.a_base == pytest.approx(a_base, rel=1e-3)
+    assert np.allclose(level.amplitude, 2e-4 * level.frequencies_hz / 117.4, rtol=1e-3)
