@@ -585,7 +585,7 @@ def overview_command(args: argparse.Namespace) -> int:
         data["dissipation"] = dissipation_key(data)
         written = write_results(folder, "overview", OVERVIEW_COLUMNS, overview_rows(data), data)
     return report(args, data, written, lambda path: plot_overview(data, path, overview_title(data)),
-                  overview_text(data))
+                  f"# {nominal_of(args, model).text()}\n{overview_text(data)}")
 
 
 # ---- ies trace ----------------------------------------------------------------------------------------------

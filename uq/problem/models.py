@@ -173,6 +173,14 @@ class IESModel:
         except SimulationInputError as exc:
             raise StudyError(f"[impactor] {exc}") from None
 
+    def normalisation(self) -> dict[str, Any]:
+        """What the outputs are normalised by (Sect. 5): `D_star` (the host's nominal D_1), `g_star_m`, the sentence
+        saying so, and the study's sphere (`sim.model.sphere.Sphere.describe`)."""
+        from sim.model.system import Nominal
+
+        nominal = Nominal.of(self._host(), self.g_star)
+        return {**nominal.describe(), "text": nominal.text(), "sphere": self.sphere().describe()}
+
     def _host(self) -> "ModalModel":
         """The host's modal model: the one this model carries, else built (`_rig`)."""
         return self.rig if self.rig is not None else self._rig()
