@@ -96,7 +96,7 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
     """`ies identify`: read, estimate, identify (all before writing), then write the outputs."""
     import numpy as np
 
-    from sim.common.files import dumps, report_written, write_csv
+    from sim.common.files import dumps, report_written, write_csv, write_text
     from sim.measured.figures import draw_frf, draw_stabilization
     from sim.measured.hammer import HammerSettings, frf_estimate
     from sim.measured.identification import Band, identify
@@ -120,6 +120,7 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
         if len(frfs) > 1:
             raise SimulationInputError(f"{args.files[1]}: give measured FRFs in one file (several responses as columns)")
         frequencies, frf, coherence, names = frfs[0].frequencies_hz, frfs[0].frf, frfs[0].coherence, list(frfs[0].frf)
+        decay = frfs[0].window_decay
         fs = 2 * float(frequencies[-1])  # the last line taken as the analyser's Nyquist frequency
     band = Band(*band_given) if band_given else Band(max(20.0, 4 * float(frequencies[0])),
                                                      min(0.78 * fs / 2, float(frequencies[-1])))
@@ -146,6 +147,9 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
         for n in names:
             data += [frf[n].real, frf[n].imag] + ([coherence[n]] if n in coherence else [])
         written.append(write_csv(folder / "frf.csv", columns, np.column_stack(data)))
+        if decay:  # the exponential window's decay rate, for a later `ies identify frf.csv` (sim.measured.records)
+            text = (folder / "frf.csv").read_text()
+            write_text(folder / "frf.csv", f"# window_decay_per_s = {float(decay)!r}\n" + text)
         d = result.diagram
         written.append(write_csv(folder / "poles.csv", list(POLES_CSV.names),
                                  zip(d.order, d.frequency_hz, d.damping_ratio, d.status)))
@@ -196,7 +200,8 @@ def add_update_arguments(parser: argparse.ArgumentParser) -> None:
                         help="largest relative frequency distance of a measured mode to its model mode (default 0.15)")
     parser.add_argument("--frf", metavar="frf.csv", help="with --plot: the measured FRF (identify's frf.csv) to compare")
     parser.add_argument("--plot", type=figure_file, metavar="FILE",
-                        help="Fig. A.1: the measured FRF against the updated model's, with the coherence (needs --frf)")
+                        help="Fig. A.1: the measured FRF against the updated model's (seen through the measurement's "
+                             "exponential window), with the coherence (needs --frf)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     add_host_arguments(parser)
 
@@ -272,7 +277,7 @@ def update_command(args: argparse.Namespace) -> int:
 
         name = next(iter(frf.frf))
         f = frf.frequencies_hz
-        written.append(draw_frf(args.plot, f, {name: frf.frf[name]}, {name: model_frf(result.model, f)}, frf.coherence,
+        written.append(draw_frf(args.plot, f, {name: frf.frf[name]}, {name: model_frf(result.model, f, frf.window_decay)}, frf.coherence,
                                 "updated model", (max(20.0, 4 * float(f[0])), 0.78 * float(f[-1]))))
     summary = {"E_Pa": result.E, "E_0_Pa": E0, "stiffness_scale": result.scale, "pairs": rows,
                "frequency_errors": result.errors, "frequencies_hz": result.model.frequencies_hz,

@@ -9,7 +9,9 @@ column and its unit, as ``name_unit``, ``name [unit]`` or ``name (unit)``:
   displacement (m, mm, um), e.g. ``time_s,force_N,accel_m_s2``. Uniform sampling.
 * FRFs: a frequency column (``frequency_Hz``; Hz) and per response either ``NAME_real_UNIT`` and ``NAME_imag_UNIT``
   or ``NAME_mag_UNIT`` and ``NAME_phase_deg`` (or ``_rad``), UNIT one of m_N, mm_N (receptance), m_s_N (mobility),
-  m_s2_N, g_N (accelerance); optionally ``NAME_coherence`` (-). ``ies identify``'s frf.csv is such a file.
+  m_s2_N, g_N (accelerance); optionally ``NAME_coherence`` (-) and a comment line ``# window_decay_per_s = X``, the
+  decay rate (1/s) an exponential window added to the poles, taken out again. ``ies identify``'s frf.csv is such a
+  file.
 
 UFF 58 (pyuff): function type 1 (time response) data sets make a time record, the force the one whose ordinate is a
 force (specific data type 13), the responses those of acceleration (12), velocity (11) or displacement (8); function
@@ -58,12 +60,14 @@ TO_DISPLACEMENT = {"acceleration": -2, "velocity": -1, "displacement": 0}
 @dataclass(frozen=True)
 class MeasuredFrf:
     """Measured FRFs of displacement per force (m/N): frequencies_hz (Hz, increasing), frf[name] (complex) and the
-    coherence[name] (-) where the file has it; source: the file."""
+    coherence[name] (-) where the file has it; source: the file; window_decay (1/s): the decay rate an exponential
+    window added to every pole (a comment line ``# window_decay_per_s = X`` of the CSV, as `ies identify` writes it)."""
 
     frequencies_hz: np.ndarray
     frf: dict[str, np.ndarray]
     coherence: dict[str, np.ndarray]
     source: str
+    window_decay: float = 0.0
 
 
 def _split_header(name: str) -> tuple[str, str]:
@@ -223,7 +227,23 @@ def read_frf_csv(path: str | os.PathLike) -> MeasuredFrf:
         positive = omega > 0
         frf[name] = value[positive] * factor * (1j * omega[positive]) ** TO_DISPLACEMENT[quantity]
     positive = omega > 0
-    return MeasuredFrf(f[positive], frf, {k: v[positive] for k, v in coherence.items() if k in frf}, str(path))
+    return MeasuredFrf(f[positive], frf, {k: v[positive] for k, v in coherence.items() if k in frf}, str(path),
+                       _window_decay(path))
+
+
+def _window_decay(path: Path) -> float:
+    """The ``# window_decay_per_s = X`` comment of an FRF CSV (0 without one)."""
+    for line in read_text(path, "FRF file", "CSV").splitlines():
+        match = re.fullmatch(r"#\s*window_decay_per_s\s*=\s*(\S+)\s*", line.strip())
+        if match:
+            try:
+                value = float(match.group(1))
+            except ValueError:
+                value = -1.0
+            if not (value >= 0 and np.isfinite(value)):
+                raise SimulationInputError(f"{path}: window_decay_per_s = {match.group(1)!r} must be a number >= 0 (1/s)")
+            return value
+    return 0.0
 
 
 def _uff_sets(path: Path) -> list[dict]:

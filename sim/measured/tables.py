@@ -13,7 +13,8 @@ MODES_CSV = OutputFile("modes.csv", "ies identify", "One row per identified mode
                                   "displacement per force; phi_response phi_drive of the mass-normalised mode, LSFD)"),
                        ))
 FRF_CSV = OutputFile("frf.csv", "ies identify", "The measured FRF of displacement per force (H_v, H_1 or H_2: "
-                     "`--estimator`), one row per frequency line; `ies identify frf.csv` reads it back.", (
+                     "`--estimator`), one row per frequency line, after a comment line `# window_decay_per_s = X` "
+                     "(1/s: the exponential window's added decay rate); `ies identify frf.csv` reads it back.", (
                          Column("frequency_Hz", "Hz", "frequency line"),
                          Column("<NAME>_real_m_N, <NAME>_imag_m_N", "SI", "real and imaginary part of the response's "
                                 "displacement per force (m/N)"),

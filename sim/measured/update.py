@@ -157,9 +157,11 @@ def update_model(model: ModalModel, measured: MeasuredModes, *, fit_mode: int | 
                   measured_mask, note)
 
 
-def model_frf(model: ModalModel, frequencies_hz: np.ndarray) -> np.ndarray:
+def model_frf(model: ModalModel, frequencies_hz: np.ndarray, window_decay: float = 0.0) -> np.ndarray:
     """Displacement per force at the tip of a tip hit (m/N) of a modal model: sum_j phi_tip,j^2 /
-    (omega_j^2 - omega^2 + 2 i D_j omega_j omega) (Eq. 7 driven at the measurement point)."""
+    (omega_j^2 - omega^2 + 2 i D_j omega_j omega) (Eq. 7 driven at the measurement point); with window_decay (1/s) as
+    a measurement through an exponential window sees it (each D_j omega_j raised by window_decay)."""
     w = 2 * np.pi * np.asarray(frequencies_hz, float)[:, None]
     wj = model.omega[None, :]
-    return np.sum(model.phi_tip[None, :] ** 2 / (wj**2 - w**2 + 2j * model.damping_ratios[None, :] * wj * w), axis=1)
+    sigma = model.damping_ratios[None, :] * wj + window_decay
+    return np.sum(model.phi_tip[None, :] ** 2 / (wj**2 - w**2 + 2j * sigma * w), axis=1)

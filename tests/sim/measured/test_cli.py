@@ -82,6 +82,7 @@ def test_identify_json(walked, capsys):
     data = json.loads(capsys.readouterr().out)
     assert len(data["frequencies_hz"]) == len(data["damping_ratios"]) == 4
     assert data["frequencies_hz"][0] == pytest.approx(117.4, rel=5e-4)
+    assert data["damping_ratios"][0] == pytest.approx(0.0006, rel=0.1)  # the window's damping known from frf.csv
 
 
 def refused(capsys, code: int, *phrases: str) -> str:
