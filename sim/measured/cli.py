@@ -153,7 +153,7 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
         d = result.diagram
         written.append(write_csv(folder / "poles.csv", list(POLES_CSV.names),
                                  zip(d.order, d.frequency_hz, d.damping_ratio, d.status)))
-        written.append(write_csv_json(folder / "identification.json", summary))
+        written.append(write_json(folder / "identification.json", summary))
         magnitude = np.sum(np.abs(matrix), axis=0)
         written.append(draw_stabilization(folder / "stabilization.png", result, magnitude))
         written.append(draw_frf(folder / "frf.png", frequencies, {n: frf[n] for n in names}, result.synthesized,
@@ -173,7 +173,7 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
     return 0
 
 
-def write_csv_json(path: Path, data: dict) -> Path:
+def write_json(path: Path, data: dict) -> Path:
     """One JSON object written atomically."""
     from sim.common.files import dumps, write_text
 
@@ -391,7 +391,7 @@ def linearity_command(args: argparse.Namespace, output_folder: Callable[..., Any
                              [[lv.a_base, h.frequency_hz, h.damping_ratio, h.peak_amplitude] for lv, h in zip(levels, halves)]),
                    write_csv(folder / "backbone.csv", list(BACKBONE_CSV.names),
                              zip(amp, mode.omega(amp) / (2 * np.pi), mode.damping(amp))),
-                   write_csv_json(folder / "linearity.json", summary),
+                   write_json(folder / "linearity.json", summary),
                    draw_linearity(folder / "linearity.png", levels, mode, halves, interval)]
         if updated is not None:
             provenance = load_provenance(args.model)

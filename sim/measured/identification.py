@@ -134,14 +134,12 @@ def _toeplitz_sums(frequencies_hz: np.ndarray, frfs: np.ndarray, band: Band, max
     power = np.ones_like(z)
     wH = weight2 * H
     wHH = weight2 * np.abs(H) ** 2
-    conj_z = np.conj(z)
     for m in range(n + 1):  # z^m for m >= 0; the negative powers are the conjugates (|z| = 1)
         r[:, m] = weight2 @ power
         t[:, m] = wHH @ power
         s[:, n + m] = -(wH @ power)
         s[:, n - m] = -(wH @ np.conj(power))
         power = power * z
-    del conj_z
     return r, s, t, omega_c, T
 
 

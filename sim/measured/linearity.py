@@ -11,7 +11,8 @@ Records (CSV, one file per level; units in the header as in `sim.measured.record
 * or time records per frequency step: ``time_s``, ``frequency_Hz`` (the step's excitation frequency on every sample),
   the base's and the tip's absolute motion ``base_UNIT``, ``tip_UNIT`` (acceleration, velocity or displacement). Of
   each step the last STEADY_SHARE of its whole periods is used: the fundamental Fourier coefficients give a_base and
-  the tip's amplitude relative to the base.
+  the tip's amplitude relative to the base; a step whose base amplitude strays from the level's mean (the shaker's
+  control) has its tip amplitude scaled to that mean, as a linear response would be.
 
 Half-power damping: the peak of a / a_base (a parabola through the three highest points), the half-power frequencies
 where (a / a_base)^2 falls to half the peak (linear interpolation), D = (f_2 - f_1) / (2 f_r).
