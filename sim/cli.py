@@ -8,6 +8,8 @@
 * `ies trace`: time histories of one stepped-sine point, like Figs. 4 and 9a (Sects. 5.1, 5.5; `sim.analysis.trace`).
 * `ies orbits`: the periodic orbits with their stability and bifurcations (`sim.orbits`).
 * `ies impacts`, `ies modal-fit`: the analyses of measured or simulated signals (`sim.analysis.cli`).
+* `ies identify`, `ies update`, `ies linearity`, `ies synthetic-tests`: the host as measured, hammer and shaker tests
+  to its modes, its updated model and its damping interval (Appendices A, B; `sim.measured.cli`).
 * `ies cache`: where the compiled kernels are cached, how big the cache is, and emptying it (`sim.common.kernel_cache`).
 
 `add_commands(subparsers)` (at the end) registers them with the front door (`uq.cli`), which only dispatches. Heavy
@@ -24,6 +26,7 @@ from pathlib import Path
 from typing import Any, Iterator, Sequence
 
 from sim.analysis import cli as signal_cli
+from sim.measured import cli as measured_cli
 from sim.common.errors import SimulationInputError
 from sim.common.options import figure_file, positive_int
 
@@ -779,12 +782,13 @@ COMMANDS = (("modes", MODES_HELP, add_modes_arguments, modes_command),
             ("orbits", ORBITS_HELP, add_orbits_arguments, orbits_command),
             ("impacts", signal_cli.IMPACTS_HELP, signal_cli.add_impacts_arguments, signal_cli.impacts_command),
             ("modal-fit", signal_cli.MODAL_FIT_HELP, signal_cli.add_modal_fit_arguments, signal_cli.modal_fit_command),
-            ("cache", CACHE_HELP, add_cache_arguments, cache_command))
+            ("cache", CACHE_HELP, add_cache_arguments, cache_command),
+            *measured_cli.commands(output_folder))
 
 
 def add_commands(subparsers: Any) -> None:
-    """Register `modes`, `sweep`, `overview`, `trace`, `orbits`, `impacts`, `modal-fit` and `cache` (COMMANDS) on the
-    front door's subparsers (argparse)."""
+    """Register `modes`, `sweep`, `overview`, `trace`, `orbits`, `impacts`, `modal-fit`, `cache` and the measured host's
+    `identify`, `update`, `linearity`, `synthetic-tests` (COMMANDS) on the front door's subparsers (argparse)."""
     for name, help_text, add_arguments, run in COMMANDS:
         parser = subparsers.add_parser(name, help=help_text, description=help_text)
         add_arguments(parser)
