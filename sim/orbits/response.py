@@ -10,13 +10,17 @@ What is computed (`orbit_response`):
    the linear orbit (only where the walls do not reach the sphere).
 2. The start's branch, continued both ways over the range (once when it closes on itself).
 3. Branch switching at every located symmetry-breaking and period-doubling point of every branch (period multiple
-   at most `max_period`; at most `switches` switchings when given, those with the fewest unstable multipliers
-   first: the ones nearest to a stable orbit), the new branches continued with detection too and switched in turn;
-   a point that a switched branch has already come back through is not switched again (the same asymmetric pair).
+   at most `max_period`; at most `switches` switchings when given), the new branches continued with detection too
+   and switched in turn, each up to where it comes back through its parent or runs onto a known branch; a point
+   whose new branch is already there (`sim.orbits.searches.known`, or a switched branch came back through it) is
+   not switched again.
 4. At every change of stability of every branch, a direct simulation from the perturbed orbit on its unstable side
    and Newton's method from its end state for a kT orbit, k <= max_period (`sim.orbits.searches`): what it finds
-   that no branch has is continued both ways as a branch of its own (and switched and searched from in turn). At
-   most MAX_BRANCHES branches in all; what is left undone is said in `notes`.
+   that no branch has is continued both ways as a branch of its own, up to where it runs onto a known one (and
+   switched and searched from in turn).
+   Steps 3 and 4 are one list of tasks, the searches first, then the switchings by their point's unstable multipliers
+   (nearest to a stable orbit first), within GROWTH_RUNS map runs and MAX_BRANCHES branches: deterministic work, so
+   that one level stays within its 30 s on the rig; what is left undone is said in `notes`.
 5. The linear orbits (no impact, the sphere at rest where the walls do not reach it) on LINEAR_POINTS values of
    the range where they exist: they are unstable in the frictionless model (a sphere given any speed drifts into
    a wall: the multiplier 1 of its free flight is a Jordan block), but they are the response a sphere at rest
