@@ -548,7 +548,7 @@ def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
 def sweep_command(args: argparse.Namespace) -> int:
     """`ies sweep`: one stepped-sine frequency response (Sects. 5.1, 5.2; Fig. 5)."""
     from sim.plots.figures import plot_sweep, sweep_title
-    from sim.stepped_sine.tables import SWEEP_COLUMNS, sweep_rows
+    from sim.stepped_sine.tables import sweep_columns, sweep_rows
 
     started = time.perf_counter()
     with simulation(args, [args.level], label="sweep") as (folder, protocol, model, impactor, (result,)):
@@ -556,7 +556,7 @@ def sweep_command(args: argparse.Namespace) -> int:
         data = result.to_dict()
         data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps,
                     **system_data(model, impactor, nominal))
-        written = write_results(folder, "sweep", SWEEP_COLUMNS, sweep_rows(result), data)
+        written = write_results(folder, "sweep", sweep_columns(result), sweep_rows(result), data)
     lines = [f"# a_base/a_base* = {result.level:g}: {result.n_runs} runs, {result.n_samples} samples, "
              f"{protocol.integrator}, {data['wall_time_s']:.1f} s",
              f"# {nominal.text()}; a_base = {result.a_base * 1e6:.4g} um",
