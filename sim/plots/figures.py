@@ -113,6 +113,10 @@ def draw_sweep(ax: Any, data: Mapping[str, Any], title: str) -> None:
     ax.fill_between(eta, data["mean_lo"], data["mean_hi"], color="C0", alpha=0.3, lw=0, hatch="////",
                     label="mean: range of the runs")
     ax.plot(eta, data["mean"], "-", color="C0", label="mean")
+    if data.get("dynamics"):  # ies sweep --lyapunov: periodic / quasi-periodic / chaotic on the mean
+        from sim.plots.dynamics import draw_dynamics
+
+        draw_dynamics(ax, eta, data["mean"], data["dynamics"])
     ax.set_xlabel(ETA_LABEL)
     ax.set_ylabel(RESPONSE_LABEL)
     ax.set_title(title, fontsize=9)
