@@ -62,7 +62,7 @@ def pattern(expected: list[str]) -> str:
 
 def test_the_readme_has_the_examples_that_are_checked():
     commands = [c for c, _ in EXAMPLES]
-    assert commands[:3] == ["ies calibrate", "ies calibrate --flat", "ies modes"]
+    assert commands[:2] == ["ies calibrate", "ies modes"]
     assert [c for c in commands if c.startswith("ies sweep")] == [
         "ies sweep --level 7.4 --eta 0.97:0.99:6 --reps 2 --out res --plot fig5.png"]
     assert all(expected for _, expected in EXAMPLES)

@@ -1,34 +1,11 @@
 """Modal-model files: bring the modes of the host structure from any FE tool (seed paper Eq. 7).
 
-Format (TOML, UTF-8). Arrays have one value per retained mode, in ascending frequency order:
-
-    format = "ies-modal-model"       # optional, but if present it must be this
-    version = 1                      # optional, 1
-    source = "CalculiX job beam.inp" # optional free text
-    frequencies_hz = [117.4, 886.0]  # natural frequencies f_j = omega_j / (2 pi), Hz, strictly ascending
-    damping_ratios = [0.00085, 0.0044]  # modal damping ratios D_j, in (0, 1) (0.001 = 0.1 %)
-    phi_wall_left  = [1.376, 1.390]  # mass-normalised x-value of mode j at the left cavity wall, 1/sqrt(kg)
-    phi_wall_right = [1.376, 1.390]  # same at the right cavity wall, 1/sqrt(kg)
-    phi_tip        = [1.324, 1.194]  # same at the measurement point (response output), 1/sqrt(kg)
-    participation  = [1.106, -0.553] # phi_j^T M b, b = unit x-translation of the base, sqrt(kg)
-    beam_mass_kg   = 1.573           # optional: mass of the beam's free length without the block, kg (Eq. 10)
-    phi_floor      = [1.380, 1.267]  # optional: same at the cavity floor on the beam axis, 1/sqrt(kg) (App. C)
-
-    [host]                           # optional: what the host is besides its modes
-    damping_interval = [0.00075, 0.0009]  # the interval of D_1 (-) the studies and `ies design` propagate; it must
-                                     # contain damping_ratios[0] (Table 2 for the seed rig; `ies linearity` measures it)
-    wall_material = "steel"          # the cavity walls' material for Eq. 8: steel (default), aluminium, titanium,
-                                     # brass, cast-iron, or your own "E=70GPa,nu=0.33" (or wall_E_Pa and wall_nu)
-
-    [units]                          # optional; if present each entry must name the unit above
-    frequencies_hz = "Hz"
-    damping_ratios = "1"
-    phi = "1/sqrt(kg)"
-    participation = "sqrt(kg)"
-
-    [provenance]                     # optional, free-form: how the modes were made (written by sim.hosts.solid and
-    model = "3D solid ..."           # sim.hosts.calculix: geometry, material, mesh, DOF count, solve time, and a
-    [provenance.convergence]         # mesh-convergence table); readers ignore it
+Format (TOML, UTF-8): README.md, section "Your own structure", the one description for users (arrays of one value per
+retained mode in ascending frequency order: frequencies_hz, damping_ratios, phi_wall_left, phi_wall_right, phi_tip,
+participation; optional beam_mass_kg, phi_floor; an optional [host] table with damping_interval and wall_material, or
+wall_E_Pa and wall_nu; optional [units] naming the units, "Hz", "1", "1/sqrt(kg)", "sqrt(kg)", and a free-form
+[provenance] table, written by sim.hosts.solid and sim.hosts.calculix, that readers ignore). `format =
+"ies-modal-model"`, `version = 1` and `source` are optional.
 
 The optional keys are needed only by the damped contact law (beam_mass_kg) and by friction (phi_floor);
 files without them load as before, and those laws then refuse the model with one line naming the key. Without a

@@ -14,9 +14,11 @@ design's seed; its optimum is the clearance with the lowest worst case. Then the
 again with two other seeds: the spread of a 3-repetition worst case (the response is chaotic: the same runs agree to
 the last bit, other seeds moved it by up to 8 % in the measured run).
 
-Checks: the recommendation within one grid step of the brute-force optimum and the same for both --candidates; its
-reported worst case within 5 % of the brute force's at the same clearance; its margin to the switch reported (at least
-the 20 % asked) with the excitation at which it switches.
+Checks: the recommendation within one grid step of the brute-force optimum and the same for both --candidates; the
+brute force's worst case at the same clearance inside the recommendation's 95 % interval (`worst_interval_m`: the
+design's worst case rests on more repetitions at its deciding cells than the brute force's 3, so the two agree within
+the noise, not to the last bit); its margin to the switch reported (at least the 20 % asked) with the excitation at
+which it switches.
 
 Run: pytest -m benchmark tests/benchmarks/test_design_brute_force.py -s   (1,296 brute-force runs and two designs)
 """
@@ -35,7 +37,6 @@ CLEARANCES = "0.4mm:1.8mm:8"
 EXCITATION = "1.2um:6um:6"
 RADIUS = "6.3mm"
 OTHER_SEEDS = (7, 11)
-TOLERANCE = 0.05
 
 
 def design_arguments(model_file):
@@ -57,14 +58,12 @@ def run_design(argv, out):
 
 def _runs(model, problem, g, point, a_base, reps, seed):
     """The resonant mean tip amplitude (m) of each repetition of one (clearance, box point, level)."""
-    from dataclasses import replace
-
     from sim.model.system import Impactor
     from sim.stepped_sine.protocol import SteppedSine, aggregate_runs, run_sweep
     from sim.model.system import a_base_star
 
     D, tolerance, factor = point
-    sphere = replace(problem.grid()[0], clearance=g)
+    sphere = problem.grid()[0].moved("clearance", g)
     impactor = Impactor(mass=sphere.mass, clearance=g + tolerance, k_H=factor * sphere.k_H)
     protocol = SteppedSine(**dict(problem.protocol))
     level = a_base / a_base_star(model)
@@ -123,11 +122,13 @@ def test_the_recommendation_matches_brute_force_on_an_unseen_host(tmp_path):
         best = data["recommendation"]
         g = best["clearance_m"]
         match = min(grid, key=lambda x: abs(x - g))
-        print(f"--candidates {candidates}: {g * 1e3:.2f} mm, worst case {best['worst_m'] * 1e3:.4f} mm (brute force "
-              f"{worst[match] * 1e3:.4f} mm, {best['worst_m'] / worst[match] - 1:+.1%}), margin {best['margin_worst']:.0%}"
+        low, high = best["worst_interval_m"]
+        print(f"--candidates {candidates}: {g * 1e3:.2f} mm, worst case {best['worst_m'] * 1e3:.4f} mm, 95 % interval "
+              f"{low * 1e3:.4f}-{high * 1e3:.4f} (brute force {worst[match] * 1e3:.4f} mm, "
+              f"{best['worst_m'] / worst[match] - 1:+.1%}), margin {best['margin_worst']:.0%}"
               f" (switch at {best['switch_worst_m'] * 1e6:.2f} um, {best['switch_kind']})")
         assert abs(g - optimum) <= step * (1 + 1e-9)
-        assert best["worst_m"] == pytest.approx(worst[match], rel=TOLERANCE)
+        assert low <= worst[match] <= high
         assert best["margin_worst"] >= 0.2 and best["switch_worst_m"] > 0 and best["admissible"]
     assert runs[1]["recommendation"]["clearance_m"] == runs[8]["recommendation"]["clearance_m"]
     from dataclasses import replace

@@ -27,8 +27,13 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"clearances to consider (default 0.3mm:1.2mm:10); also {', '.join(flags[1:])} (the "
                              "same quantity as in ies sweep)")
     parser.add_argument("--radius", metavar="RANGE", help="sphere radii (default the paper's 7.92mm)")
-    parser.add_argument("--material", metavar="LIST", help="sphere materials, comma separated: brass, steel, tungsten "
-                                                           "(default brass)")
+    parser.add_argument("--material", metavar="LIST", help="sphere materials, comma separated: brass, steel, tungsten, "
+                                                           "or your own E=200GPa,nu=0.29,density=7850kg/m3 (default brass)")
+    from sim.model.materials import WALL_MATERIALS
+
+    parser.add_argument("--wall-material", metavar="NAME",
+                        help=f"the cavity walls' material for Eq. 8's k_H*: {', '.join(WALL_MATERIALS)}, or your own "
+                             "E=70GPa,nu=0.33 (default: the host's [host] wall_material, else steel)")
     parser.add_argument("--model", metavar="FILE", help="the host as a modal-model file (default: the built-in rig)")
     from uq.design.objectives import OBJECTIVES
 
@@ -40,11 +45,15 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
                         help="the margin a design's switch to the almost periodic response must keep above the top of "
                              "--excitation at every corner of the box, as a fraction in (0, 1] (default 0.2: 20 %%)")
     D, g, k_H = (PARAMETERS[name].spread for name in ("D", "g", "k_H"))  # Table 2's intervals (the one vocabulary)
-    parser.add_argument("--damping", metavar="LOW:HIGH", help=f"interval of D_1 (default Table 2: {D.low:g}:{D.high:g})")
+    parser.add_argument("--damping", metavar="LOW:HIGH",
+                        help="interval of D_1, containing the host's nominal D_1* (default: the host's [host] "
+                             f"damping_interval, else Table 2's relative interval around its D_1*; the rig: "
+                             f"{D.low:g}:{D.high:g})")
     parser.add_argument("--clearance-tolerance", metavar="LOW:HIGH",
                         help=f"tolerance added to each clearance (default Table 2: {g.low * 1e3:g}:{g.high * 1e3:g}mm)")
     parser.add_argument("--k-H-factor", metavar="LOW:HIGH",
-                        help=f"factor on Eq. 8's k_H (default Table 2: {k_H.low:g}:{k_H.high:.4g})")
+                        help=f"factor on Eq. 8's k_H* of each sphere on the walls (default Table 2: "
+                             f"{k_H.low:g}:{k_H.high:.4g})")
     parser.add_argument("--calibration", metavar="FILE",
                         help="`ies calibrate --json` output: its k_H / k_H* becomes the upper end of the k_H factor "
                              "(the crater's stiffening, as `ies reproduce` uses it)")
@@ -73,7 +82,10 @@ def design_problem(args: argparse.Namespace) -> tuple[Any, Path, Any]:
 
 
 def design_command(args: argparse.Namespace) -> int:
-    """`ies design`: screen, verify and recommend (uq.design)."""
+    """`ies design`: screen, verify and recommend (uq.design); exit 3 with the verified designs written (all marked not
+    admissible) when none keeps the margin."""
+    import sys
+
     from uq.design.results import design_table
     from uq.design.search import run_design
 
@@ -83,4 +95,7 @@ def design_command(args: argparse.Namespace) -> int:
                             progress=not args.quiet, figures=not args.no_figures, client=client)
     print(design_table(result))
     print_files(result.folder, result.files)
+    if result.refusal is not None:
+        sys.stderr.write(f"ies design: no admissible design: {result.refusal}\n")
+        return 3
     return 0

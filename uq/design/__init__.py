@@ -1,8 +1,15 @@
 """Design of an IES for a user's structure under uncertainty (`ies design`): which clearance g and which sphere
 (radius R, material) keep the objective (`uq.design.objectives`; by default the resonant tip amplitude) lowest over
-an operating range of base excitation, in the worst case over the uncertain D_1, clearance tolerance and k_H factor
-(Table 2's intervals by default), while the switch from strongly modulated to almost periodic response stays a
-margin above the top of that range at every corner of the box.
+an operating range of base excitation, in the worst case over the uncertain D_1, clearance tolerance and k_H factor,
+while the switch from strongly modulated to almost periodic response stays a margin above the top of that range at
+every corner of the box.
+
+The host decides the box and the contact (`uq.design.problem.problem_of`): D_1's interval is the host's own
+(`ModalModel.damping_box`: its [host] damping_interval, else Table 2's relative interval around its nominal D_1*,
+said so in the output) unless `--damping`; every sphere's k_H* is Eq. 8 with both bodies' E and nu on the host's wall
+material (`--wall-material` to override), through `sim.model.sphere`, so that `ies sweep --radius --material
+--wall-material` simulates the same sphere; levels and a / a_noabs* are normalised by the host's D_1* and the
+structure without IES is drawn at it.
 
 Why the margin. An IES works best just below that switch (Sect. 5.3: the optimum at a_base/a_base* ~ 6.7 lies at the
 switch): below it the response is strongly modulated and low, above it the amplitude jumps several-fold onto the
@@ -31,8 +38,15 @@ Method, in three stages (`uq.design.search`):
 
 A design is admissible when its margin at the box's worst corner (predicted, or lower where a verified run was almost
 periodic) is at least `--margin` and no verified run of its box is almost periodic: never on the steep side of a
-switch anywhere in the box. The recommendation is the admissible verified design with the lowest verified worst
-case; a range where none is admissible is one line naming the best margin found.
+switch anywhere in the box. A level counts as almost periodic at a box point when any one of its runs is (not most
+of them: the conservative rule, `uq.design.results.APR_RULE`), at or above the point's first impacts. The
+recommendation is the admissible verified design with the lowest verified worst case, which comes with the 95 %
+interval of a repeat of its verification (`uq.design.uncertainty`); where the runner-up's interval overlaps it, both
+gain repetitions at the cells deciding them until the intervals part or 5x the repetitions are spent
+(`uq.design.search.settle`), and the result says which. Refusals: where the similarity law predicts no design keeping
+the margin, one line with the best predicted margins before any verification (exit 2); where no verified design is
+admissible, design.csv and design.json hold every verified design marked not admissible (exit 3); both say how many
+designs fit the block and which --block-width takes the grid.
 
 The objective of a design is the worst case over the operating levels and the box's corners and centre of the
 objective's value per run (the mean over a period's amplitudes at the resonant frequency, Sect. 5.3, for

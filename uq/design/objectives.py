@@ -42,7 +42,15 @@ class Objective:
     screened: Callable[[np.ndarray, float], np.ndarray]
 
     def describe(self) -> dict[str, str]:
-        return {"name": self.name, "quantity": self.quantity, "statistic": self.statistic, "unit": self.unit}
+        return {"name": self.name, "quantity": self.quantity, "statistic": self.statistic, "unit": self.unit,
+                "key_suffix": self.suffix}
+
+    @property
+    def suffix(self) -> str:
+        """The unit's suffix of the output keys holding this objective's values: `_m` for an amplitude (`worst_m`),
+        `_m_per_s2` for m/s^2 (`worst_m_per_s2`): one name per quantity, its unit in the name."""
+        text = self.unit.replace("^", "").replace("/", "_per_").replace(" ", "")
+        return "_" + text if text not in ("", "-", "1") else ""
 
     def shown(self, value: float) -> str:
         """`value` (SI) in the printed unit, 3 significant digits."""

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from uq.design.objectives import Objective
-from uq.design.problem import DesignProblem, Sphere
+from uq.design.problem import DesignProblem, Design
 
 #: adjacent reference kappas at most this factor apart (the switch moves about one level per factor 2 on the rig)
 KAPPA_RATIO = 2.5
@@ -51,7 +51,7 @@ class Corner:
         return f"D_1 {self.D:g}, g + {self.tolerance * 1e3:.3g} mm, k_H x{self.k_H_factor:.3g}"
 
 
-def corner_of(point: Mapping[str, float], sphere: Sphere) -> Corner:
+def corner_of(point: Mapping[str, float], sphere: Design) -> Corner:
     """A box point's task parameters (`DesignProblem.corners`: D, g, k_H in SI) as a Corner of `sphere`."""
     tolerance = round(float(point["g"]) - sphere.clearance, 12)  # to the picometre: no -1e-19 m from the subtraction
     return Corner(float(point["D"]), tolerance + 0.0, float(point["k_H"]) / sphere.k_H)
@@ -66,7 +66,7 @@ class DesignPrediction:
     (m): at the box's centre; *_kind: "found", "above" (no switch up to it: a lower bound) or "below" (an upper bound);
     jump: the objective (SI) just below and just above the switch at the worst corner (NaN without one)."""
 
-    sphere: Sphere
+    design: Design
     per_level: np.ndarray
     switch_worst: float
     switch_worst_kind: str
@@ -104,7 +104,7 @@ class Predictor:
 
         self.problem, self.objective, self.rig, self._run = problem, objective, rig, run
         self.laws: dict[tuple[float, str], SphereLaw] = {}
-        self._predicted: dict[Sphere, DesignPrediction] = {}  # a law never changes once built
+        self._predicted: dict[Design, DesignPrediction] = {}  # a law never changes once built
         self._a_star = lambda g: a_base_star(rig, Nominal.of(rig, g))  # a_base*(g) (m), Sect. 5.3 with g* -> g
         self._a_star_nominal = a_base_star(rig)
 
@@ -115,13 +115,13 @@ class Predictor:
     def reps(self) -> int:
         return min(REFERENCE_REPS, self.problem.repetitions)
 
-    def plan(self, sphere: Sphere) -> tuple[list[tuple[float, float]], list[tuple[float, float, float]], list[float]]:
+    def plan(self, sphere: Design) -> tuple[list[tuple[float, float]], list[tuple[float, float, float]], list[float]]:
         """The references (kappa, D), their realisations (g, k_H, D) and the own levels of the law of `sphere`'s radius
         and material (its clearance does not matter)."""
         from sim.reduced.similarity import kappa, own_levels, reference_kappas
 
         p = self.problem
-        gs = [g for g in p.clearances if p.fits(Sphere(g, sphere.radius, sphere.material))] or list(p.clearances)
+        gs = [g for g in p.clearances if p.fits(sphere.moved("clearance", g))] or list(p.clearances)
         t_lo, t_hi = min(p.clearance_tolerance), max(p.clearance_tolerance)
         f_lo, f_hi = min(p.k_H_factor), max(p.k_H_factor)
         k_lo, k_hi = kappa(f_lo * sphere.k_H, min(gs) + t_lo), kappa(f_hi * sphere.k_H, max(gs) + t_hi)
@@ -140,7 +140,7 @@ class Predictor:
         high = min(max(high, low), LEVEL_CEILING)
         return references, realisations, own_levels(low, high, LEVEL_RATIO)
 
-    def ensure(self, spheres: Sequence[Sphere]) -> None:
+    def ensure(self, spheres: Sequence[Design]) -> None:
         """Build the law of every sphere (radius, material) among `spheres` that has none yet."""
         from sim.reduced.similarity import reference_curves
 
@@ -156,6 +156,11 @@ class Predictor:
 
     def _evaluator(self, realisations: Sequence[tuple[float, float, float]], mass: float,
                    counted: list[int]) -> Callable[[list[tuple[int, float]]], list[Any]]:
+        """The references' outcomes at own levels: the share of almost periodic runs and the objective per a_noabs*.
+        Below a reference's first impacts, own level D_1 / D_1* (Eq. 7, mode 1: the linear wall amplitude at resonance
+        reaches g at a_base = 2 D_1 g / (phi_c phi^T M b), a_base*(g) at D_1*), the response is linear and its almost
+        periodic label (a cv below 0.1) means nothing: it counts as no switch, as in `Verified.apr_seen_at` (a
+        reference of the rig at own level 0.51 had one such run, and the law put the switch there)."""
         from sim.reduced.similarity import Outcome
         from uq.problem.tasks import Task
 
@@ -173,7 +178,9 @@ class Predictor:
             out = []
             for request in batch:
                 runs = [records[t] for t in tasks[request]]
-                apr = [r["outputs"].get("apr", 0.0) for r in runs if not r.get("error")]
+                i, own = request
+                linear = own < realisations[i][2] / self.rig.D_star  # below its first impacts (`onset_own_level`)
+                apr = [0.0 if linear else r["outputs"].get("apr", 0.0) for r in runs if not r.get("error")]
                 values = [self.objective.of_run(r, omega_1) / r["trace"]["a_noabs"] for r in runs
                           if not r.get("error") and "trace" in r]
                 values = [v for v in values if math.isfinite(v)]
@@ -182,7 +189,7 @@ class Predictor:
 
         return evaluate
 
-    def predict(self, sphere: Sphere) -> DesignPrediction | None:
+    def predict(self, sphere: Design) -> DesignPrediction | None:
         """The prediction for one design (None when its sphere has no law yet)."""
         from sim.model.system import a_noabs_star
         from sim.reduced.similarity import kappa

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from sim.model.materials import STEEL_WALL, Material, material
 from sim.model.parameters import PARAMETERS, UncertainParameter, boxed_parameters
 from uq.errors import StudyError
 
@@ -53,37 +54,50 @@ MAX_SCREENED = 2_000_000
 
 
 @dataclass(frozen=True)
-class Sphere:
-    """One design: clearance g (m), sphere radius (m) and material name (`sim.model.materials`)."""
+class Design:
+    """One design: clearance g (m) and the sphere, its radius (m) and material name (`sim.model.materials`), striking
+    walls of `wall` (`sim.model.materials.Material`, the host's; the same for every design of a problem, so it takes no
+    part in comparing designs). Its mass and k_H* come from `sim.model.sphere` (the paper's sphere on steel keeps
+    Tables 1-2's 17.7 g and 282e3 N/mm^1.5, any other the solid sphere's mass and Eq. 8 with both bodies' E and nu), so
+    that `ies sweep --radius R --material M --wall-material W` simulates the same sphere."""
 
     clearance: float
     radius: float
     material: str
+    wall: Material = field(default=STEEL_WALL, compare=False)
+
+    @property
+    def sphere(self) -> Any:
+        """The sphere (`sim.model.sphere.Design`) on this design's walls."""
+        from sim.model.sphere import sphere_of
+
+        return sphere_of(self.radius, material(self.material), wall=self.wall)
 
     @property
     def mass(self) -> float:
-        """m_a (kg) from the radius and the material's density."""
-        from sim.model.materials import material, sphere_mass
-
-        return sphere_mass(self.radius, material(self.material))
+        """m_a (kg) of the sphere (`sim.model.sphere.Design.mass`)."""
+        return self.sphere.mass
 
     @property
     def k_H(self) -> float:
-        """k_H (N/m^1.5) of Eq. 8 against the host's steel wall."""
-        from sim.model.materials import hertz_constant, material
-
-        return hertz_constant(self.radius, material(self.material))
+        """k_H* (N/m^1.5) of Eq. 8, the sphere on the host's wall (`sim.model.sphere.Design.k_H_star`)."""
+        return self.sphere.k_H_star
 
     def cavity(self) -> float:
         """The cavity's width 2R + 2g (m)."""
         return 2.0 * (self.radius + self.clearance)
+
+    def moved(self, axis: str, value: Any) -> "Design":
+        """This design with one of clearance, radius or material changed."""
+        return dataclasses.replace(self, **{axis: value})
 
     def label(self) -> str:
         return f"g {self.clearance * 1e3:.3f} mm, {self.material} R {self.radius * 1e3:.2f} mm"
 
     def describe(self) -> dict[str, Any]:
         return {"clearance_m": self.clearance, "radius_m": self.radius, "material": self.material,
-                "mass_kg": self.mass, "k_H_N_per_m1p5": self.k_H, "cavity_m": self.cavity()}
+                "wall_material": self.wall.name, "mass_kg": self.mass, "k_H_N_per_m1p5": self.k_H,
+                "cavity_m": self.cavity()}
 
     def value(self, row: UncertainParameter) -> float:
         """This design's nominal value of a parameter row: its clearance (g), k_H (Eq. 8), mass (m_a), or the row's
@@ -93,8 +107,9 @@ class Sphere:
 
 @dataclass(frozen=True)
 class DesignProblem:
-    """What `ies design` is asked: the operating base amplitudes a_base (m), the design grid, the uncertainty box, the
-    objective, how many screened candidates to verify, the repetitions and the stepped sine of a verification run."""
+    """What `ies design` is asked: the operating base amplitudes a_base (m), the design grid, the uncertainty box (D: the
+    interval of D_1, where it comes from in `damping_source`), the objective, how many screened candidates to verify,
+    the repetitions and the stepped sine of a verification run, the cavity walls' material (`wall`, Eq. 8)."""
 
     excitation: tuple[float, ...]
     clearances: tuple[float, ...]
@@ -112,8 +127,10 @@ class DesignProblem:
     block_width: float = BLOCK_WIDTH
     min_wall: float = MIN_WALL
     modal_file: str | None = None
-    baseline: Sphere | None = None
+    baseline: Design | None = None
     seed: int = 2024
+    wall: Material = STEEL_WALL
+    damping_source: str = "Table 2"
     protocol: Mapping[str, Any] = field(default_factory=lambda: dict(PROTOCOL))
 
     def check(self) -> None:
@@ -181,12 +198,35 @@ class DesignProblem:
         """The widest cavity (m) that leaves walls of min_wall."""
         return self.block_width - 2.0 * self.min_wall
 
-    def fits(self, sphere: Sphere) -> bool:
-        return sphere.cavity() <= self.room() * (1 + 1e-12)
+    def fits(self, design: Design) -> bool:
+        return design.cavity() <= self.room() * (1 + 1e-12)
 
-    def grid(self) -> list[Sphere]:
+    def fitting_text(self) -> str:
+        """How many designs of the grid fit the block and which (their clearances per sphere), and, where larger ones
+        are cut off, the --block-width that would take the whole grid."""
+        grid = self.grid()
+        fitting = [d for d in grid if self.fits(d)]
+        by_sphere: dict[tuple[str, float], list[float]] = {}
+        for d in fitting:
+            by_sphere.setdefault((d.material, d.radius), []).append(d.clearance)
+        which = "; ".join(f"{m} R {R * 1e3:.3g} mm: g {', '.join(f'{g * 1e3:.3g}' for g in gs)} mm"
+                          for (m, R), gs in by_sphere.items())
+        text = (f"{len(fitting)} of {len(grid)} designs fit the {self.block_width * 1e3:g} mm block (cavity 2R + 2g "
+                f"<= {self.room() * 1e3:.3g} mm between {self.min_wall * 1e3:g} mm walls)" + (f": {which}" if which else ""))
+        if len(fitting) < len(grid):
+            wide = max(d.cavity() for d in grid) + 2.0 * self.min_wall
+            text += f"; the larger ones need a wider block (--block-width {math.ceil(wide * 1e4) / 10:g}mm takes them all)"
+        return text
+
+    def box_text(self) -> str:
+        """The uncertainty box in words, with where D_1's interval comes from."""
+        t, f = self.clearance_tolerance, self.k_H_factor
+        return (f"box: D_1 {100 * self.D[0]:.4g}-{100 * self.D[1]:.4g} % ({self.damping_source}), clearance + "
+                f"{t[0] * 1e3:.3g}-{t[1] * 1e3:.3g} mm, k_H x {f[0]:.3g}-{f[1]:.3g} of Eq. 8 on {self.wall.name} walls")
+
+    def grid(self) -> list[Design]:
         """Every design of the grid, material by material, radius by radius, clearance by clearance."""
-        return [Sphere(g, R, m) for m in self.materials for R in self.radii for g in self.clearances]
+        return [Design(g, R, m, self.wall) for m in self.materials for R in self.radii for g in self.clearances]
 
     def spreads(self) -> list[tuple[UncertainParameter, Any]]:
         """The uncertainty box: each row with a `Spread` (`sim.model.parameters.boxed_parameters`) with its spread,
@@ -204,7 +244,7 @@ class DesignProblem:
         """The base amplitude (m) of the margin check: the top of the operating range times 1 + margin."""
         return max(self.excitation) * (1.0 + self.margin)
 
-    def corners(self, sphere: Sphere) -> list[dict[str, float]]:
+    def corners(self, sphere: Design) -> list[dict[str, float]]:
         """The uncertainty box of one design as task parameters (SI; the rows with a spread, then m_a): its corners
         (each once), then the nominal point (the box's centre) for the monotonicity check."""
         import itertools
@@ -247,17 +287,18 @@ def host_mode(model: Any) -> Any:
 
 
 def levels_of(model: Any, a_base: Sequence[float]) -> np.ndarray:
-    """Excitation levels a_base / a_base* (-) of base amplitudes (m), a_base* of the paper's nominal D*, g* (Sect. 5.3)."""
+    """Excitation levels a_base / a_base* (-) of base amplitudes (m), a_base* of the host's nominal D_1* and the paper's
+    g* (Sect. 5.3, `sim.model.system.Nominal.of`)."""
     from sim.model.system import a_base_star
 
     return np.asarray(a_base, dtype=float) / a_base_star(model)
 
 
-def no_absorber(model: Any, a_base: Sequence[float], D: float) -> np.ndarray:
-    """Resonant tip amplitude (m) of the host alone at damping D (Sect. 5's a_noabs* with D* = D)."""
-    from sim.model.system import Nominal, a_noabs_star
+def no_absorber(model: Any, a_base: Sequence[float]) -> np.ndarray:
+    """Resonant tip amplitude (m) of the host alone at its nominal D_1* (Sect. 5's a_noabs*, `Nominal.of`)."""
+    from sim.model.system import a_noabs_star
 
-    return a_noabs_star(model, np.asarray(a_base, dtype=float), Nominal(D1=D))
+    return a_noabs_star(model, np.asarray(a_base, dtype=float))
 
 
 def first_impacts(mode: Any, clearance: float) -> float:
@@ -392,22 +433,37 @@ def parse_interval(text: str, what: str, quantity: str | None = None) -> tuple[f
     return lo, hi
 
 
-def parse_baseline(text: str, radii: Sequence[float], materials: Sequence[str]) -> Sphere:
-    """`G[,R[,MATERIAL]]` -> a Sphere; R and the material default to the first of the grid's."""
-    from sim.common.errors import SimulationInputError
-    from sim.model.materials import material
-
-    parts = [t.strip() for t in str(text).split(",")]
+def parse_baseline(text: str, radii: Sequence[float], materials: Sequence[str], wall: Material = STEEL_WALL) -> Design:
+    """`G[,R[,MATERIAL]]` -> a Design on `wall`; R and the material default to the first of the grid's."""
+    parts = [t.strip() for t in str(text).split(",", 2)]
     if not 1 <= len(parts) <= 3 or not parts[0]:
         raise StudyError(f"--baseline {text!r}: give G[,R[,MATERIAL]], e.g. 0.58mm,7.92mm,brass")
     g = parse_range(parts[0], "clearance", count=1)[0]
     R = parse_range(parts[1], "radius", count=1)[0] if len(parts) > 1 and parts[1] else radii[0]
-    name = parts[2] if len(parts) > 2 else materials[0]
+    name = material_names(parts[2], "--baseline")[0] if len(parts) > 2 else materials[0]
+    return Design(g, R, name, wall)
+
+
+def material_names(text: str, option: str = "--material") -> tuple[str, ...]:
+    """The sphere materials of a comma-separated list (`brass,steel`; one of one's own keeps its commas:
+    `brass,E=200GPa,nu=0.29,density=7850kg/m3`), each by its canonical name (`sim.model.materials.material_of`); one
+    line (StudyError) naming the known ones for an unknown material."""
+    from sim.common.errors import SimulationInputError
+
+    items: list[str] = []
+    for part in (t.strip() for t in str(text).split(",")):
+        if not part:
+            continue
+        if "=" in part and items and "=" in items[-1]:
+            items[-1] += "," + part  # E=...,nu=...,density=... is one material
+        else:
+            items.append(part)
+    if not items:
+        raise StudyError(f"{option}: give at least one sphere material, e.g. brass")
     try:
-        material(name)
+        return tuple(dict.fromkeys(material(item).name for item in items))
     except SimulationInputError as exc:
-        raise StudyError(f"--baseline: {exc}") from None
-    return Sphere(g, R, name.lower())
+        raise StudyError(f"{option}: {exc}") from None
 
 
 def protocol_of(table: Mapping[str, Any], where: str) -> dict[str, Any]:
@@ -433,7 +489,7 @@ DESIGN_SETTINGS: dict[str, Any] = {
     "excitation": None, "clearance": "0.3mm:1.2mm:10", "radius": "7.92mm", "material": "brass", "model": None,
     "objective": "mean", "damping": None, "clearance_tolerance": None, "k_H_factor": None, "calibration": None,
     "candidates": 5, "reps": 3, "restitution": None, "baseline": None, "block_width": None, "min_wall": None,
-    "margin": None, "allow_large": False, "output": "ies-out/design"}
+    "margin": None, "allow_large": False, "wall_material": None, "output": "ies-out/design"}
 
 
 @dataclass(frozen=True)
@@ -474,19 +530,41 @@ def read_design_file(path: Any) -> DesignFile:
 
 def problem_of(settings: Mapping[str, Any], protocol: Mapping[str, Any] = PROTOCOL) -> DesignProblem:
     """The checked `DesignProblem` of a design's settings (`DESIGN_SETTINGS` keys; ranges and lengths as text with
-    units) and stepped sine; one line (StudyError) for anything wrong."""
+    units) and stepped sine; one line (StudyError) for anything wrong. The host decides what is not given: the interval
+    of D_1 (its `damping_box`: its own interval, else Table 2's relative one around its D_1*) and the cavity walls'
+    material (its `wall_material`, else steel) that Eq. 8 takes for every sphere's k_H*."""
+    from sim.common.errors import SimulationInputError
+    from sim.model.materials import material_of
+    from sim.model.system import check_damping_interval
+
     value = {**DESIGN_SETTINGS, **settings}
     if value["excitation"] is None:
         raise StudyError("--excitation is required: the operating base amplitudes, e.g. --excitation 0.66um:6.6um:10")
     problem = DesignProblem(excitation=(), clearances=(), radii=(), modal_file=value["model"], protocol=dict(protocol))
-    mode = host_mode(host_model(problem))
-    materials = tuple(m.strip().lower() for m in str(value["material"]).split(",") if m.strip())
+    model = host_model(problem)
+    mode = host_mode(model)
+    wall = model.wall_material
+    if value["wall_material"] is not None:
+        try:
+            wall = material_of(str(value["wall_material"]), "wall")
+        except SimulationInputError as exc:
+            raise StudyError(f"--wall-material: {exc}") from None
+    materials = material_names(value["material"])
     radii = parse_range(value["radius"], "radius", count=4)
+    box, said = model.damping_box()
     fields: dict[str, Any] = dict(
         excitation=parse_range(value["excitation"], "excitation", count=10, omega=mode.omega),
         clearances=parse_range(value["clearance"], "clearance", count=10), radii=radii, materials=materials,
-        objective=value["objective"], candidates=int(value["candidates"]), repetitions=int(value["reps"]))
-    for name, key, quantity in (("damping", "D", None), ("clearance_tolerance", "clearance_tolerance", "clearance"),
+        objective=value["objective"], candidates=int(value["candidates"]), repetitions=int(value["reps"]), wall=wall,
+        D=tuple(box), damping_source=said)
+    if value["damping"] is not None:
+        interval = parse_interval(value["damping"], "--damping")
+        try:
+            fields["D"] = check_damping_interval(interval, model.D_star)
+        except SimulationInputError as exc:
+            raise StudyError(f"--damping {value['damping']}: {exc}") from None
+        fields["damping_source"] = "--damping"
+    for name, key, quantity in (("clearance_tolerance", "clearance_tolerance", "clearance"),
                                 ("k_H_factor", "k_H_factor", None)):
         if value[name] is not None:
             fields[key] = parse_interval(value[name], "--" + name.replace("_", "-"), quantity)
@@ -508,7 +586,7 @@ def problem_of(settings: Mapping[str, Any], protocol: Mapping[str, Any] = PROTOC
         fields["margin"] = _number(value["margin"], "--margin", "a fraction in (0, 1], e.g. 0.2 for 20 %")
     fields["allow_large"] = bool(value["allow_large"])
     if value["baseline"] is not None:
-        fields["baseline"] = parse_baseline(value["baseline"], radii, materials)
+        fields["baseline"] = parse_baseline(value["baseline"], radii, materials, wall)
     problem = dataclasses.replace(problem, **fields)
     problem.check()
     return problem

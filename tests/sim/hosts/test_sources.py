@@ -118,6 +118,6 @@ def test_a_host_source_reaches_the_design_by_its_files(beam3_row, tmp_path) -> N
     beam = tmp_path / "rig.beam3"
     beam.write_text("117.4")
     data = tiny_design(tmp_path, beam)
-    # the structure without IES is the toy's: phi_tip phi^T M b a_base / (2 D_1) at the lower end of D (Sect. 5)
-    assert data["no_absorber"]["tip_m"] == pytest.approx([1.0 * 0.95 * 1.5e-6 / (2 * 0.00075)], rel=1e-14)
+    # the structure without IES is the toy's: phi_tip phi^T M b a_base / (2 D_1*) at its nominal D_1* (Sect. 5)
+    assert data["no_absorber"]["tip_m"] == pytest.approx([1.0 * 0.95 * 1.5e-6 / (2 * 0.00085)], rel=1e-14)
     assert data["host"]["omega_1_rad_per_s"] == pytest.approx(2 * np.pi * 117.4, rel=1e-12)
