@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import signal
 import sys
 from typing import Sequence
 
@@ -86,7 +87,17 @@ def version_line() -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run `ies` with `argv` (default: the process arguments) and return the exit code."""
+    """Run `ies` with `argv` (default: the process arguments) and return the exit code.
+
+    Run as the process's own command (argv None: the console script, ``python -m uq``), Ctrl-C is ignored once the
+    exit code is settled: an interrupt while the interpreter shuts down (joblib's workers, HDF5, matplotlib being torn
+    down) would otherwise end it with a traceback, "Exception ignored", a fatal error or a silent kill after the one
+    line was written. While files are written it is held back until each file is whole (`sim.common.files`)."""
+    def settled(code: int) -> int:
+        if argv is None:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+        return code
+
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -94,7 +105,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(exc.code or 0)
     prog = f"ies {args.command}"
     try:
-        return int(args._run(args) or 0)
+        return settled(int(args._run(args) or 0))
+    except KeyboardInterrupt:
+        settled(130)
+        if getattr(args, "resume", None) is not None:
+            sys.stderr.write(f"{prog}: interrupted; finished results were kept (rerun with --resume)\n")
+        else:
+            sys.stderr.write(f"{prog}: interrupted; no results were written (rerun the command)\n")
+        return 130
     except USER_ERRORS as exc:
         sys.stderr.write(f"{prog}: error: {exc}\n")
         return 2
@@ -123,12 +141,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 3
         sys.stderr.write(f"{prog}: error: {exc.strerror or exc}{where}\n")
         return 2
-    except KeyboardInterrupt:
-        if getattr(args, "resume", None) is not None:
-            sys.stderr.write(f"{prog}: interrupted; finished results were kept (rerun with --resume)\n")
-        else:
-            sys.stderr.write(f"{prog}: interrupted; no results were written (rerun the command)\n")
-        return 130
+    finally:
+        settled(0)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -75,6 +75,22 @@ class ResultStore:
     def load(self, key: str) -> dict:
         return json.loads(self._path(key).read_text())
 
+    def read(self, key: str) -> dict | None:
+        """The stored record of `key`; None when there is none, or when its file is damaged (cut short, not a task's
+        JSON, another task's record: a disk that filled up, a copy cut off), which is then removed so that the task
+        runs again (`run_tasks` says so)."""
+        path = self._path(key)
+        try:
+            record = json.loads(path.read_bytes())
+        except FileNotFoundError:
+            return None
+        except (OSError, ValueError):  # json.JSONDecodeError and UnicodeDecodeError are ValueErrors
+            record = None
+        if isinstance(record, dict) and record.get("key") == key and {"outputs", "error"} <= set(record):
+            return record
+        path.unlink(missing_ok=True)
+        return None
+
 
 def check_writable(folder: str | Path) -> Path:
     """Create `folder` (and parents) and prove a file can be written in it, else a one-line StudyError."""
@@ -208,7 +224,8 @@ def choose_jobs(jobs: int | None, work_s: float, cores: int | None = None, strea
 
 def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultStore, *, jobs: int | None = 1,
               scheduler: str | None = None, progress: bool = True, client: Any = None) -> tuple[dict[Task, dict], int]:
-    """Run every task whose result is not in `store`; return all results by task and how many ran now.
+    """Run every task whose result is not in `store` (or whose stored file is damaged: removed and run again, said
+    in one warning line, `ResultStore.read`); return all results by task and how many ran now.
 
     jobs: local worker processes (joblib/loky; 1 = in this process; None: `choose_jobs` after timing the first task
     in this process, which also gives the cost estimate of the rest, `sim.stepped_sine.cost.announce_runs`).
@@ -224,10 +241,23 @@ def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultSt
     version = model.version()
     keyer = _keyer(model, seed, version)
     keys = {task: keyer(task) for task in tasks}
+    records: dict[str, dict] = {}
     unique: dict[str, Task] = {}
+    damaged = []
     for task, key in keys.items():
-        if key not in unique and not store.has(key):
+        if key in unique or key in records:
+            continue
+        present = store.has(key)
+        record = store.read(key) if present else None
+        if record is None:
             unique[key] = task
+            if present:
+                damaged.append(key)
+        else:
+            records[key] = record
+    if damaged:
+        sys.stderr.write(f"warning: {len(damaged)} stored task file(s) in {store.folder} were damaged (cut short or not "
+                         f"a task's record, e.g. {damaged[0]}.json) and were removed; they run again\n")
     pending = list(unique.items())
     total = len(set(keys.values()))
     bar = tqdm(total=total, initial=total - len(pending), desc="tasks", unit="run",
@@ -240,7 +270,8 @@ def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultSt
             _run_and_store(model, pending, seed, jobs, client, store, bar, total)
     finally:
         bar.close()
-    return {task: store.load(key) for task, key in keys.items()}, len(pending)
+    records.update((key, store.load(key)) for key, _ in pending)
+    return {task: records[key] for task, key in keys.items()}, len(pending)
 
 
 def _run_and_store(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int | None, client: Any,

@@ -18,7 +18,6 @@ formats of the plot options (PNG and PDF by default).
 """
 from __future__ import annotations
 
-import csv
 import json
 from collections import defaultdict
 from dataclasses import dataclass
@@ -39,7 +38,7 @@ from sim.plots.figures import (
     tip_mm_per_level,
     tip_note,
 )
-from sim.common.files import pyplot, save_figure
+from sim.common.files import pyplot, read_rows, save_figure
 from sim.plots.redraw import KINDS, PlotOptions, kind_of, register, selected
 from uq.outputs.results import nominal_regimes, study_kind
 
@@ -52,9 +51,9 @@ _DISCRETE_OUTPUTS = ("restitution", "restitution_wall")
 
 
 def _rows(path: Path, options: PlotOptions | None = None) -> list[dict]:
-    """A CSV file's rows; with `options`, only the rows of the chosen levels."""
-    with open(path, newline="") as fh:
-        rows = list(csv.DictReader(fh))
+    """A CSV file's rows (`sim.common.files.read_rows`: one line naming the file and the line where it is cut short);
+    with `options`, only the rows of the chosen levels."""
+    rows = read_rows(path)
     if options is not None and rows and "level" in rows[0]:
         rows = [r for r in rows if options.keeps(float(r["level"]))]
     return rows
@@ -428,11 +427,21 @@ def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list
 def read_overview(folder: Path, options: PlotOptions | None = None) -> dict[str, list]:
     """A folder's overview.csv as `sim.stepped_sine.tables.overview_data` keys (numbers as floats, the regime as text); with
     `options`, only the chosen levels."""
+    path = folder / "overview.csv"
     data: dict[str, list] = defaultdict(list)
-    for r in _rows(folder / "overview.csv", options):
+    for r in _rows(path, options):
         for key, value in r.items():
-            data["levels" if key == "level" else key].append(value if key == "regime" else float(value))
+            data["levels" if key == "level" else key].append(value if key == "regime" else _number(path, key, value))
     return dict(data)
+
+
+def _number(path: Path, column: str, text: str) -> float:
+    """A table's cell as a number; one line naming the file and the column where it is none (a damaged file)."""
+    try:
+        return float(text)
+    except ValueError:
+        raise SimulationInputError(f"{path}: {text!r} in column {column!r} is not a number (the file is damaged); rerun "
+                                   "the command that wrote it") from None
 
 
 @dataclass(frozen=True)

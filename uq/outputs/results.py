@@ -9,7 +9,6 @@ confidence intervals and the noise share. All read only the study's files.
 """
 from __future__ import annotations
 
-import csv
 import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -40,8 +39,9 @@ class Effect:
 
 
 def _rows(path: Path) -> list[dict]:
-    with open(path, newline="") as fh:
-        return list(csv.DictReader(fh))
+    from sim.common.files import read_rows
+
+    return read_rows(path)
 
 
 def nominal_regimes(points: list[dict], output: str = "mean") -> dict[float, str]:

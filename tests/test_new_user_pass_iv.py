@@ -1,0 +1,178 @@
+"""The fourth new-user pass (issue 43): the last tracebacks, silent wrong values refused, work estimated before it
+starts, one run per output folder, plain progress lines in logs, and study files of the previous release.
+
+Each bad input ends in one line on stderr with exit code 2 (caught before any work) or 3 (after work, keeping what was
+done), no traceback, nothing half-written. The studies here use the Ishigami model or the three-mode model file (runs
+of a few hundredths of a simulated second), so the file runs in about a minute.
+"""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from uq.cli import main
+
+from tests.support import FAST
+
+ROOT = Path(__file__).resolve().parents[1]
+ISHIGAMI = "[study]\nkind = 'sobol'\nmodel = 'ishigami'\nseed = 5\n[sobol]\nn = {n}\nbootstrap = 20\n"
+
+
+def one_line(capsys, code: int, expected: int, *phrases: str) -> str:
+    """Assert exit code `expected` with one line on stderr holding `phrases`; return the line."""
+    err = capsys.readouterr().err
+    assert code == expected, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    for phrase in phrases:
+        assert phrase in err, err
+    return err
+
+
+def ishigami(tmp_path: Path, n: int = 8) -> Path:
+    study = tmp_path / "ishigami.toml"
+    study.write_text(ISHIGAMI.format(n=n))
+    return study
+
+
+def whole_files(folder: Path) -> None:
+    """Every file of a study folder is whole: CSV tables end with their last line, JSON and results.nc read, and
+    no temporary file of a write is left."""
+    from sim.common.files import read_rows
+    from uq.outputs.netcdf import open_results
+
+    assert not [p.name for p in folder.rglob(".*")], "a temporary file of a write is left"
+    for path in folder.glob("*.csv"):
+        read_rows(path)
+    for path in [*folder.glob("*.json"), *(folder / "tasks").glob("*.json")]:
+        json.loads(path.read_text())
+    if (folder / "results.nc").exists():
+        open_results(folder)
+
+
+# ---- 1. the last tracebacks --------------------------------------------------------------------------------------
+
+def test_resume_over_a_task_file_cut_short_runs_that_task_again_and_says_so(tmp_path, capsys):
+    study, out = ishigami(tmp_path), tmp_path / "out"
+    assert main(["sobol", str(study), "--out", str(out), "--no-figures", "--quiet"]) == 0
+    first = (out / "sobol.csv").read_text()
+    tasks = sorted((out / "tasks").glob("*.json"))
+    tasks[3].write_text(tasks[3].read_text()[:40])  # a disk that filled up, a copy cut off
+    tasks[5].write_text("[1, 2]")  # JSON, but not a task's record
+    capsys.readouterr()
+    assert main(["sobol", str(study), "--out", str(out), "--no-figures", "--quiet", "--resume"]) == 0
+    captured = capsys.readouterr()
+    assert "2 run now" in captured.out and "Traceback" not in captured.err
+    warnings = [line for line in captured.err.splitlines() if "damaged" in line]
+    assert len(warnings) == 1 and "2 stored task file(s)" in warnings[0] and "run again" in warnings[0]
+    assert (out / "sobol.csv").read_text() == first  # the same runs, the same numbers
+
+
+def test_compare_on_an_overview_cut_short_names_the_file_and_the_line(tmp_path, capsys):
+    folder = tmp_path / "study"
+    folder.mkdir()
+    (folder / "study.json").write_text(json.dumps({"study": {"kind": "response", "name": "s"}, "landmarks": {}}))
+    (folder / "overview.csv").write_text("level,resonant_mean,regime\n5.3,0.05,SMR\n6.7,0.0")
+    one_line(capsys, main(["compare", str(folder), "--out", str(tmp_path / "c")]), 2,
+             f"{folder / 'overview.csv'}: line 3 has 2 cells but the header names 3 columns", "cut short")
+    (folder / "overview.csv").write_text("level,resonant_mean,regime\n5.3,0.05,SMR\n6.7,0.04,AP")
+    one_line(capsys, main(["compare", str(folder), "--out", str(tmp_path / "c")]), 2,
+             "line 3 ends without a line end")
+    (folder / "overview.csv").write_text("level,resonant_mean,regime\n5.3,0.0\x005,SMR\n")
+    one_line(capsys, main(["compare", str(folder), "--out", str(tmp_path / "c")]), 2,
+             "in column 'resonant_mean' is not a number")
+    assert not (tmp_path / "c").exists()
+
+
+def test_plot_on_a_table_cut_short_names_the_file_and_the_line(tmp_path, capsys):
+    study, out = ishigami(tmp_path), tmp_path / "out"
+    assert main(["sobol", str(study), "--out", str(out), "--no-figures", "--quiet"]) == 0
+    text = (out / "sobol.csv").read_text()
+    (out / "sobol.csv").write_text(text[: text.rindex(",")])
+    capsys.readouterr()
+    one_line(capsys, main(["plot", str(out)]), 2, f"{out / 'sobol.csv'}: line ", "cut short")
+
+
+def _interrupting_at(count: int):
+    """A profile function that sends this process a real SIGINT at its `count`-th function call."""
+    calls = [0]
+
+    def profile(frame, event, arg):
+        if event == "call":
+            calls[0] += 1
+            if calls[0] == count:
+                os.kill(os.getpid(), signal.SIGINT)
+
+    return profile, calls
+
+
+def test_ctrl_c_at_any_point_of_the_final_writes_is_one_line_and_leaves_whole_files(tmp_path, capsys, monkeypatch):
+    """A real SIGINT at many points of a study's final writing (the tables, results.nc through HDF5, study.json, the
+    figures): always exit 130 with one line, or 0 when it came after the last file; never a traceback; every file
+    whole or absent; and the interrupt never fires inside a writer (HDF5, matplotlib's savefig, ...: `atomic_path`),
+    where it can leave a library in a state that ends the interpreter with a fatal error: it is held back and
+    delivered between files."""
+    import uq.engine.execution
+
+    fired_inside_a_writer = []
+    writers = {"savefig", "to_netcdf", "write_bytes"}  # matplotlib's, xarray's (HDF5) and the text files' writer
+
+    def interrupt(signum, frame):  # Python's default handler, noting where it fires
+        while frame is not None:
+            if frame.f_code.co_name in writers:
+                fired_inside_a_writer.append(frame.f_code.co_name)
+            frame = frame.f_back
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(signal, "default_int_handler", interrupt)
+    previous = signal.signal(signal.SIGINT, interrupt)
+    study = ishigami(tmp_path)
+    analyse = uq.engine.execution.statistics
+    counted: dict[str, int] = {}
+
+    def final_writes_profiled(*args, **kwargs):  # the runs are done: profile from here to the end of the command
+        sys.setprofile(profile)
+        return analyse(*args, **kwargs)
+
+    monkeypatch.setattr(uq.engine.execution, "statistics", final_writes_profiled)
+    for k in range(2):  # count only, how many calls the final writes make, once everything is imported
+        profile, calls = _interrupting_at(-1)
+        try:
+            assert main(["sobol", str(study), "--out", str(tmp_path / f"count{k}"), "--quiet"]) == 0
+        finally:
+            sys.setprofile(None)
+    total = calls[0]
+    assert total > 10_000
+    codes = []
+    for k, at in enumerate(sorted({int(total * f) for f in (0.001, 0.01, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7,
+                                                             0.8, 0.9, 0.95, 0.99, 0.999, 1.2)})):
+        out = tmp_path / f"o{k}"
+        profile, calls = _interrupting_at(at)
+        capsys.readouterr()
+        try:
+            code = main(["sobol", str(study), "--out", str(out), "--quiet"])
+        finally:
+            sys.setprofile(None)
+        err = capsys.readouterr().err
+        assert "Traceback" not in err and len(err.strip().splitlines()) == (code == 130), (at, err)
+        assert code in (0, 130) and (code == 0) == (at > total), (at, code, err)
+        whole_files(out)
+        codes.append(code)
+    signal.signal(signal.SIGINT, previous)
+    assert codes.count(130) == len(codes) - 1 and not fired_inside_a_writer
+
+
+def test_ctrl_c_after_the_command_is_done_is_ignored(tmp_path):
+    """Through the process entry (argv from the command line): an interrupt once the exit code is settled, while the
+    interpreter shuts down, no longer ends the process with a traceback, "Exception ignored" or a kill by SIGINT."""
+    study = ishigami(tmp_path)
+    code = ("import os, signal, sys; from uq.cli import main; code = main(); os.kill(os.getpid(), signal.SIGINT); "
+            "sys.exit(code)")
+    done = subprocess.run([sys.executable, "-c", code, "sobol", str(study), "--out", str(tmp_path / "o"), "--quiet",
+                           "--no-figures"], capture_output=True, text=True, cwd=ROOT)
+    assert done.returncode == 0 and done.stderr == "", done.stderr
