@@ -317,11 +317,13 @@ def build_protocol(args: argparse.Namespace) -> Any:
 
 @contextmanager
 def output_folder(path: str | None, force: bool = False) -> Iterator[Path | None]:
-    """--out DIR, created up front and proved writable (a clear error if it cannot be a folder, holds earlier
-    results and `force` is not given, or the disk refuses a file) and removed again if the command fails before
-    writing anything into it (no empty result folders after a bad input)."""
+    """--out DIR, created up front, proved writable and locked for this run (`sim.common.folder_lock`: a second run
+    into it is refused, naming this one) (a clear error if it cannot be a folder, is in use, holds earlier results and
+    `force` is not given, or the disk refuses a file) and removed again if the command fails before writing anything
+    into it (no empty result folders after a bad input)."""
     from sim.common.errors import ResourceFailure
     from sim.common.files import RESOURCE_ERRNOS, check_writable
+    from sim.common.folder_lock import LOCK_FILE, locked
 
     if path is None:
         yield None
@@ -329,9 +331,6 @@ def output_folder(path: str | None, force: bool = False) -> Iterator[Path | None
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
         raise SimulationInputError(f"--out {folder} exists and is not a folder; choose another path")
-    if folder.is_dir() and not force and any(folder.iterdir()):
-        raise SimulationInputError(f"--out {folder} is not empty (earlier results?); choose another folder or pass "
-                                   "--force to replace its files")
     created = not folder.exists()
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -341,7 +340,11 @@ def output_folder(path: str | None, force: bool = False) -> Iterator[Path | None
                     "computed)") from None
     try:
         check_writable(folder, "--out", folder=True)
-        yield folder
+        with locked(folder):
+            if not force and any(p.name != LOCK_FILE for p in folder.iterdir()):
+                raise SimulationInputError(f"--out {folder} is not empty (earlier results?); choose another folder or "
+                                           "pass --force to replace its files")
+            yield folder
     except BaseException:
         if created and not any(folder.iterdir()):
             folder.rmdir()

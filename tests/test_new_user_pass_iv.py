@@ -176,3 +176,88 @@ def test_ctrl_c_after_the_command_is_done_is_ignored(tmp_path):
     done = subprocess.run([sys.executable, "-c", code, "sobol", str(study), "--out", str(tmp_path / "o"), "--quiet",
                            "--no-figures"], capture_output=True, text=True, cwd=ROOT)
     assert done.returncode == 0 and done.stderr == "", done.stderr
+
+
+# ---- 4. one run per output folder --------------------------------------------------------------------------------
+
+def _started(command: list[str], lock: Path) -> subprocess.Popen:
+    """A real `ies` process (`python -m uq`, from the source tree), once it holds the lock `lock`."""
+    import time
+
+    process = subprocess.Popen([sys.executable, "-m", "uq", *command], cwd=ROOT, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120.0
+    while not lock.exists():
+        assert process.poll() is None, process.communicate()
+        assert time.monotonic() < deadline, "the first run never took the folder's lock"
+        time.sleep(0.05)
+    return process
+
+
+def _second(command: list[str]) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "uq", *command], cwd=ROOT, capture_output=True, text=True)
+
+
+def test_two_study_runs_into_one_folder_the_second_is_refused_naming_the_first(tmp_path):
+    """Two `ies interval` runs into one --out: the second (with or without --resume) is refused with one line naming
+    the first (pid, host, command, start time) while it runs; after it ends the folder is free and the lock gone."""
+    import socket
+
+    from sim.common.folder_lock import LOCK_FILE
+    from tests.support import AB_PARAMETERS
+
+    study = tmp_path / "slow.toml"
+    study.write_text(f"[study]\nkind = 'interval'\nmodel = 'tests.support:sleepy'\n{AB_PARAMETERS}[interval]\n"
+                     "designs = ['individual', 'joint']\n")
+    out = tmp_path / "out"
+    command = ["interval", str(study), "--out", str(out), "--quiet", "--jobs", "1", "--no-figures"]
+    first = _started(command, out / LOCK_FILE)
+    for extra in ([], ["--resume"]):
+        second = _second([*command, *extra])
+        assert second.returncode == 2 and len(second.stderr.strip().splitlines()) == 1, second.stderr
+        assert f"--out {out} is in use by another run: pid {first.pid} on {socket.gethostname()}" in second.stderr
+        assert f"interval {study} --out {out}" in second.stderr and "started 20" in second.stderr
+    assert first.wait(timeout=300) == 0, first.communicate()
+    assert not (out / LOCK_FILE).exists()
+    again = _second([*command, "--resume"])
+    assert again.returncode == 0 and "0 run now" in again.stdout, again.stderr
+
+
+def test_resume_takes_over_from_a_run_that_died(tmp_path):
+    """A run killed (SIGKILL: no chance to clean up) leaves its lock file, not its lock: --resume takes the folder over
+    at once and finishes the study with the runs the dead one stored."""
+    from sim.common.folder_lock import LOCK_FILE
+    from tests.support import AB_PARAMETERS
+
+    study = tmp_path / "slow.toml"
+    study.write_text(f"[study]\nkind = 'interval'\nmodel = 'tests.support:sleepy'\n{AB_PARAMETERS}[interval]\n"
+                     "designs = ['individual', 'joint']\n")
+    out = tmp_path / "out"
+    command = ["interval", str(study), "--out", str(out), "--quiet", "--jobs", "1", "--no-figures"]
+    first = _started(command, out / LOCK_FILE)
+    while len(list((out / "tasks").glob("*.json"))) < 2:
+        assert first.poll() is None
+    first.kill()
+    first.wait()
+    assert (out / LOCK_FILE).exists()
+    again = _second([*command, "--resume"])
+    assert again.returncode == 0, again.stderr
+    assert "reused" in again.stdout and not (out / LOCK_FILE).exists()
+
+
+def test_two_sweeps_with_force_into_one_folder_do_not_race(tmp_path, model_file):
+    """`ies sweep --force` twice into one folder: the second is refused while the first runs, and after the first is
+    killed a third takes the folder over."""
+    from sim.common.folder_lock import LOCK_FILE
+
+    out = tmp_path / "res"
+    command = ["sweep", "--level", "6", "--eta", "0.98:1.0:40", "--wait", "20", "--hold", "20", "--reps", "3",
+               "--model", model_file, "--out", str(out), "--force"]
+    first = _started(command, out / LOCK_FILE)
+    second = _second(command)
+    assert second.returncode == 2 and f"pid {first.pid}" in second.stderr, second.stderr
+    first.kill()
+    first.wait()
+    third = _second(["sweep", "--level", "6", *FAST, "--model", model_file, "--out", str(out), "--force"])
+    assert third.returncode == 0, third.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["sweep.csv", "sweep.json"]

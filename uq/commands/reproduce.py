@@ -95,11 +95,13 @@ def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
     with engine(args, None) as batch, dask_client(args.scheduler, batch) as client:
         # connected (or the batch cluster started) once, first: a bad address leaves nothing behind
         check_writable(args.out)
+        from sim.common.folder_lock import locked
         from sim.integration.integrators import warm_up_all
 
-        # every kernel any study's workers will call, compiled here once, before the first bar
-        warm_up_all(pair for model in models if hasattr(model, "kernel_variants") for pair in model.kernel_variants())
-        return _reproduce(args, figures, studies, client, calibrate, calibration)
+        with locked(args.out):  # one reproduction per --out: its calibration, summary and index beside the figures
+            # every kernel any study's workers will call, compiled here once, before the first bar
+            warm_up_all(pair for model in models if hasattr(model, "kernel_variants") for pair in model.kernel_variants())
+            return _reproduce(args, figures, studies, client, calibrate, calibration)
 
 
 def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list, client: Any,

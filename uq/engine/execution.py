@@ -19,7 +19,9 @@ import numpy as np
 
 from sim.common.files import dumps, write_csv, write_text
 from sim.common.outputs import header
-from uq.engine.runner import ResultStore, dask_client, describe_model, prepare_output, run_tasks
+from sim.common.folder_lock import locked
+from uq.engine.runner import (ResultStore, check_writable, dask_client, describe_model, prepare_output, release_output,
+                              run_tasks)
 from uq.outputs.tables import RUNS_CSV, parameter_columns, runs_rows
 from uq.problem.method import Analysis, Plan, Runs
 from uq.problem.study import Study
@@ -92,10 +94,22 @@ def run_study(study: Study, *, out: Path | None = None, jobs: int | None = 1, sc
     model.check()
     plan = method.plan(study)
     check_run_total(len(plan.points), len(study.levels), study.repetitions, allow_large=allow_large)
+    folder = Path(out or study.output)
+    try:
+        return _run(study, model, plan, folder, jobs=jobs, scheduler=scheduler, resume=resume, progress=progress,
+                    client=client)
+    finally:
+        release_output(folder)  # the lock prepare_output took, once the last file is written
+
+
+def _run(study: Study, model: Any, plan: Plan, folder: Path, *, jobs: int | None, scheduler: str | None, resume: bool,
+         progress: bool, client: Any) -> StudyResult:
+    """`run_study` of one study from its output folder on: the tasks, the analysis and the files."""
+    method = study.method
     with dask_client(scheduler, client) as client:
         if hasattr(model, "with_rig"):
             model = model.with_rig()
-        folder = prepare_output(out or study.output, resume=resume, study=(study.name, study_key(study, model)))
+        folder = prepare_output(folder, resume=resume, study=(study.name, study_key(study, model)))
         if hasattr(model, "warm_up"):
             model.warm_up()  # compile the kernels before the progress bar (workers load them from the cache)
         started = time.perf_counter()
@@ -165,11 +179,20 @@ def _run_parts(study: Study, parts: list[tuple[str, Study]], *, out: Path | None
     """A study of sub-studies (a response series, Fig. 11): each in its own folder OUT/NAME=VALUE (resumable like any
     study), OUT/results.nc with their datasets along the dimension NAME (the values its coordinate) and
     OUT/study.json naming them."""
+    folder = Path(out) if out is not None else study.output
+    check_writable(folder)
+    with locked(folder):  # the series' own files (results.nc, study.json) beside its parts' folders
+        return _series(study, parts, folder, jobs=jobs, scheduler=scheduler, resume=resume, progress=progress,
+                       client=client, allow_large=allow_large)
+
+
+def _series(study: Study, parts: list[tuple[str, Study]], folder: Path, *, jobs: int | None, scheduler: str | None,
+            resume: bool, progress: bool, client: Any, allow_large: bool) -> StudyResult:
+    """`_run_parts` in its locked folder."""
     import xarray as xr
 
     from uq.outputs.netcdf import finish, open_results
 
-    folder = Path(out) if out is not None else study.output
     result = StudyResult(folder)
     totals = {"tasks": 0, "ran": 0, "reused": 0, "failed_runs": 0, "wall_time_s": 0.0, "points": 0}
     names = []

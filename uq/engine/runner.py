@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 from sim.common.files import write_text
+from sim.common.folder_lock import lock_folder, unlock_folder
 from uq.errors import StudyError
 from uq.problem.tasks import Task
 
@@ -111,27 +112,39 @@ STUDY_MARK = "STUDY.txt"
 
 
 def prepare_output(folder: str | Path, *, resume: bool, study: tuple[str, str] | None = None) -> Path:
-    """Create the output folder and check it can be written; refuse to overwrite finished results, and refuse
-    `resume` into a folder that holds the tasks of another study. `study`: (name, key) of the study to run
-    (`uq.engine.execution.study_key`), kept in OUT/tasks/STUDY.txt."""
+    """Create the output folder, check it can be written and take its lock (`sim.common.folder_lock`: a second run
+    into a folder in use is refused with one line naming the other run; `release_output` gives it back when the
+    run's last file is written); refuse to overwrite finished results, and refuse `resume` into a folder that holds
+    the tasks of another study. `study`: (name, key) of the study to run (`uq.engine.execution.study_key`), kept in
+    OUT/tasks/STUDY.txt."""
     folder = Path(folder)
     store = ResultStore(folder)
-    if not resume and store.count():
-        raise StudyError(f"output folder {folder} already holds task results; pass --resume to continue that study "
-                         "or choose another --out")
-    mark = store.folder / STUDY_MARK
-    if resume and study is not None and mark.is_file():
-        name, key = (mark.read_text().splitlines() + ["", ""])[:2]
-        if key != study[1] and store.count():
-            raise StudyError(f"output folder {folder} holds the tasks of another study ('{name}', key {key[:12]}), not "
-                             f"of '{study[0]}' (key {study[1][:12]}); --resume continues only the same study: choose "
-                             "another --out")
     check_writable(store.folder)
-    if study is not None:
-        write_text(mark, f"{study[0]}\n{study[1]}\n")
-    for stale in store.folder.glob(".*.json"):  # a temporary file of a write cut off by SIGKILL
-        stale.unlink(missing_ok=True)
+    lock_folder(folder)  # before the folder's tasks are looked at: another run may be adding to them
+    try:
+        if not resume and store.count():
+            raise StudyError(f"output folder {folder} already holds task results; pass --resume to continue that study "
+                             "or choose another --out")
+        mark = store.folder / STUDY_MARK
+        if resume and study is not None and mark.is_file():
+            name, key = (mark.read_text().splitlines() + ["", ""])[:2]
+            if key != study[1] and store.count():
+                raise StudyError(f"output folder {folder} holds the tasks of another study ('{name}', key {key[:12]}), "
+                                 f"not of '{study[0]}' (key {study[1][:12]}); --resume continues only the same study: "
+                                 "choose another --out")
+        if study is not None:
+            write_text(mark, f"{study[0]}\n{study[1]}\n")
+        for stale in store.folder.glob(".*.json"):  # a temporary file of a write cut off by SIGKILL
+            stale.unlink(missing_ok=True)
+    except BaseException:
+        unlock_folder(folder)
+        raise
     return folder
+
+
+def release_output(folder: str | Path) -> None:
+    """Give back the lock `prepare_output` took on `folder` (nothing if this process holds none)."""
+    unlock_folder(folder)
 
 
 def evaluate(model: Callable, task: Task, seed: int) -> dict:
