@@ -144,7 +144,7 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
     (Table 2's D, g, k_H; r_cont, friction, k_t; a contact law's own constant), with its aliases."""
     from sim.hosts.sources import add_host_arguments
     from sim.model.contact_law import DEFAULT_LAW, LAWS
-    from sim.model.parameters import PARAMETERS
+    from sim.model.parameters import ALLOW_IMPLAUSIBLE, PARAMETERS
 
     add_host_arguments(parser)
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
@@ -158,6 +158,9 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
         if option is not None:
             parser.add_argument(*option.flags, dest=name, type=option.parse or parameter.option_value, default=None,
                                 metavar=option.metavar, help=option.help_text())
+    parser.add_argument(ALLOW_IMPLAUSIBLE, action="store_true",
+                        help="compute with a value whose magnitude is implausible for its quantity (a clearance of "
+                             "0.6 m, a damping ratio of 8.5 %%), refused by default as a unit slip")
 
 
 def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int) -> None:
@@ -267,13 +270,18 @@ def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     from the options of `sim.model.parameters.PARAMETERS` and the integrator's record (its law, friction)."""
     from sim.hosts.sources import resolve_host
     from sim.integration.integrators import integrator_named
-    from sim.model.parameters import PARAMETERS, SystemSettings, system_settings
-    from sim.model.system import build_impactor
+    from sim.model.parameters import PARAMETERS, SystemSettings, check_plausible, system_settings
+    from sim.model.system import build_impactor, check_resonant_mode
     from sim.model.system import build_system as build
 
+    values = {name: getattr(args, name, None) for name in PARAMETERS}
+    check_plausible(values, allow=args.allow_implausible)  # a unit slip is refused, not computed with
     integrator = integrator_named(args.integrator)
     model = resolve_host(args).model
-    values = {name: getattr(args, name, None) for name in PARAMETERS}
+    try:
+        check_resonant_mode(model)  # walls at a node of mode 1: refused before any work
+    except SimulationInputError as exc:
+        raise SimulationInputError(f"{model.source}: {exc}") from None
     settings = system_settings(values, SystemSettings(contact_law=args.contact_law))
     if args.no_impactor:  # the impactor's values are checked all the same
         build_impactor(settings)

@@ -261,3 +261,71 @@ def test_two_sweeps_with_force_into_one_folder_do_not_race(tmp_path, model_file)
     third = _second(["sweep", "--level", "6", *FAST, "--model", model_file, "--out", str(out), "--force"])
     assert third.returncode == 0, third.stderr
     assert sorted(p.name for p in out.iterdir()) == ["sweep.csv", "sweep.json"]
+
+
+# ---- 2. silent wrong values --------------------------------------------------------------------------------------
+
+def test_a_damping_ratio_in_percent_is_read_as_such_and_a_bare_one_above_5_percent_refused(tmp_path, model_file,
+                                                                                          capsys):
+    base = ["sweep", "--level", "6", *FAST, "--model", model_file, "--json"]
+    assert main([*base, "--D", "0.085%"]) == 0
+    assert json.loads(capsys.readouterr().out)["D1"] == 0.00085  # the same float as --D 0.00085
+    one_line(capsys, main([*base, "--D", "0.085"]), 2, "--D 0.085: 8.5 % is implausible for a damping ratio (above "
+             "5 %); did you mean 0.085%? Give the unit, or pass --allow-implausible")
+    assert main([*base, "--D", "0.085", "--allow-implausible"]) == 0
+    assert json.loads(capsys.readouterr().out)["D1"] == 0.085
+
+
+def test_implausible_values_in_a_study_file_are_refused_with_the_reading_meant(tmp_path, capsys):
+    head = "[study]\nkind = 'interval'\n[excitation]\nlevels = [6.7]\n"
+    cases = [("[parameters.D]\nmax = 0.09\n", "[parameters.D] max = 0.09: 9 % is implausible for a damping ratio "
+                                              "(above 5 %); did you mean 0.09%?"),
+             ("[parameters.g]\nmax = '612 um'\nnominal = 0.6\n", "[parameters.g] nominal = 0.6: 0.6 m is implausible"),
+             ("[parameters.k_H]\n[interval]\ndesigns = ['residual']\nfix = { k_H = 350e3 }\n",
+              "[interval] fix.k_H = 350000.0: 3.5e+05 N/m^1.5 is implausible")]
+    for k, (table, phrase) in enumerate(cases):
+        study = tmp_path / f"s{k}.toml"
+        study.write_text(head + table)
+        one_line(capsys, main(["interval", str(study), "--out", str(tmp_path / f"o{k}")]), 2, f"{study}: {phrase}")
+        assert not (tmp_path / f"o{k}").exists()
+    from uq.methods import load_study
+
+    study.write_text(head + "[parameters.D]\nmin = '0.075 %'\nmax = '0.09%'\n")
+    assert load_study(study).space["D"].max == 0.0009
+
+
+def test_a_modal_file_whose_walls_stand_still_in_mode_1_is_refused_for_what_it_means(tmp_path, model_file):
+    """Through the console script: one line saying the IES sits at a node of the resonance (no numpy RuntimeWarning
+    about a division by zero first, no "a_base must be >= 0, got inf")."""
+    text = Path(model_file).read_text()
+    node = tmp_path / "node.toml"
+    node.write_text(text.replace("phi_wall_left = [\n    1.05,", "phi_wall_left = [\n    0.0,")
+                    .replace("phi_wall_right = [\n    1.05,", "phi_wall_right = [\n    0.0,"))
+    assert node.read_text() != text
+    study = tmp_path / "s.toml"
+    study.write_text(f"[study]\nkind = 'response'\nmodal_model = '{node}'\n[excitation]\nlevels = [6.7]\n")
+    for command in (["sweep", "--level", "6", *FAST, "--model", str(node)], ["response", str(study)]):
+        done = subprocess.run([sys.executable, "-m", "uq", *command, "--out", str(tmp_path / "o")], cwd=ROOT,
+                              capture_output=True, text=True)
+        assert done.returncode == 2 and len(done.stderr.splitlines()) == 1, done.stderr
+        assert "the cavity walls do not move in mode 1" in done.stderr and "node of the resonance" in done.stderr
+        assert "RuntimeWarning" not in done.stderr and not (tmp_path / "o").exists()
+
+
+def test_plot_and_compare_name_a_damaged_results_nc(tmp_path, model_file, capsys):
+    study = tmp_path / "r.toml"
+    study.write_text(f"[study]\nkind = 'response'\nmodal_model = '{model_file}'\nrepetitions = 1\n[excitation]\n"
+                     "levels = [6.7]\neta = { start = 0.98, stop = 0.99, n = 2 }\nwait = 0.02\nhold = 0.05\n"
+                     "[response]\nfigures = ['fig6']\n")
+    out = tmp_path / "out"
+    assert main(["response", str(study), "--out", str(out), "--quiet", "--jobs", "1"]) == 0
+    data = (out / "results.nc").read_bytes()
+    (out / "results.nc").write_bytes(data[: len(data) // 2])
+    capsys.readouterr()
+    for command in (["plot", str(out), "--out", str(tmp_path / "figs")], ["compare", str(out), "--out",
+                                                                          str(tmp_path / "cmp")]):
+        one_line(capsys, main(command), 2, f"{out / 'results.nc'} is damaged or cut short",
+                 f"rerun `ies response {study} --out {out} --resume`")
+    assert not (tmp_path / "figs").exists() and not (tmp_path / "cmp").exists()
+    assert main(["response", str(study), "--out", str(out), "--quiet", "--resume", "--no-figures"]) == 0
+    assert main(["plot", str(out), "--out", str(tmp_path / "figs")]) == 0  # written again: drawn

@@ -105,7 +105,8 @@ def write_index(out: Path) -> Path:
              "in the workbench's source. Figures are written as PNG and PDF.", ""]
     folders = sorted({p.parent for p in out.rglob("*") if p.is_file() and "tasks" not in p.relative_to(out).parts})
     for folder in folders:
-        files = sorted(p for p in folder.iterdir() if p.is_file() and p.name != "index.md")
+        files = sorted(p for p in folder.iterdir() if p.is_file() and p.name != "index.md"
+                       and not p.name.startswith("."))  # not the run's lock (sim.common.folder_lock)
         if not files:
             continue
         rel = folder.relative_to(out).as_posix()

@@ -173,13 +173,18 @@ class IESModel:
         task runs (and before anything is written)."""
         from sim.common.errors import SimulationInputError
         from sim.integration.integrators import get_integrator
+        from sim.model.system import check_resonant_mode
 
         protocol = self._stepped_sine()
         try:
             get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
         except SimulationInputError as exc:
             raise StudyError(f"[excitation]: {exc}") from None
-        self._rig()
+        rig = self._rig()
+        try:
+            check_resonant_mode(rig)  # walls at a node of mode 1: refused before any task runs
+        except SimulationInputError as exc:
+            raise StudyError(f"[study] modal_model {rig.source}: {exc}") from None
         self.check_physics({})
 
     def check_physics(self, params: Mapping[str, float]) -> None:
