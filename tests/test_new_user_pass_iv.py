@@ -329,3 +329,22 @@ def test_plot_and_compare_name_a_damaged_results_nc(tmp_path, model_file, capsys
     assert not (tmp_path / "figs").exists() and not (tmp_path / "cmp").exists()
     assert main(["response", str(study), "--out", str(out), "--quiet", "--resume", "--no-figures"]) == 0
     assert main(["plot", str(out), "--out", str(tmp_path / "figs")]) == 0  # written again: drawn
+
+
+# ---- 8. study files of the previous release ----------------------------------------------------------------------
+
+def test_a_pce_study_of_the_previous_release_with_n_runs_and_says_points_is_its_setting(tmp_path, capsys):
+    """`[sobol] n = 32` beside method = "pce" (the release before the method registry accepted and ignored it): the
+    study runs as then, with one line that `points` is the surrogate's setting; Saltelli's own keys stay refused
+    beside the other method."""
+    study = tmp_path / "old.toml"
+    study.write_text(ISHIGAMI.format(n=32).replace("[sobol]\n", "[sobol]\nmethod = 'pce'\n"))
+    assert main(["sobol", str(study), "--out", str(tmp_path / "o"), "--no-figures", "--quiet"]) == 0
+    err = [line for line in capsys.readouterr().err.splitlines() if "[sobol] n" in line]
+    assert err == [f"warning: {study}: [sobol] n = 32 is not a setting of method = \"pce\" (an earlier release ignored "
+                   "it too) and is ignored: its setting is points, here points = 32; remove n or write points = N"]
+    meta = json.loads((tmp_path / "o" / "study.json").read_text())
+    assert meta["study"]["sobol"]["method"] == "pce" and "n" not in meta["study"]["sobol"]
+    study.write_text(ISHIGAMI.format(n=32).replace("[sobol]\n", "[sobol]\npoints = 16\n"))
+    one_line(capsys, main(["sobol", str(study), "--out", str(tmp_path / "p")]), 2,
+             "[sobol] points only applies to method = \"pce\"")

@@ -61,6 +61,7 @@ a `StudyError` whose one line names the file, the key and the fix.
 from __future__ import annotations
 
 import math
+import sys
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -388,6 +389,7 @@ def method_settings(candidates: list[Any], table: Mapping[str, Any], context: Co
     own = {s.key for s in method.settings}
     if chosen and chosen != from_file:  # the command line switched the method: the file's keys of the other go
         table = {k: v for k, v in table.items() if k in own}
+    ignored = {k: table.pop(k) for k in list(table) if k in method.superseded}  # a file of an earlier release
     others: dict[str, list[str]] = {}
     for m in candidates:
         if m is not method:
@@ -415,7 +417,14 @@ def method_settings(candidates: list[Any], table: Mapping[str, Any], context: Co
             values[s.key] = s.read(table[s.key], context)
         else:
             values[s.key] = s.default
-    return method, method.finish(values, context)
+    values = method.finish(values, context)
+    for key, value in ignored.items():
+        instead = method.superseded[key]
+        where = f"{context.source}: " if context.source else ""
+        sys.stderr.write(f"warning: {where}[{kind}] {key} = {value!r} is not a setting of method = \"{method.name}\" "
+                         f"(an earlier release ignored it too) and is ignored: its setting is {instead}, here "
+                         f"{instead} = {values[instead]!r}; remove {key} or write {instead} = N\n")
+    return method, values
 
 
 def with_settings(study: Study, methods: Mapping[str, Any], given: Mapping[str, Any]) -> Study:
