@@ -600,7 +600,7 @@ def cache_command(args: argparse.Namespace) -> int:
     from sim.integration import jit
 
     root, chosen_by = kernel_cache.cache_root()
-    current = kernel_cache.folder_name(jit.CACHE_GROUP, jit.fingerprint())
+    current = kernel_cache.folder_name(jit.CACHE_GROUP, kernel_cache.code_version())  # as `ies --version` names it
     if args.clear:
         removed, freed = kernel_cache.clear(root)
         left = kernel_cache.version_folders(root)
@@ -613,7 +613,7 @@ def cache_command(args: argparse.Namespace) -> int:
         return 0
     folders = kernel_cache.version_folders(root)
     now = time.time()
-    data = {"folder": root, "chosen_by": chosen_by, "total_bytes": sum(e.size for e in folders),
+    data = {"folder": root, "chosen_by": chosen_by, "total_bytes": kernel_cache.disk_size(folders),
             "versions": [{"folder": e.path.name, "group": e.group, "bytes": e.size, "files": e.files,
                           "last_used": e.last_used, "current": e.path.name == current} for e in folders]}
     if args.json:
@@ -629,7 +629,8 @@ def cache_command(args: argparse.Namespace) -> int:
               f"{_ago(now - entry.last_used)}")
     if not folders:
         print("  empty: the next run compiles the kernels (once per version of the code)")
-    print(f"total {_megabytes(data['total_bytes'])} in {len(folders)} folder(s); `ies cache --clear` empties it")
+    print(f"total {_megabytes(data['total_bytes'])} on disk in {len(folders)} folder(s) (the versions share the machine "
+          "code of the same kernel sources); `ies cache --clear` empties it")
     return 0
 
 

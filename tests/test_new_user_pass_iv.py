@@ -348,3 +348,18 @@ def test_a_pce_study_of_the_previous_release_with_n_runs_and_says_points_is_its_
     study.write_text(ISHIGAMI.format(n=32).replace("[sobol]\n", "[sobol]\npoints = 16\n"))
     one_line(capsys, main(["sobol", str(study), "--out", str(tmp_path / "p")]), 2,
              "[sobol] points only applies to method = \"pce\"")
+
+
+# ---- 5. logs: one hash, plain progress lines ---------------------------------------------------------------------
+
+def test_one_hash_names_the_simulators_code_in_version_cache_and_the_kernel_folder(capsys):
+    from sim.integration import jit
+    from uq.problem.models import IESModel
+
+    assert main(["--version"]) == 0
+    line = capsys.readouterr().out.strip()
+    version = line.split("simulator code ")[1].rstrip(")")
+    assert main(["cache", "--json"]) == 0
+    current = [v["folder"] for v in json.loads(capsys.readouterr().out)["versions"] if v["current"]]
+    assert current == [f"sim-{version}"] == [jit.cache_folder().name]
+    assert IESModel().version() == version  # the code version in every task's key

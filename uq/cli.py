@@ -73,17 +73,18 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def version_line() -> str:
-    """``ies-workbench VERSION (simulator code HASH)``: the installed distribution's version and the hash of the
-    simulator's source (the code version in every study's task keys, `uq.problem.models`)."""
+    """``ies-workbench VERSION (simulator code HASH)``: the installed distribution's version and the simulator's code
+    version (`sim.common.kernel_cache.code_version`: in every study's task keys, and the name of the kernel folder
+    ``sim-HASH`` that `ies cache` lists)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    from uq.problem.models import IESModel
+    from sim.common.kernel_cache import code_version
 
     try:
         installed = version("ies-workbench")
     except PackageNotFoundError:
         installed = "(not installed)"
-    return f"ies-workbench {installed} (simulator code {IESModel().version()})"
+    return f"ies-workbench {installed} (simulator code {code_version()})"
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -15,7 +15,8 @@ Each model also aggregates the runs of one (point, level) over the repetitions: 
 -> {output: (value, standard error, samples)}; the simulator does it exactly as `ies sweep` does.
 
 Models are small picklable objects: they travel to joblib and Dask workers, and their ``version()``
-(a hash of the code that computes the outputs) is part of every cached task's key.
+(a hash of the code that computes the outputs: for the simulator its code version, which `ies --version` prints) is
+part of every cached task's key.
 """
 from __future__ import annotations
 
@@ -152,7 +153,11 @@ class IESModel:
         return parameter_of(PARAMETERS[name])
 
     def version(self) -> str:
-        return _source_version("sim", "uq/problem/models.py")
+        """The simulator's code version (`sim.common.kernel_cache.code_version`: what `ies --version` prints and the
+        kernel folder is named by); this file's own code, which turns a run into outputs, is in `describe`."""
+        from sim.common.kernel_cache import code_version
+
+        return code_version()
 
     def resolved_protocol(self) -> dict:
         """The protocol with every default filled in (for the study metadata)."""
@@ -271,8 +276,9 @@ class IESModel:
 
     def describe(self) -> dict:
         """Settings that define a task's computation (part of its cache key; the built-in rig is covered by
-        version, a modal file by its content)."""
-        out = {"class": type(self).__name__, "protocol": dict(self.protocol), "n_modes": self.n_modes}
+        version, a modal file by its content, the code that turns a run into outputs, this file, by its hash)."""
+        out = {"class": type(self).__name__, "protocol": dict(self.protocol), "n_modes": self.n_modes,
+               "outputs_code": _source_version("uq/problem/models.py")}
         from sim.model.contact_law import DEFAULT_LAW
 
         if self._law_name() != DEFAULT_LAW:  # the default law is not in the key (keys from before the choice)
