@@ -216,9 +216,15 @@ def add_simulation_arguments(parser: argparse.ArgumentParser, *, default_reps: i
 
 
 def add_force_argument(parser: argparse.ArgumentParser) -> None:
-    """--force: write into a non-empty --out folder (its files of the same names are replaced)."""
+    """--force: write into a non-empty --out folder (its files of the same names are replaced); --allow-large: run work
+    estimated above an hour (`sim.stepped_sine.cost`)."""
+    from sim.stepped_sine.cost import LIMIT_S, duration_text
+
     parser.add_argument("--force", action="store_true",
                         help="write into a non-empty --out folder, replacing its files of the same names (default: refuse)")
+    parser.add_argument("--allow-large", action="store_true",
+                        help=f"run work whose cost estimate (measured here before it starts) exceeds "
+                             f"{duration_text(LIMIT_S)} (refused by default)")
 
 
 def parse_grid(text: str, option: str) -> tuple[float, float, int]:
@@ -367,15 +373,13 @@ LONG_SWEEP_S = 60.0
 def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str) -> Iterator[tuple]:
     """(--out folder or None, protocol, model, impactor, one `sim.stepped_sine.protocol.sweep` result per level) of the
     options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder.
-    The integrator's kernels are warmed up (compiled on the first run) before one progress bar, `label`, counts
-    the stepped-sine points of every level and repetition (on a terminal; for one level only when it is long)."""
-    import sys
-
-    from tqdm import tqdm
-
+    The integrator's kernels are warmed up (compiled on the first run) before one progress report, `label`, counts
+    the stepped-sine points of every level and repetition (`sim.common.progress`: a bar on a terminal, plain lines in a
+    log; for one level only when it is long)."""
     from sim.common.files import check_writable
+    from sim.common.progress import progress
     from sim.integration.integrators import warm_up
-    from sim.stepped_sine.cost import announce, cost_per_simulated_second, simulated_seconds
+    from sim.stepped_sine.cost import check_estimate, estimate, seconds_per_run, simulated_seconds, worth_probing
     from sim.stepped_sine.protocol import sweep
 
     protocol = build_protocol(args)
@@ -386,12 +390,12 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
     long_run = len(levels) > 1 or total * (protocol.wait + protocol.hold) > LONG_SWEEP_S
     with output_folder(args.out, args.force) as folder:
         warm_up(protocol.integrator, law="hertz" if impactor is None else impactor.contact_law.law.name)
-        per_run = simulated_seconds(protocol, float(model.omega[0]))
-        if len(levels) * args.reps * per_run > LONG_SWEEP_S:  # long enough to be worth the probe (< 1 s)
-            announce(len(levels) * args.reps, per_run, cost_per_simulated_second(model, impactor, max(levels), protocol),
-                     "lower --reps, the --eta points, --wait/--hold or the number of levels")
-        with tqdm(total=total, desc=label, unit="pt", disable=not (long_run and sys.stderr.isatty()), leave=False,
-                  file=sys.stderr, dynamic_ncols=True) as bar:
+        if worth_probing(len(levels) * args.reps, simulated_seconds(protocol, float(model.omega[0]))):
+            cost = seconds_per_run(model, impactor, levels, protocol)  # measured here, before the first run
+            check_estimate(estimate({level: args.reps for level in levels}, cost),
+                           "lower --reps, the --eta points, --wait/--hold or the number of levels",
+                           allow_large=args.allow_large)
+        with progress(total, label, "pt", enabled=long_run, leave=False) as bar:
             results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed, progress=bar.update)
                        for level in levels]
         yield folder, protocol, model, impactor, results
@@ -513,7 +517,8 @@ def trace_command(args: argparse.Namespace) -> int:
     from sim.plots.figures import plot_trace
     from sim.common.files import check_writable, dumps, report_written, write_or_fallback
     from sim.integration.integrators import warm_up
-    from sim.stepped_sine.cost import announce, check_trace_memory, cost_per_simulated_second, simulated_seconds
+    from sim.stepped_sine.cost import ANNOUNCE_AFTER_S, check_estimate, check_trace_memory, estimate, probe_cost, \
+        simulated_seconds, worth_probing
     from sim.stepped_sine.protocol import check_level
 
     started = time.perf_counter()
@@ -527,11 +532,12 @@ def trace_command(args: argparse.Namespace) -> int:
         check_writable(args.plot, "--plot")
     with output_folder(args.out, args.force) as folder:
         warm_up(protocol.integrator, law="hertz" if impactor is None else impactor.contact_law.law.name)
-        per_run = (simulated_seconds(protocol, float(model.omega[0]))
-                   + args.periods / (protocol.eta[-1] * model.frequencies_hz[0]))  # the recorded periods
-        announce(1, per_run,
-                 cost_per_simulated_second(model, impactor, level, protocol) + samples / per_run * SAMPLE_COST_S,
-                 "lower --periods, --fs, the --eta points or --wait/--hold")
+        simulated = (simulated_seconds(protocol, float(model.omega[0]))
+                     + args.periods / (protocol.eta[-1] * model.frequencies_hz[0]))  # the recorded periods
+        if worth_probing(1, simulated) or samples * SAMPLE_COST_S > ANNOUNCE_AFTER_S:
+            seconds = simulated * probe_cost(model, impactor, level, protocol) + samples * SAMPLE_COST_S
+            check_estimate(estimate({level: 1}, {level: seconds}), "lower --periods, --fs, the --eta points or "
+                           "--wait/--hold", allow_large=args.allow_large)
         trace = record_trace(model, impactor, level, protocol, periods=args.periods, fs=args.fs, seed=args.seed)
         settings = {"integrator": protocol.integrator, "seed": args.seed, "protocol": dataclasses.asdict(protocol),
                     "fs_requested": args.fs, **system_data(model, impactor)}

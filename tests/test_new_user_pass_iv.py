@@ -207,8 +207,8 @@ def test_two_study_runs_into_one_folder_the_second_is_refused_naming_the_first(t
     from tests.support import AB_PARAMETERS
 
     study = tmp_path / "slow.toml"
-    study.write_text(f"[study]\nkind = 'interval'\nmodel = 'tests.support:sleepy'\n{AB_PARAMETERS}[interval]\n"
-                     "designs = ['individual', 'joint']\n")
+    study.write_text(f"[study]\nkind = 'interval'\nmodel = 'tests.support:sleepy'\nrepetitions = 6\n{AB_PARAMETERS}"
+                     "[interval]\ndesigns = ['individual', 'joint']\n")  # 66 runs of 0.25 s
     out = tmp_path / "out"
     command = ["interval", str(study), "--out", str(out), "--quiet", "--jobs", "1", "--no-figures"]
     first = _started(command, out / LOCK_FILE)
@@ -352,6 +352,31 @@ def test_a_pce_study_of_the_previous_release_with_n_runs_and_says_points_is_its_
 
 # ---- 5. logs: one hash, plain progress lines ---------------------------------------------------------------------
 
+def test_progress_in_a_log_is_plain_lines_never_a_bar(tmp_path, capsys, monkeypatch):
+    """stderr not a terminal (a log file): the tasks' progress is plain lines, one per PLAIN_EVERY_S (0 here: every
+    run), the last saying done; no carriage return, and every other line stands on its own."""
+    monkeypatch.setattr("sim.common.progress.PLAIN_EVERY_S", 0.0)
+    study = ishigami(tmp_path)
+    assert main(["sobol", str(study), "--out", str(tmp_path / "o"), "--no-figures"]) == 0
+    err = capsys.readouterr().err
+    assert "\r" not in err
+    lines = [line for line in err.splitlines() if line.startswith("tasks: ")]
+    assert len(lines) == 8 * (3 + 2) + 1 and lines[0].startswith("tasks: 1/40 run (2 %), ")
+    assert "left" in lines[0] and lines[-1].startswith("tasks: 40/40 run (100 %), ") and lines[-1].endswith(", done")
+
+
+def test_short_work_in_a_log_prints_no_progress_at_all(tmp_path):
+    """Through the console script into a file, with the default period: a study of seconds writes no progress (and
+    no bar's carriage returns) to the log."""
+    study = ishigami(tmp_path)
+    with open(tmp_path / "log.txt", "w") as log:
+        done = subprocess.run([sys.executable, "-m", "uq", "sobol", str(study), "--out", str(tmp_path / "o"),
+                               "--no-figures"], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=log)
+    assert done.returncode == 0
+    text = (tmp_path / "log.txt").read_text()
+    assert "\r" not in text and "tasks:" not in text and "it/s" not in text
+
+
 def test_one_hash_names_the_simulators_code_in_version_cache_and_the_kernel_folder(capsys):
     from sim.integration import jit
     from uq.problem.models import IESModel
@@ -363,3 +388,63 @@ def test_one_hash_names_the_simulators_code_in_version_cache_and_the_kernel_fold
     current = [v["folder"] for v in json.loads(capsys.readouterr().out)["versions"] if v["current"]]
     assert current == [f"sim-{version}"] == [jit.cache_folder().name]
     assert IESModel().version() == version  # the code version in every task's key
+
+
+# ---- 3. work estimated before it starts --------------------------------------------------------------------------
+
+INTERVAL = ("[study]\nkind = 'interval'\nrepetitions = 5\nmodal_model = '{model}'\n[parameters.D]\n[parameters.g]\n"
+            "[parameters.k_H]\n[excitation]\nlevels = [5.3, 6.7, 7.4]\neta = {{ start = 0.96, stop = 1.0, n = 21 }}\n"
+            "[interval]\ndesigns = ['individual', 'joint']\n")
+
+
+def test_a_study_estimated_above_an_hour_is_refused_before_its_first_run(tmp_path, model_file, capsys, monkeypatch):
+    """The issue's interval study that printed "about 80 h" after its first run: now its time comes from a probe of its
+    protocol before any run (here the probe is made to say 1 s per simulated second), and above an hour it is refused
+    with the estimate and --allow-large; with --allow-large the estimate is the first line, before the first run."""
+    import uq.engine.runner
+
+    monkeypatch.setattr("sim.stepped_sine.cost.probe_cost", lambda *a: 1.0)
+    ran = []
+    monkeypatch.setattr(uq.engine.runner, "evaluate", lambda *a: ran.append(1) or (_ for _ in ()).throw(
+        KeyboardInterrupt))
+    study = tmp_path / "big.toml"
+    study.write_text(INTERVAL.format(model=model_file))
+    out = tmp_path / "out"
+    one_line(capsys, main(["interval", str(study), "--out", str(out)]), 2, "cost estimate: 225 run(s) x 2.9 min",
+             "on one core", "more than the 1.0 h a command runs without --allow-large", "or pass --allow-large")
+    assert not ran and not out.exists()
+    assert main(["interval", str(study), "--out", str(out), "--allow-large", "--jobs", "1"]) == 130
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("warning: cost estimate: 225 run(s) x 2.9 min") and len(ran) == 1
+
+
+def test_a_sobol_study_refused_by_its_run_count_says_its_time(tmp_path, capsys):
+    study = tmp_path / "s.toml"
+    study.write_text("[study]\nkind = 'sobol'\n[parameters.D]\n[parameters.g]\n[excitation]\nlevels = [6.7]\n")
+    one_line(capsys, main(["sobol", str(study), "--n", str(2**17), "--out", str(tmp_path / "o")]), 2,
+             "524,288 runs (524,288 parameter points x 1 levels x 1 repetitions, about ", "h on one core)",
+             "--allow-large")
+
+
+def test_reproduce_all_is_refused_above_an_hour_before_its_calibration(tmp_path, capsys, monkeypatch):
+    import uq.commands.reproduce
+
+    monkeypatch.setattr("sim.stepped_sine.cost.probe_cost", lambda *a: 1.0)
+    monkeypatch.setattr(uq.commands.reproduce, "run_calibration", lambda *a: pytest.fail("calibrated before refusing"))
+    out = tmp_path / "out"
+    one_line(capsys, main(["reproduce", "all", "--out", str(out)]), 2, "cost estimate: 1255 run(s)",
+             "run --quick (minutes), one figure at a time", "--allow-large")
+    assert not out.exists()
+
+
+def test_a_design_is_refused_above_an_hour_before_its_first_run(tmp_path, model_file, capsys, monkeypatch):
+    import uq.engine.runner
+
+    monkeypatch.setattr("sim.stepped_sine.cost.probe_cost", lambda *a: 50.0)
+    monkeypatch.setattr(uq.engine.runner, "evaluate", lambda *a: pytest.fail("a run before the refusal"))
+    study = tmp_path / "design.toml"
+    study.write_text(f"[study]\nkind = 'design'\noutput = '{tmp_path / 'out'}'\n[design]\nexcitation = '1.5um'\n"
+                     f"clearance = '0.5mm:0.6mm:2'\nradius = '7.92mm'\ncandidates = 1\nreps = 1\nmodel = '{model_file}'\n"
+                     "[excitation]\neta = { start = 0.98, stop = 0.99, n = 2 }\n")  # the paper's wait and hold
+    one_line(capsys, main(["design", str(study), "--jobs", "1", "--quiet"]), 2, "cost estimate: ", "--allow-large")
+    assert not (tmp_path / "out").exists()

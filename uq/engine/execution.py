@@ -20,8 +20,8 @@ import numpy as np
 from sim.common.files import dumps, write_csv, write_text
 from sim.common.outputs import header
 from sim.common.folder_lock import locked
-from uq.engine.runner import (ResultStore, check_writable, dask_client, describe_model, prepare_output, release_output,
-                              run_tasks)
+from uq.engine.runner import (ResultStore, check_cost, check_writable, dask_client, describe_model, pending_tasks,
+                              prepare_output, release_output, run_tasks)
 from uq.outputs.tables import RUNS_CSV, parameter_columns, runs_rows
 from uq.problem.method import Analysis, Plan, Runs
 from uq.problem.study import Study
@@ -93,28 +93,35 @@ def run_study(study: Study, *, out: Path | None = None, jobs: int | None = 1, sc
     model = study.make_model()
     model.check()
     plan = method.plan(study)
-    check_run_total(len(plan.points), len(study.levels), study.repetitions, allow_large=allow_large)
+    typical = getattr(model, "typical_seconds_per_run", None)
+    check_run_total(len(plan.points), len(study.levels), study.repetitions, allow_large=allow_large,
+                    per_run_s=typical() if typical is not None else None)
     folder = Path(out or study.output)
     try:
         return _run(study, model, plan, folder, jobs=jobs, scheduler=scheduler, resume=resume, progress=progress,
-                    client=client)
+                    client=client, allow_large=allow_large)
     finally:
         release_output(folder)  # the lock prepare_output took, once the last file is written
 
 
 def _run(study: Study, model: Any, plan: Plan, folder: Path, *, jobs: int | None, scheduler: str | None, resume: bool,
-         progress: bool, client: Any) -> StudyResult:
-    """`run_study` of one study from its output folder on: the tasks, the analysis and the files."""
+         progress: bool, client: Any, allow_large: bool) -> StudyResult:
+    """`run_study` of one study from its output folder on: the kernels, the cost estimate (refused above an hour
+    unless `allow_large`), the tasks, the analysis and the files."""
     method = study.method
+    tasks = _tasks(plan.points, study)
     with dask_client(scheduler, client) as client:
         if hasattr(model, "with_rig"):
             model = model.with_rig()
-        folder = prepare_output(folder, resume=resume, study=(study.name, study_key(study, model)))
         if hasattr(model, "warm_up"):
-            model.warm_up()  # compile the kernels before the progress bar (workers load them from the cache)
+            model.warm_up()  # compile the kernels before the estimate and the progress bar (workers load them)
+        todo = pending_tasks(model, tasks, study.seed, folder) if resume else tasks
+        work = check_cost(model, todo, jobs=jobs, client=client, allow_large=allow_large,
+                          quiet=not progress)  # before the first run
+        folder = prepare_output(folder, resume=resume, study=(study.name, study_key(study, model)))
         started = time.perf_counter()
-        records, ran = run_tasks(model, _tasks(plan.points, study), study.seed, ResultStore(folder), jobs=jobs,
-                                 progress=progress, client=client)
+        records, ran = run_tasks(model, tasks, study.seed, ResultStore(folder), jobs=jobs, progress=progress,
+                                 client=client, expected_s=work.per_run_s if work is not None else None)
         elapsed = time.perf_counter() - started
     result = StudyResult(folder)
     failed = sum(1 for rec in records.values() if rec["error"])

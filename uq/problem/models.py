@@ -261,6 +261,28 @@ class IESModel:
 
         warm_up_all(self.kernel_variants())
 
+    def seconds_per_run(self, levels: list[float], runs: int) -> dict[float, float] | None:
+        """Estimated seconds of one run at each of `levels` on one core of this machine now
+        (`sim.stepped_sine.cost.seconds_per_run`: a probe of the study's protocol at its nominal point, the kernels
+        loaded by `warm_up`); None when `runs` runs cannot take long enough to be worth the probe."""
+        from sim.stepped_sine.cost import seconds_per_run, simulated_seconds, worth_probing
+
+        protocol = self._stepped_sine()
+        model, impactor = self.simulated_system({})
+        if not worth_probing(runs, simulated_seconds(protocol, float(model.omega[0]))):
+            return None
+        return seconds_per_run(model, impactor, levels, protocol)
+
+    def typical_seconds_per_run(self) -> float:
+        """Seconds of one run at the integrator's typical cost on one quiet core (`Integrator.typical_cost`): a size
+        before anything is compiled or measured."""
+        from sim.integration.integrators import integrator_named
+        from sim.stepped_sine.cost import simulated_seconds
+
+        protocol = self._stepped_sine()
+        rig = self.rig if self.rig is not None else self._rig()
+        return simulated_seconds(protocol, float(rig.omega[0])) * integrator_named(protocol.integrator).typical_cost
+
     def kernel_variants(self) -> list[tuple[str, str]]:
         """(integrator, contact law) of every kernel specialisation this study's runs use: its law and, since
         r_cont = 1 runs it, the law's elastic counterpart."""
