@@ -7,7 +7,8 @@ one way every stage writes a file, lives here, with what every stage's command l
 (`sim.common.options`, quantities with units from `sim.common.units`) and the redrawing of result folders (`sim.plots.redraw`). Its
 commands, `sim.cli.COMMANDS`: `ies modes`, `ies sweep`, `ies overview`, `ies trace`, `ies cache` (the compiled
 kernels' per-user cache, `sim.common.kernel_cache`; `sim.cli`), `ies orbits` (`sim.orbits.cli`: periodic orbits,
-their stability and bifurcations) and `ies impacts`, `ies modal-fit` (`sim.analysis.cli`); independent references for
+their stability and bifurcations), `ies impacts`, `ies modal-fit` (`sim.analysis.cli`) and `ies identify`, `ies update`,
+`ies linearity`, `ies synthetic-tests` (`sim.measured.cli`: the host as measured, Appendices A and B); independent references for
 tests in `sim.integration.references`.
 
 Public names, each imported from its module on first use, so that `import sim.common.errors` (done by the `ies`

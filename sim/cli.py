@@ -8,6 +8,8 @@
 * `ies trace`: time histories of one stepped-sine point, like Figs. 4 and 9a (Sects. 5.1, 5.5; `sim.analysis.trace`).
 * `ies orbits`: the periodic orbits with their stability and bifurcations (`sim.orbits`).
 * `ies impacts`, `ies modal-fit`: the analyses of measured or simulated signals (`sim.analysis.cli`).
+* `ies identify`, `ies update`, `ies linearity`, `ies synthetic-tests`: the host as measured, hammer and shaker tests
+  to its modes, its updated model and its damping interval (Appendices A, B; `sim.measured.cli`).
 * `ies cache`: where the compiled kernels are cached, how big the cache is, and emptying it (`sim.common.kernel_cache`).
 
 `add_commands(subparsers)` (at the end) registers them with the front door (`uq.cli`), which only dispatches. Heavy
@@ -24,6 +26,7 @@ from pathlib import Path
 from typing import Any, Iterator, Sequence
 
 from sim.analysis import cli as signal_cli
+from sim.measured import cli as measured_cli
 from sim.common.errors import SimulationInputError
 from sim.common.options import figure_file, positive_int
 
@@ -46,18 +49,25 @@ def add_modes_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
     parser.add_argument("--save", metavar="FILE", help="write the model as a modal-model file (.toml)")
     from sim.hosts.sources import add_host_arguments
+    from sim.model.sphere import add_sphere_arguments
 
     add_host_arguments(parser)  # sim.hosts.sources.HOST_SOURCES: --model, --solid, ...; --variant, --n-modes, FE options
+    add_sphere_arguments(parser)  # the sphere the mass ratio and k_H* are reported for; --g-star for a_base*
 
 
-def describe_modes(model: Any, rig: Any = None) -> dict:
+def describe_modes(model: Any, rig: Any = None, sphere: Any = None, nominal: Any = None) -> dict:
     """The JSON object of `ies modes --json` (Sect. 3.1, Eq. 7; Sect. 5 for a_base*; SI units): the model's
-    arrays, the modal mass ratio, a_base*, the paper's ode3 step dt = 2 pi/(15 omega_n), and with the
+    arrays, the host (its nominal D_1*, damping interval and wall material), the impactor (`sim.model.sphere.Sphere`:
+    radius, material, mass, k_H* of Eq. 8 on the host's wall; the paper's by default) and its modal mass ratio,
+    a_base* with the D* and g* it is normalised by, the paper's ode3 step dt = 2 pi/(15 omega_n), and with the
     built-in rig (`sim.hosts.rig.RigModes`) its updating summary (Appendix A)."""
     import numpy as np
 
-    from sim.model.system import SPHERE_MASS, a_base_star
+    from sim.model.sphere import sphere_of
+    from sim.model.system import Nominal, a_base_star
 
+    sphere = sphere_of(host_wall=model.wall_material) if sphere is None else sphere
+    nominal = Nominal.of(model) if nominal is None else nominal
     phi_c = model.phi_contact
     data = {
         "source": model.source,
@@ -68,14 +78,18 @@ def describe_modes(model: Any, rig: Any = None) -> dict:
         "phi_wall_right": model.phi_wall_right,
         "phi_tip": model.phi_tip,
         "participation": model.participation,
-        "modal_mass_ratio": SPHERE_MASS * phi_c**2,
+        "modal_mass_ratio": sphere.mass * phi_c**2,
         "phi_tip_over_phi_c": float(model.phi_tip[0] / phi_c),
         "phi_floor": model.phi_floor,
         "beam_mass_kg": model.beam_mass,
-        "a_base_star": a_base_star(model),
+        "host": host_data(model),
+        "impactor": sphere.describe(),
+        **nominal.describe(),
+        "a_base_star": a_base_star(model, nominal),
         "dt": 2.0 * np.pi / (15.0 * float(model.omega[-1])),
         "units": {"frequencies_hz": "Hz", "damping_ratios": "1", "phi": "1/sqrt(kg)", "participation": "sqrt(kg)",
-                  "beam_mass_kg": "kg (free length without block; null if unknown)", "a_base_star": "m", "dt": "s", "modal_mass_ratio": "1 (sphere mass m_a = %g kg)" % SPHERE_MASS},
+                  "beam_mass_kg": "kg (free length without block; null if unknown)", "a_base_star": "m", "dt": "s",
+                  "modal_mass_ratio": "1 (sphere mass m_a = %g kg)" % sphere.mass, "D_star": "1", "g_star_m": "m"},
     }
     if rig is not None:
         data["rig"] = rig.summary()
@@ -96,9 +110,15 @@ def modes_table(data: dict) -> str:
     if data["beam_mass_kg"] is not None:
         paper = f" (paper: ca. {data['rig']['beam_mass_paper_kg']:g} kg)" if data.get("rig") else ""
         lines.append(f"beam mass (free length without block, Eq. 10): {data['beam_mass_kg']:.4f} kg{paper}")
+    lines.append(host_text(data["host"]))
+    sphere = data["impactor"]
+    lines.append(f"sphere R = {1e3 * sphere['radius_m']:.4g} mm {sphere['material']['name']}, m_a = "
+                 f"{1e3 * sphere['mass_kg']:.4g} g, k_H* = {sphere['k_H_star_N_per_m1p5'] / 1e3**1.5:.6g} N/mm^1.5 (Eq. 8 "
+                 f"on {sphere['wall_material']['name']})")
     lines.append(f"modal mass ratio m_a phi_c^2 = {100 * data['modal_mass_ratio']:.2f} %   "
                  f"phi_tip/phi_c = {data['phi_tip_over_phi_c']:.4f}")
-    lines.append(f"a_base* = {data['a_base_star']:.4e} m   ode3 step dt = 2 pi/(15 omega_{data['n_modes']}) = {data['dt']:.4e} s")
+    lines.append(f"a_base* = {data['a_base_star']:.4e} m (D* = {100 * data['D_star']:.4g} %, g* = "
+                 f"{1e3 * data['g_star_m']:.4g} mm)   ode3 step dt = 2 pi/(15 omega_{data['n_modes']}) = {data['dt']:.4e} s")
     rig = data.get("rig")
     if rig:
         errors = ", ".join(f"{round(100 * e, 4) + 0.0:+.4f} %" for e in rig["f_model_error"])
@@ -126,7 +146,7 @@ def modes_command(args: argparse.Namespace) -> int:
         check_writable(args.save, "--save")  # before a solid model or a re-update takes minutes
     host = host_model(args)  # the row of sim.hosts.sources.HOST_SOURCES the options select
     model, rig, provenance, report = host.model, host.rig, host.provenance, host.report
-    data = describe_modes(model, rig)
+    data = describe_modes(model, rig, sphere_for(args, model), nominal_of(args, model))
     if provenance is not None:
         data["provenance"] = provenance
     if args.save:
@@ -139,14 +159,17 @@ def modes_command(args: argparse.Namespace) -> int:
 # ---- the system and the protocol, shared by ies sweep and ies overview ---------------------------------------
 
 def add_system_arguments(parser: argparse.ArgumentParser) -> None:
-    """Host and impactor options: the host's (`sim.hosts.sources.add_host_arguments`: --model, --solid, ...),
+    """Host and impactor options: the host's (`sim.hosts.sources.add_host_arguments`: --model, --solid, ...), the
+    sphere's (`sim.model.sphere.add_sphere_arguments`: --radius, --material, --mass, --wall-material, --g-star),
     --no-impactor, --contact-law and one option per parameter of `sim.model.parameters.PARAMETERS` that has one
     (Table 2's D, g, k_H; r_cont, friction, k_t; a contact law's own constant), with its aliases."""
     from sim.hosts.sources import add_host_arguments
     from sim.model.contact_law import DEFAULT_LAW, LAWS
     from sim.model.parameters import ALLOW_IMPLAUSIBLE, PARAMETERS
+    from sim.model.sphere import add_sphere_arguments
 
     add_host_arguments(parser)
+    add_sphere_arguments(parser)
     parser.add_argument("--no-impactor", action="store_true", help="simulate the host structure alone (linear)")
     laws = "; ".join(f"{name} ({law.summary}"
                      + (")" if law.collocation else ", the exact integrator takes its contacts by Dormand-Prince)")
@@ -241,39 +264,117 @@ def parse_grid(text: str, option: str) -> tuple[float, float, int]:
     raise SimulationInputError(f"{option} must look like START:STOP:N (e.g. 0.96:1.02:31), got {text!r}")
 
 
-def parse_levels(text: str) -> list[float]:
-    """Excitation levels a_base/a_base* (Sect. 5.3) from '1.26,5.3' or 'START:STOP:N'; each must be positive."""
-    import numpy as np
+class BaseAmplitude(float):
+    """An excitation given as the base amplitude a_base (m, with its unit: ``3.3um``) instead of a level
+    a_base/a_base*; `level_of` turns it into the level of the host's normalisation."""
 
+
+def level_value(text: str, option: str = "--level") -> float:
+    """An excitation level a_base/a_base* (a plain number > 0), or a base amplitude with a length unit (``3.3um``,
+    a `BaseAmplitude` in m); one `SimulationInputError` line otherwise."""
+    from sim.common.units import LENGTH_UNITS, Quantity, parse_quantity
     from sim.stepped_sine.protocol import check_level
 
+    text = str(text).strip()
+    if text[:1] in "0123456789.+-" and text and text[-1].isalpha():  # a number with its unit
+        quantity = Quantity("base amplitude a_base", "m", {**LENGTH_UNITS, "nm": 1e-9}, (1e-10, 1e-2), "3.3um")
+        value = parse_quantity(text, quantity)
+        if not value > 0:
+            raise SimulationInputError(f"{option} {text!r}: a base amplitude must be positive")
+        return BaseAmplitude(value)
+    try:
+        level = float(text)
+    except ValueError:
+        raise SimulationInputError(f"{option} must be a level a_base/a_base* like 7.4 or a base amplitude like 3.3um, "
+                                   f"got {text!r}") from None
+    return check_level(level)
+
+
+def level_option(text: str) -> float:
+    """argparse type of --level (`level_value`)."""
+    try:
+        return level_value(text)
+    except SimulationInputError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def level_of(value: float, model: Any, nominal: Any) -> float:
+    """The level a_base/a_base* (Sect. 5.3) of a `level_value`: a base amplitude over a_base* of `nominal`."""
+    from sim.model.system import a_base_star
+
+    return value / a_base_star(model, nominal) if isinstance(value, BaseAmplitude) else float(value)
+
+
+def parse_levels(text: str) -> list[float]:
+    """Excitation levels a_base/a_base* (Sect. 5.3) from '1.26,5.3' or 'START:STOP:N', or base amplitudes with their
+    unit ('1um,3um', '0.66um:6.6um:10'; `BaseAmplitude`); each must be positive."""
+    import numpy as np
+
     if ":" in text:
-        start, stop, n = parse_grid(text, "--levels")
+        parts = text.split(":")
+        if len(parts) != 3:
+            raise SimulationInputError(f"--levels must look like START:STOP:N (e.g. 2:8:13), got {text!r}")
+        start, stop = (level_value(part, "--levels") for part in parts[:2])
+        _, _, n = parse_grid(f"0:1:{parts[2]}", "--levels")
+        if isinstance(start, BaseAmplitude) != isinstance(stop, BaseAmplitude):
+            raise SimulationInputError(f"--levels {text!r}: give START and STOP both as levels or both with a unit")
         if n < 1 or (n > 1 and stop <= start):
             raise SimulationInputError(f"--levels {text!r} is empty or reversed; give START < STOP and N >= 1")
-        values = list(np.linspace(start, stop, n))
+        kind = BaseAmplitude if isinstance(start, BaseAmplitude) else float
+        values = [kind(v) for v in np.linspace(start, stop, n)]
     else:
         items = text.split(",")
         if len(items) > 1 and any(not v.strip() for v in items):
             raise SimulationInputError(f"--levels {text!r} has an empty entry; give numbers like 1.26,5.3,6.7")
-        try:
-            values = [float(v) for v in items if v.strip()]
-        except ValueError:
-            raise SimulationInputError(
-                f"--levels must be numbers like 1.26,5.3,6.7 or a grid START:STOP:N, got {text!r}") from None
+        values = [level_value(v, "--levels") for v in items if v.strip()]
     if not values:
         raise SimulationInputError("--levels is empty; give at least one excitation level")
+    if len({isinstance(v, BaseAmplitude) for v in values}) > 1:
+        raise SimulationInputError(f"--levels {text!r}: give every value as a level or every one with a unit")
     repeated = sorted({v for v in values if values.count(v) > 1})
     if repeated:
         raise SimulationInputError(f"--levels {text!r} repeats {', '.join(f'{v:g}' for v in repeated)}; give each "
                                    "excitation level once (more repetitions: --reps)")
-    return [check_level(v) for v in values]
+    return values
+
+
+def host_data(model: Any) -> dict:
+    """The JSON key `host` of every simulation command: the host's nominal D_1* (`D_star`), its damping interval and
+    where it comes from (`sim.model.system.ModalModel.damping_box`), its wall material (Eq. 8)."""
+    interval, said = model.damping_box()
+    return {"D_star": model.D_star, "damping_interval": list(interval), "damping_interval_source": said,
+            "wall_material": model.wall_material.describe(), "wall_material_given": model.wall is not None}
+
+
+def host_text(host: dict) -> str:
+    """One line of `host_data`: nominal damping, interval and wall."""
+    low, high = host["damping_interval"]
+    wall = host["wall_material"]["name"] + ("" if host["wall_material_given"] else " (none given: the rig's)")
+    source = "" if host["damping_interval_source"] == "the host's damping interval" else " (Table 2's, relative)"
+    return (f"host: D_1* = {100 * host['D_star']:.4g} %, interval {100 * low:.4g}-{100 * high:.4g} %{source}; walls "
+            f"{wall}")
+
+
+def sphere_for(args: argparse.Namespace, model: Any) -> Any:
+    """The sphere of the options (`sim.model.sphere.sphere_from_options`) on the host's walls unless --wall-material."""
+    from sim.model.sphere import sphere_from_options
+
+    return sphere_from_options(args, host_wall=model.wall_material)
+
+
+def nominal_of(args: argparse.Namespace, model: Any) -> Any:
+    """The normalisation of a command (Sect. 5): the host's nominal D_1* and g* = --g-star (the paper's 0.58 mm)."""
+    from sim.model.system import Nominal
+
+    return Nominal.of(model, getattr(args, "g_star", None))
 
 
 def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     """(modal model, impactor or None) of the host and impactor options (Eqs. 3-7, Table 2): the host through the
-    one resolver (`sim.hosts.sources.resolve_host`), the impactor built and checked by `sim.model.system.build_system`
-    from the options of `sim.model.parameters.PARAMETERS` and the integrator's record (its law, friction)."""
+    one resolver (`sim.hosts.sources.resolve_host`), the sphere of --radius, --material, --mass and --wall-material
+    (`sim.model.sphere`: its mass and Eq. 8's k_H*), then the options of `sim.model.parameters.PARAMETERS` (--g, --k-H
+    given outright, ...), built and checked by `sim.model.system.build_system` with the integrator's record (its law,
+    friction)."""
     from sim.hosts.sources import resolve_host
     from sim.integration.integrators import integrator_named
     from sim.model.parameters import PARAMETERS, SystemSettings, check_plausible, system_settings
@@ -288,23 +389,30 @@ def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
         check_resonant_mode(model)  # walls at a node of mode 1: refused before any work
     except SimulationInputError as exc:
         raise SimulationInputError(f"{model.source}: {exc}") from None
-    settings = system_settings(values, SystemSettings(contact_law=args.contact_law))
+    sphere = sphere_for(args, model)  # radius, material, mass, walls: the mass and Eq. 8's k_H* the options start from
+    settings = system_settings(values, sphere.settings(SystemSettings(contact_law=args.contact_law)))
     if args.no_impactor:  # the impactor's values are checked all the same
         build_impactor(settings)
         return (model if settings.D1 is None else model.with_damping(settings.D1)), None
-    return build(model, settings, integrator=integrator)
+    model, impactor = build(model, settings, integrator=integrator)
+    return model, dataclasses.replace(impactor, sphere=sphere)
 
 
-def system_data(model: Any, impactor: Any) -> dict:
+def system_data(model: Any, impactor: Any, nominal: Any = None) -> dict:
     """The JSON keys of the simulated system: `model` (its source), the host's parameters (`D1`, the damping ratio of
-    mode 1) and `impactor`: `contact_law` and every other row's key (`sim.model.parameters.UncertainParameter.json_key`:
-    `mass_kg`, `g_m`, `k_H_N_per_m1p5`, `r_cont`, `friction` (mu), `k_t_N_per_m`, a law's own constant, ...; a row
-    that feeds no field of its own only when it was given); None without impactor."""
+    mode 1 simulated) and `host` (`host_data`: its nominal D_1*, damping interval, wall), the normalisation (`D_star`,
+    `g_star_m`: `sim.model.system.Nominal`, the host's own unless `nominal` is given) and `impactor`: `contact_law`,
+    every other row's key (`sim.model.parameters.UncertainParameter.json_key`: `mass_kg`, `g_m`, `k_H_N_per_m1p5`,
+    `r_cont`, `friction` (mu), `k_t_N_per_m`, a law's own constant, ...; a row that feeds no field of its own only when
+    it was given) and `sphere` (`sim.model.sphere.Sphere.describe`: radius, material, k_H* of Eq. 8, wall); None
+    without impactor."""
     from sim.model.parameters import PARAMETERS, SystemSettings
-    from sim.model.system import settings_of
+    from sim.model.system import Nominal, settings_of
 
     host_rows = [row for row in PARAMETERS.values() if row.feeds.field == "D1"]
-    data = {"model": model.source, **{row.json_key: float(model.damping_ratios[0]) for row in host_rows}}
+    nominal = Nominal.of(model) if nominal is None else nominal
+    data = {"model": model.source, **{row.json_key: float(model.damping_ratios[0]) for row in host_rows},
+            "host": host_data(model), **nominal.describe()}
     if impactor is None:
         return {**data, "impactor": None}
     settings: SystemSettings = settings_of(model, impactor)
@@ -312,6 +420,8 @@ def system_data(model: Any, impactor: Any) -> dict:
     for row in PARAMETERS.values():
         if row not in host_rows and (value := row.reported(settings)) is not None:
             values[row.json_key] = value
+    if impactor.sphere is not None:
+        values["sphere"] = impactor.sphere.describe()
     return {**data, "impactor": values}
 
 
@@ -372,7 +482,9 @@ LONG_SWEEP_S = 60.0
 @contextmanager
 def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str) -> Iterator[tuple]:
     """(--out folder or None, protocol, model, impactor, one `sim.stepped_sine.protocol.sweep` result per level) of the
-    options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder.
+    options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder. Levels
+    are a_base/a_base* or base amplitudes (`BaseAmplitude`), normalised by the host's own D_1* and --g-star
+    (`nominal_of`); each result carries its level.
     The integrator's kernels are warmed up (compiled on the first run) before one progress report, `label`, counts
     the stepped-sine points of every level and repetition (`sim.common.progress`: a bar on a terminal, plain lines in a
     log; for one level only when it is long)."""
@@ -384,6 +496,8 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
 
     protocol = build_protocol(args)
     model, impactor = build_system(args)
+    nominal = nominal_of(args, model)
+    levels = [level_of(value, model, nominal) for value in levels]
     if args.plot:
         check_writable(args.plot, "--plot")
     total = len(levels) * args.reps * len(protocol.legs) * protocol.n_eta
@@ -391,13 +505,13 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
     with output_folder(args.out, args.force) as folder:
         warm_up(protocol.integrator, law="hertz" if impactor is None else impactor.contact_law.law.name)
         if worth_probing(len(levels) * args.reps, simulated_seconds(protocol, float(model.omega[0]))):
-            cost = seconds_per_run(model, impactor, levels, protocol)  # measured here, before the first run
+            cost = seconds_per_run(model, impactor, levels, protocol, nominal)  # measured here, before the first run
             check_estimate(estimate({level: args.reps for level in levels}, cost),
                            "lower --reps, the --eta points, --wait/--hold or the number of levels",
                            allow_large=args.allow_large)
         with progress(total, label, "pt", enabled=long_run, leave=False) as bar:
-            results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed, progress=bar.update)
-                       for level in levels]
+            results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed, nominal=nominal,
+                             progress=bar.update) for level in levels]
         yield folder, protocol, model, impactor, results
 
 
@@ -432,25 +546,27 @@ def report(args: argparse.Namespace, data: dict, written: list, plot: Any, text:
 
 def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies sweep`."""
-    parser.add_argument("--level", type=float, required=True, metavar="L",
-                        help="excitation level a_base/a_base* (-), a_base* = 2 D* g*/(phi_c phi^T M b)")
+    parser.add_argument("--level", type=level_option, required=True, metavar="L",
+                        help="excitation level a_base/a_base* (-), a_base* = 2 D* g*/(phi_c phi^T M b) with the host's "
+                             "nominal D* and g* (--g-star); or the base amplitude with its unit, e.g. 3.3um")
     add_simulation_arguments(parser, default_reps=5, figure="Fig. 5", stem="sweep")
 
 
 def sweep_command(args: argparse.Namespace) -> int:
     """`ies sweep`: one stepped-sine frequency response (Sects. 5.1, 5.2; Fig. 5)."""
     from sim.plots.figures import plot_sweep, sweep_title
-    from sim.stepped_sine.protocol import check_level
     from sim.stepped_sine.tables import SWEEP_COLUMNS, sweep_rows
 
     started = time.perf_counter()
-    level = check_level(args.level)
-    with simulation(args, [level], label=f"sweep {level:g}") as (folder, protocol, model, impactor, (result,)):
+    with simulation(args, [args.level], label="sweep") as (folder, protocol, model, impactor, (result,)):
+        nominal = nominal_of(args, model)
         data = result.to_dict()
-        data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps, **system_data(model, impactor))
+        data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps,
+                    **system_data(model, impactor, nominal))
         written = write_results(folder, "sweep", SWEEP_COLUMNS, sweep_rows(result), data)
-    lines = [f"# a_base/a_base* = {level:g}: {result.n_runs} runs, {result.n_samples} samples, "
+    lines = [f"# a_base/a_base* = {result.level:g}: {result.n_runs} runs, {result.n_samples} samples, "
              f"{protocol.integrator}, {data['wall_time_s']:.1f} s",
+             f"# {nominal.text()}; a_base = {result.a_base * 1e6:.4g} um",
              f"{'eta':>7} {'mean':>8} {'max':>8} {'cv':>6} {'imp/T':>6}  regime"]
     for i, eta in enumerate(result.eta):
         lines.append(f"{eta:7.4f} {result.mean[i]:8.4f} {result.max[i]:8.4f} {result.cv[i]:6.3f} "
@@ -465,7 +581,8 @@ def sweep_command(args: argparse.Namespace) -> int:
 def add_overview_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies overview`."""
     parser.add_argument("--levels", required=True, metavar="L1,L2,..|START:STOP:N",
-                        help="excitation levels a_base/a_base* (-), a list like 1.26,5.3,6.7,7.4 or a grid 2:8:13")
+                        help="excitation levels a_base/a_base* (-), a list like 1.26,5.3,6.7,7.4 or a grid 2:8:13; or "
+                             "base amplitudes with their unit, e.g. 1um,3um or 0.66um:6.6um:10")
     add_simulation_arguments(parser, default_reps=3, figure="Fig. 6", stem="overview")
 
 
@@ -475,14 +592,15 @@ def overview_command(args: argparse.Namespace) -> int:
     from sim.stepped_sine.tables import OVERVIEW_COLUMNS, dissipation_key, overview_data, overview_rows, overview_text
 
     started = time.perf_counter()
-    levels = parse_levels(args.levels)
-    with simulation(args, levels, label="overview") as (folder, protocol, model, _, results):
+    with simulation(args, parse_levels(args.levels), label="overview") as (folder, protocol, model, impactor, results):
+        levels = [result.level for result in results]
         data = {**overview_data(levels, results), "sweeps": [r.to_dict() for r in results], "reps": args.reps,
-                "seed": args.seed, "model": model.source, "wall_time_s": time.perf_counter() - started}
+                "seed": args.seed, **system_data(model, impactor, nominal_of(args, model)),
+                "wall_time_s": time.perf_counter() - started}
         data["dissipation"] = dissipation_key(data)
         written = write_results(folder, "overview", OVERVIEW_COLUMNS, overview_rows(data), data)
     return report(args, data, written, lambda path: plot_overview(data, path, overview_title(data)),
-                  overview_text(data))
+                  f"# {nominal_of(args, model).text()}\n{overview_text(data)}")
 
 
 # ---- ies trace ----------------------------------------------------------------------------------------------
@@ -491,7 +609,8 @@ def add_trace_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies trace`."""
     from sim.analysis.trace import DEFAULT_FS, DEFAULT_PERIODS
 
-    parser.add_argument("--level", type=float, required=True, metavar="L", help="excitation level a_base/a_base* (-)")
+    parser.add_argument("--level", type=level_option, required=True, metavar="L",
+                        help="excitation level a_base/a_base* (-), or the base amplitude with its unit, e.g. 3.3um")
     parser.add_argument("--eta", required=True, metavar="ETA|START:STOP:N",
                         help="eta = Omega/omega_1 of the traced point, or a grid: the run visits it as ies sweep does "
                              "(--sequence) and traces its last point")
@@ -519,12 +638,12 @@ def trace_command(args: argparse.Namespace) -> int:
     from sim.integration.integrators import warm_up
     from sim.stepped_sine.cost import ANNOUNCE_AFTER_S, check_estimate, check_trace_memory, estimate, probe_cost, \
         simulated_seconds, worth_probing
-    from sim.stepped_sine.protocol import check_level
 
     started = time.perf_counter()
-    level = check_level(args.level)
     protocol = build_protocol(args)
     model, impactor = build_system(args)
+    nominal = nominal_of(args, model)
+    level = level_of(args.level, model, nominal)
     check_trace_settings(model, protocol, args.periods, args.fs)  # before the kernels compile
     samples = trace_samples(model, protocol, args.periods, args.fs)
     check_trace_memory(samples, model.n_modes, "lower --periods or --fs")
@@ -535,12 +654,13 @@ def trace_command(args: argparse.Namespace) -> int:
         simulated = (simulated_seconds(protocol, float(model.omega[0]))
                      + args.periods / (protocol.eta[-1] * model.frequencies_hz[0]))  # the recorded periods
         if worth_probing(1, simulated) or samples * SAMPLE_COST_S > ANNOUNCE_AFTER_S:
-            seconds = simulated * probe_cost(model, impactor, level, protocol) + samples * SAMPLE_COST_S
+            seconds = simulated * probe_cost(model, impactor, level, protocol, nominal) + samples * SAMPLE_COST_S
             check_estimate(estimate({level: 1}, {level: seconds}), "lower --periods, --fs, the --eta points or "
                            "--wait/--hold", allow_large=args.allow_large)
-        trace = record_trace(model, impactor, level, protocol, periods=args.periods, fs=args.fs, seed=args.seed)
+        trace = record_trace(model, impactor, level, protocol, periods=args.periods, fs=args.fs, seed=args.seed,
+                             nominal=nominal)
         settings = {"integrator": protocol.integrator, "seed": args.seed, "protocol": dataclasses.asdict(protocol),
-                    "fs_requested": args.fs, **system_data(model, impactor)}
+                    "fs_requested": args.fs, **system_data(model, impactor, nominal)}
         plot = Path(args.plot) if args.plot else None
         data, written = write_or_fallback(
             lambda where: write_trace(where, trace, settings, plot if where == folder or plot is None else where / plot.name,
@@ -552,6 +672,7 @@ def trace_command(args: argparse.Namespace) -> int:
     print(f"# a_base/a_base* = {level:g}, eta = {trace.eta_actual:.5f} ({protocol.integrator}): {trace.amplitudes.size} "
           f"periods at fs = {trace.fs:.1f} Hz ({trace.samples_per_period} samples per period; requested {args.fs:g} Hz), "
           f"{data['wall_time_s']:.1f} s")
+    print(f"# {nominal.text()}")
     print(f"a/a_noabs*: mean {data['mean']:.4f}, max {data['max']:.4f}, cv {data['cv']:.3f}; "
           f"{data['impacts_per_period']:.2f} contact onsets per period, {len(data['impacts'])} impacts between samples")
     report_written(written)
@@ -649,12 +770,13 @@ COMMANDS = (("modes", MODES_HELP, add_modes_arguments, modes_command),
             ("orbits", ORBITS_HELP, add_orbits_arguments, orbits_command),
             ("impacts", signal_cli.IMPACTS_HELP, signal_cli.add_impacts_arguments, signal_cli.impacts_command),
             ("modal-fit", signal_cli.MODAL_FIT_HELP, signal_cli.add_modal_fit_arguments, signal_cli.modal_fit_command),
-            ("cache", CACHE_HELP, add_cache_arguments, cache_command))
+            ("cache", CACHE_HELP, add_cache_arguments, cache_command),
+            *measured_cli.commands(output_folder))
 
 
 def add_commands(subparsers: Any) -> None:
-    """Register `modes`, `sweep`, `overview`, `trace`, `orbits`, `impacts`, `modal-fit` and `cache` (COMMANDS) on the
-    front door's subparsers (argparse)."""
+    """Register `modes`, `sweep`, `overview`, `trace`, `orbits`, `impacts`, `modal-fit`, `cache` and the measured host's
+    `identify`, `update`, `linearity`, `synthetic-tests` (COMMANDS) on the front door's subparsers (argparse)."""
     for name, help_text, add_arguments, run in COMMANDS:
         parser = subparsers.add_parser(name, help=help_text, description=help_text)
         add_arguments(parser)

@@ -145,10 +145,11 @@ def test_the_walk_sees_every_kind_of_import():
 
 #: Inside `sim`, the simulator's parts as a pipeline: the shared layer; the coupled system and the paper's vocabulary;
 #: the host models; the integrators; the stepped-sine protocol, its measures and the paper's landmarks; signal
-#: analysis; the reduced (slow-flow) model; the periodic orbits of the full model (they start from the slow flow's);
-#: figures. A part may import the parts before it, none after it. `sim` itself (its lazy public names) and `sim.cli`
+#: analysis; the host as measured (hammer and shaker tests to its modes and damping interval); the reduced
+#: (slow-flow) model; the periodic orbits of the full model (they start from the slow flow's); figures. A part may import the parts before it, none after it. `sim` itself (its lazy public names) and `sim.cli`
 #: (the commands) may import every part.
-SIM_PIPELINE = ("common", "model", "hosts", "integration", "stepped_sine", "analysis", "reduced", "orbits", "plots")
+SIM_PIPELINE = ("common", "model", "hosts", "integration", "stepped_sine", "analysis", "measured", "reduced", "orbits",
+                "plots")
 #: sub-package -> the sub-packages it may import (besides itself): those before it in SIM_PIPELINE
 SIM_LAYERS: dict[str, set[str]] = {part: set(SIM_PIPELINE[:i]) for i, part in enumerate(SIM_PIPELINE)}
 #: The written-down exceptions: (importing module, the part after it that it may also import), each with its reason

@@ -595,7 +595,28 @@ def draw_orbits(tmp: Path) -> None:
                                    tmp / "orbits.png", max_period=2, title="periodic orbits")
 
 
-FIGURES = {"response (fig5, fig6, figD2, figD3)": draw_response, "orbits": draw_orbits, "design (map, curves)": draw_design, "sweep": draw_sweep, "overview": draw_overview_command,
+def draw_measured(tmp: Path) -> None:
+    """`ies identify`'s stabilization diagram and FRF (Fig. A.1's layout) and `ies linearity`'s Fig. B.2, from an
+    analytic four-mode FRF and three levels of a known single nonlinear mode."""
+    from sim.measured.figures import draw_frf, draw_linearity, draw_stabilization
+    from sim.measured.identification import Band, identify
+    from sim.measured.linearity import LevelRecord, NonlinearMode, damping_interval, half_power
+
+    f = np.arange(1, 20001) * 0.5
+    w, wj = 2 * np.pi * f[:, None], 2 * np.pi * np.array([117.4, 886.0, 2494.0, 4712.0])
+    H = np.sum(np.array([1.84, 1.39, 1.02, 0.57]) / (wj**2 - w**2 + 2j * np.array([6e-4, 4.4e-3, 5e-4, 3.1e-3]) * wj * w), 1)
+    result = identify(f, H[None], ["tip"], Band(50, 6400), modes=4)
+    draw_stabilization(tmp / "stabilization.png", result, np.abs(H))
+    draw_frf(tmp / "frf.png", f, {"tip": H}, result.synthesized, {"tip": np.ones(f.size)}, "synthesized", (50, 6400))
+    mode = NonlinearMode(2 * np.pi * 117.4, (-1e-3,), 6e-4, (4e-4,), 1.43, 1e-3)
+    steps = 117.4 * np.linspace(0.992, 1.004, 25)
+    levels = [LevelRecord(a, steps, np.array([mode.responses(2 * np.pi * x, a, 2e-3).max() for x in steps]), "level")
+              for a in (3e-7, 6e-7, 1.2e-6)]
+    draw_linearity(tmp / "linearity.png", levels, mode, [half_power(lv) for lv in levels],
+                   damping_interval(mode, 0.58e-3, 0.95e-3, (0.3e-3, 1e-3)))
+
+
+FIGURES = {"response (fig5, fig6, figD2, figD3)": draw_response, "measured host (figA1, figB2)": draw_measured, "orbits": draw_orbits, "design (map, curves)": draw_design, "sweep": draw_sweep, "overview": draw_overview_command,
            "interval (fig7, fig8, nominal-levels)": draw_interval, "interval of r (figD3)": draw_interval_restitution,
            "sobol": draw_sobol, "series (fig11, figC1, compare)": draw_series, "trace": draw_trace,
            "motion": draw_motion, "modal-fit (fig9b)": draw_modal_fit, "calibrate": draw_calibrate,
@@ -620,7 +641,8 @@ def test_no_legend_on_data_and_no_title_on_a_title(checked, name, look):
 
 
 @pytest.mark.parametrize("name", ["response (fig5, fig6, figD2, figD3)", "interval (fig7, fig8, nominal-levels)",
-                                  "interval of r (figD3)", "sobol", "trace", "series (fig11, figC1, compare)"])
+                                  "interval of r (figD3)", "sobol", "trace", "series (fig11, figC1, compare)",
+                                  "measured host (figA1, figB2)"])
 def test_grayscale_leaves_nothing_in_colour(checked, name):
     with style("grayscale"):
         drawn = checked(FIGURES[name])

@@ -125,7 +125,9 @@ def sweep_table(lines: list[str]) -> tuple[str, list[tuple], tuple, list[str]]:
     written = [line for line in lines if line.startswith("wrote ")]
     lines = lines[:len(lines) - len(written)]
     rows = []
-    for line in lines[2:-1]:
+    for line in lines[1:-1]:
+        if line.startswith("#") or line.lstrip().startswith("eta"):  # the normalisation's line, the column heads
+            continue
         eta, mean, peak, cv, impacts, regime = SWEEP_ROW.match(line).groups()
         rows.append((eta, float(mean), float(peak), float(cv), float(impacts), regime))
     mean, eta_mean, regime, peak, eta_max = SWEEP_SUMMARY.match(lines[-1]).groups()

@@ -9,6 +9,7 @@ from pathlib import Path
 from sim.analysis.cli import IMPACTS_JSON, MODAL_FIT_JSON
 from sim.analysis.trace import TRACE_CSV, TRACE_JSON
 from sim.common.outputs import OutputFile, describe
+from sim.measured.tables import TABLES as MEASURED_TABLES
 from sim.orbits.tables import ORBITS_CSV
 from sim.stepped_sine.tables import OVERVIEW_CSV, OVERVIEW_JSON, SWEEP_CSV, SWEEP_JSON
 from uq.design.results import DESIGN_CSV, DESIGN_JSON, DESIGN_LEVELS_CSV
@@ -46,6 +47,7 @@ SECTIONS: tuple[tuple[str, tuple[OutputFile, ...]], ...] = (
     ("Several response studies side by side (`ies compare`)", (COMPARE_CSV,)),
     ("Designs (`ies design`)", (DESIGN_CSV, DESIGN_LEVELS_CSV, DESIGN_JSON)),
     ("Periodic orbits (`ies orbits`)", (ORBITS_CSV,)),
+    ("The measured host (`ies identify`, `ies linearity`)", MEASURED_TABLES),
 )
 
 INTRO = """# Output reference

@@ -139,7 +139,7 @@ def trace_samples(model: ModalModel, protocol: SteppedSine, periods: int, fs: fl
 
 def record_trace(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *,
                  periods: int = DEFAULT_PERIODS, fs: float = DEFAULT_FS, seed: int = 0, rep: int = 0,
-                 nominal: Nominal = Nominal()) -> Trace:
+                 nominal: Nominal | None = None) -> Trace:
     """Simulate the stepped-sine run of `protocol` at a_base = level a_base* (Sect. 5.1) to its last point and
     record `periods` excitation periods of that point's hold at fs (Hz, rounded to M f_exc; module docstring).
 

@@ -42,6 +42,8 @@ LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6}
 CLEARANCE = Quantity("clearance g", "m", LENGTH_UNITS, (1e-5, 1e-2), "0.58mm")
 #: the sphere's radius R (Sect. 2: 7.92 mm); plausible 0.5-100 mm
 RADIUS = Quantity("sphere radius R", "m", LENGTH_UNITS, (0.5e-3, 0.1), "7.92mm")
+#: the sphere's mass m_a (Table 1: 17.7 g); plausible 0.1 g - 10 kg
+MASS = Quantity("sphere mass m_a", "kg", {"kg": 1.0, "g": 1e-3}, (1e-4, 10.0), "17.7g")
 #: the Hertzian spring constant k_H (Eq. 8: 282e3 N/mm^1.5 = 8.918e9 N/m^1.5); plausible 1e6-1e14 N/m^1.5
 K_H = Quantity("Hertzian spring constant k_H", "N/m^1.5", {"N/m^1.5": 1.0, "N/mm^1.5": 1e3**1.5}, (1e6, 1e14), "282e3N/mm^1.5")
 #: the tangential stiffness k_t of the floor contact (Appendix C: 22 kN/mm = 2.2e7 N/m); plausible 1e4-1e10 N/m

@@ -30,7 +30,7 @@ import numpy as np
 
 from sim.common.errors import SimulationInputError
 from sim.common.files import write_text
-from sim.hosts.rig import damping_ratios
+from sim.hosts.rig import damping_ratios, rig_host
 from sim.model.system import ModalModel
 
 UNITS = {"m-kg-s": (1.0, 1.0), "mm-t-s": (1e-3, 1e3)}  # (length in m, mass in kg) of one unit
@@ -428,7 +428,7 @@ def calculix_modal_model(frd: str | os.PathLike, inp: str | os.PathLike, wall_le
         frequencies_hz=result.frequencies[chosen], damping_ratios=damping_ratios(chosen.size),
         phi_wall_left=values["wall_left"] * sign, phi_wall_right=values["wall_right"] * sign,
         phi_tip=values["tip"] * sign, participation=gamma, source=f"CalculiX job {frd.name} (sim.hosts.calculix)",
-        phi_floor=values["floor"] * sign if floor else None, beam_mass=beam_mass)
+        phi_floor=values["floor"] * sign if floor else None, beam_mass=beam_mass, **rig_host(walls=False))
     coords = {node: xyz for node, xyz in zip(deck.node_ids, deck.coordinates * length_unit)}
     provenance = {
         "model": "CalculiX eigenvectors (sim.hosts.calculix)", "frd": str(frd), "inp": str(inp), "dat": str(dat),

@@ -14,6 +14,12 @@ Format (TOML, UTF-8). Arrays have one value per retained mode, in ascending freq
     beam_mass_kg   = 1.573           # optional: mass of the beam's free length without the block, kg (Eq. 10)
     phi_floor      = [1.380, 1.267]  # optional: same at the cavity floor on the beam axis, 1/sqrt(kg) (App. C)
 
+    [host]                           # optional: what the host is besides its modes
+    damping_interval = [0.00075, 0.0009]  # the interval of D_1 (-) the studies and `ies design` propagate; it must
+                                     # contain damping_ratios[0] (Table 2 for the seed rig; `ies linearity` measures it)
+    wall_material = "steel"          # the cavity walls' material for Eq. 8: steel (default), aluminium, titanium,
+                                     # brass, cast-iron, or your own "E=70GPa,nu=0.33" (or wall_E_Pa and wall_nu)
+
     [units]                          # optional; if present each entry must name the unit above
     frequencies_hz = "Hz"
     damping_ratios = "1"
@@ -25,7 +31,10 @@ Format (TOML, UTF-8). Arrays have one value per retained mode, in ascending freq
     [provenance.convergence]         # mesh-convergence table); readers ignore it
 
 The optional keys are needed only by the damped contact law (beam_mass_kg) and by friction (phi_floor);
-files without them load as before, and those laws then refuse the model with one line naming the key.
+files without them load as before, and those laws then refuse the model with one line naming the key. Without a
+[host] table the walls are steel and the damping interval is Table 2's relative one around damping_ratios[0]
+(`sim.model.system.ModalModel.damping_box`; every command says so). damping_ratios[0] is the host's nominal D_1*: the
+amplitudes are normalised by it (Sect. 5), so that the host alone peaks at a / a_noabs* = 1.
 
 Signs follow sim/model/system.py: the wall directions w_l, w_r are both +x, so phi_wall_* are the x-components of
 the mass-normalised modes (phi_j^T M phi_j = 1 kg^0). A mode's overall sign is free, but phi_wall_*, phi_tip,
@@ -49,6 +58,8 @@ FORMAT_VERSION = 1
 ARRAY_KEYS = ("frequencies_hz", "damping_ratios", "phi_wall_left", "phi_wall_right", "phi_tip", "participation")
 OPTIONAL_ARRAY_KEYS = ("phi_floor",)
 BEAM_MASS_KEY = "beam_mass_kg"
+#: the keys of the [host] table
+HOST_KEYS = ("damping_interval", "wall_material", "wall_E_Pa", "wall_nu")
 UNITS = {"frequencies_hz": "Hz", "damping_ratios": "1", "phi": "1/sqrt(kg)", "participation": "sqrt(kg)"}
 
 _HEADER = """\
@@ -108,9 +119,61 @@ def load_modal_model(path: str | os.PathLike) -> ModalModel:
     if beam_mass is not None and (isinstance(beam_mass, bool) or not isinstance(beam_mass, (int, float))):
         raise SimulationInputError(f"{path}: '{BEAM_MASS_KEY}' must be a number (kg), e.g. {BEAM_MASS_KEY} = 1.573")
     try:
-        return ModalModel(**arrays, source=str(source), beam_mass=beam_mass)
+        return ModalModel(**arrays, source=str(source), beam_mass=beam_mass, **host_table(data.get("host", {})))
     except SimulationInputError as exc:
         raise SimulationInputError(f"{path}: {exc}") from None
+
+
+def host_table(table: object) -> dict:
+    """The `ModalModel` fields of a [host] table (damping_interval, wall; format in the module docstring); one
+    `SimulationInputError` line (without the file's name) for an unknown key or a value of the wrong kind."""
+    from sim.model.materials import Material, wall_material
+
+    if not isinstance(table, dict):
+        raise SimulationInputError("'host' must be a table, e.g. [host] wall_material = \"steel\"")
+    unknown = sorted(set(table) - set(HOST_KEYS))
+    if unknown:
+        raise SimulationInputError(f"unknown key(s) {', '.join(unknown)} in [host]; known: {', '.join(HOST_KEYS)}")
+    fields: dict = {}
+    if "damping_interval" in table:
+        interval = table["damping_interval"]
+        if (not isinstance(interval, list) or len(interval) != 2
+                or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in interval)):
+            raise SimulationInputError(f"[host] damping_interval must be two damping ratios [low, high], e.g. "
+                                       f"[0.00075, 0.0009], got {interval!r}")
+        fields["damping_interval"] = tuple(float(v) for v in interval)
+    own = [key for key in ("wall_E_Pa", "wall_nu") if key in table]
+    if "wall_material" in table and own:
+        raise SimulationInputError("[host] give wall_material or wall_E_Pa and wall_nu, not both")
+    if "wall_material" in table:
+        if not isinstance(table["wall_material"], str):
+            raise SimulationInputError(f"[host] wall_material must be a name such as \"aluminium\" or \"E=70GPa,nu=0.33\", "
+                                       f"got {table['wall_material']!r}")
+        fields["wall"] = wall_material(table["wall_material"])
+    elif own:
+        if len(own) == 1:
+            raise SimulationInputError(f"[host] has {own[0]} but not {({'wall_E_Pa', 'wall_nu'} - set(own)).pop()}; Eq. 8 "
+                                       "needs the wall's E (Pa) and nu")
+        E, nu = table["wall_E_Pa"], table["wall_nu"]
+        if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in (E, nu)):
+            raise SimulationInputError("[host] wall_E_Pa and wall_nu must be numbers (Pa and -)")
+        fields["wall"] = wall_material(f"E={float(E)!r},nu={float(nu)!r}")
+    return fields
+
+
+def host_document(model: ModalModel) -> dict:
+    """The [host] table of a model (what `host_table` reads back): its damping interval and wall, where it has them."""
+    from sim.model.materials import WALL_MATERIALS
+
+    doc: dict = {}
+    if model.damping_interval is not None:
+        doc["damping_interval"] = [float(v) for v in model.damping_interval]
+    if model.wall is not None:
+        if WALL_MATERIALS.get(model.wall.name) == model.wall:
+            doc["wall_material"] = model.wall.name
+        else:
+            doc.update(wall_E_Pa=model.wall.E, wall_nu=model.wall.nu)
+    return doc
 
 
 def modal_model_document(model: ModalModel, provenance: dict | None = None) -> dict:
@@ -123,6 +186,8 @@ def modal_model_document(model: ModalModel, provenance: dict | None = None) -> d
         doc["phi_floor"] = [float(v) for v in model.phi_floor]
     if model.beam_mass is not None:
         doc[BEAM_MASS_KEY] = model.beam_mass
+    if host := host_document(model):
+        doc["host"] = host
     doc["units"] = dict(UNITS)
     if provenance:
         doc["provenance"] = provenance

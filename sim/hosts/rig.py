@@ -534,6 +534,15 @@ def damping_ratios(n_modes: int) -> np.ndarray:
     return np.array([DAMPING_RATIOS[j] if j < len(DAMPING_RATIOS) else DAMPING_HIGHER for j in range(n_modes)])
 
 
+def rig_host(walls: bool = True) -> dict:
+    """The `ModalModel` fields of a host with the seed rig's damping (`damping_ratios`): Table 2's interval of D_1
+    (Appendix B) and, with `walls`, the rig's steel walls (Table 1)."""
+    from sim.model.materials import STEEL_WALL
+    from sim.model.parameters import D1_INTERVAL
+
+    return {"damping_interval": D1_INTERVAL, **({"wall": STEEL_WALL} if walls else {})}
+
+
 @dataclass(frozen=True)
 class UpdatingProblem:
     """One model-updating problem (Appendix A): the free RigParameters fields with bounds (log10 for
@@ -599,7 +608,8 @@ def rig_modal_model(params: RigParameters, n_modes: int = 9, source: str = "") -
     return ModalModel(
         frequencies_hz=modes.frequencies_hz, damping_ratios=damping_ratios(n_modes),
         phi_wall_left=modes.phi_contact, phi_wall_right=modes.phi_contact, phi_tip=modes.phi_tip,
-        participation=modes.participation, beam_mass=modes.beam_mass, phi_floor=modes.phi_floor, source=source)
+        participation=modes.participation, beam_mass=modes.beam_mass, phi_floor=modes.phi_floor, source=source,
+        **rig_host())
 
 
 @lru_cache(maxsize=8)

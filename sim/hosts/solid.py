@@ -52,7 +52,8 @@ import scipy.sparse.linalg
 
 from sim.common.errors import SimulationInputError
 from sim.common.files import to_jsonable
-from sim.hosts.rig import JOINT_SPRING_PARAMETERS, NU_STEEL, RHO_STEEL, ContactHeights, RigGeometry, damping_ratios
+from sim.hosts.rig import (JOINT_SPRING_PARAMETERS, NU_STEEL, RHO_STEEL, ContactHeights, RigGeometry, damping_ratios,
+                           rig_host)
 from sim.model.system import ModalModel
 
 INSTALL_HINT = "the 3D solid model needs scikit-fem: pip install '.[solid]'"
@@ -678,7 +679,7 @@ def solid_modal_model(modes: SolidModes, patch_radius: float = 0.0,
         frequencies_hz=modes.frequencies_hz, damping_ratios=damping_ratios(modes.n_modes),
         phi_wall_left=sign * left, phi_wall_right=sign * right, phi_tip=sign * modes.tip_values,
         participation=sign * modes.participation[:, 0], beam_mass=s.material.rho * g.beam_volume,
-        phi_floor=sign * floor,
+        phi_floor=sign * floor, **rig_host(),
         source=f"3D solid model (sim.hosts.solid, {s.element}, element size {1e3 * s.element_size:g} mm, "
                f"{s.n_free} free DOFs, E = {s.material.E / 1e9:g} GPa)")
 

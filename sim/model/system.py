@@ -38,15 +38,16 @@ Conventions shared by every integrator in `sim`
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any, NamedTuple
 
 import numpy as np
 
 from sim.model.contact_law import HERTZ, ContactLaw, Law, contact_law_of
 from sim.common.errors import SimulationInputError
-from sim.model.parameters import (CLEARANCE_NOMINAL, D1_NOMINAL, K_H_NOMINAL, K_T_PAPER,  # noqa: F401 (re-exported)
-                                  PARAMETERS, SPHERE_MASS, SystemSettings)
+from sim.model.materials import STEEL_WALL, Material
+from sim.model.parameters import (CLEARANCE_NOMINAL, D1_INTERVAL, D1_NOMINAL, K_H_NOMINAL,  # noqa: F401 (re-exported)
+                                  K_T_PAPER, PARAMETERS, SPHERE_MASS, SystemSettings)
 
 
 
@@ -64,6 +65,12 @@ class ModalModel:
         beam_mass: mass of the beam's free length without the block (kg), for d_H of Eq. 10; None if unknown.
         phi_floor: mass-normalised x-values at the cavity floor on the beam axis (1/sqrt(kg)), the host point
             under the sphere's friction contact (Appendix C); None if unknown.
+        nominal_damping: the host's nominal damping ratio of mode 1, D_1* (-), by which every amplitude and level is
+            normalised (Sect. 5); None: damping_ratios[0] (`D_star`). It stays when a study varies D_1 (`with_damping`).
+        damping_interval: (low, high) of D_1 (-), the interval the studies and `ies design` propagate (Table 2 for
+            the seed rig; measured: `ies linearity`); None: unknown (`damping_box` then states a default).
+        wall: the material of the cavity walls (`sim.model.materials`; Eq. 8 takes its E and nu); None: the rig's
+            steel (`wall_material`).
     """
 
     frequencies_hz: np.ndarray
@@ -75,6 +82,9 @@ class ModalModel:
     source: str = "unspecified"
     beam_mass: float | None = None
     phi_floor: np.ndarray | None = None
+    nominal_damping: float | None = None
+    damping_interval: tuple[float, float] | None = None
+    wall: Material | None = None
 
     def __post_init__(self) -> None:
         names = ("frequencies_hz", "damping_ratios", "phi_wall_left", "phi_wall_right", "phi_tip", "participation")
@@ -104,6 +114,30 @@ class ModalModel:
             if isinstance(mass, bool) or not isinstance(mass, (int, float)) or not math.isfinite(mass) or mass <= 0:
                 raise SimulationInputError(f"modal model: beam mass must be a positive number (kg), got {mass!r}")
             object.__setattr__(self, "beam_mass", float(mass))
+        if self.nominal_damping is not None:
+            object.__setattr__(self, "nominal_damping", check_open_unit(self.nominal_damping, "modal model: the "
+                                                                        "nominal damping ratio D_1*"))
+        if self.damping_interval is not None:
+            object.__setattr__(self, "damping_interval", check_damping_interval(self.damping_interval, self.D_star))
+
+    @property
+    def D_star(self) -> float:
+        """D_1* (-): the host's nominal damping ratio of mode 1, the normalisation's (Sect. 5)."""
+        return float(self.damping_ratios[0]) if self.nominal_damping is None else self.nominal_damping
+
+    @property
+    def wall_material(self) -> Material:
+        """The cavity walls' material (Eq. 8): `wall`, or the rig's steel (Table 1) when the host names none."""
+        return STEEL_WALL if self.wall is None else self.wall
+
+    def damping_box(self) -> tuple[tuple[float, float], str]:
+        """(low, high) of D_1 (-) to propagate, and where it comes from: the host's `damping_interval`, else Table 2's
+        interval relative to its nominal value (0.075-0.09 % of 0.085 %: -11.8 % .. +5.9 %) around this host's D_1*."""
+        if self.damping_interval is not None:
+            return self.damping_interval, "the host's damping interval"
+        low, high = (end / D1_NOMINAL * self.D_star for end in D1_INTERVAL)
+        return (low, high), (f"no damping interval in the host: Table 2's relative interval (-11.8 % .. +5.9 %) "
+                             f"around its D_1* = {100 * self.D_star:.4g} %")
 
     @property
     def n_modes(self) -> int:
@@ -120,18 +154,20 @@ class ModalModel:
         return 0.5 * float(self.phi_wall_left[0] + self.phi_wall_right[0])
 
     def with_damping(self, D1: float) -> "ModalModel":
-        """Copy with the damping ratio of mode 1 replaced (the uncertain D of Table 2, checked by its row)."""
+        """Copy with the damping ratio of mode 1 replaced (the uncertain D of Table 2, checked by its row); the
+        nominal D_1* stays the host's (`D_star`), so that varied damping stays on the same axes (Sect. 5)."""
         D1 = PARAMETERS["D"].check(D1)
         d = self.damping_ratios.copy()
         d[0] = D1
-        return replace(self, damping_ratios=d)
+        return replace(self, damping_ratios=d, nominal_damping=self.D_star)
 
 
 @dataclass(frozen=True)
 class Impactor:
     """The sphere and its contacts (Eqs. 3-6): mass m_a (kg), clearance g (m), k_H (N/m^1.5), and the normal
     contact law at both walls (Eq. 4 by default, or the damped law of Eq. 10); inputs: (name, value) of the
-    parameters it was built from (`SystemSettings.inputs`; a contact law's own constant is read from there).
+    parameters it was built from (`SystemSettings.inputs`; a contact law's own constant is read from there); sphere:
+    the described sphere (`sim.model.sphere.Sphere`: radius, material, wall) its mass and k_H* came from, or None.
     Every value is checked against its row of `sim.model.parameters.PARAMETERS` (one line each)."""
 
     mass: float = SPHERE_MASS
@@ -141,6 +177,7 @@ class Impactor:
     friction: float = 0.0  # Coulomb coefficient mu of the floor contact (Appendix C); 0: no friction
     k_t: float = K_T_PAPER  # N/m, tangential stiffness of the floor contact (Appendix C: 22 kN/mm)
     inputs: tuple[tuple[str, float], ...] = ()
+    sphere: Any = field(default=None, compare=False)  # the described sphere it was built from (`sim.model.sphere`)
 
     def __post_init__(self) -> None:
         for row in PARAMETERS.values():
@@ -164,20 +201,39 @@ _IMPACTOR_FIELDS = ("mass", "clearance", "k_H", "friction", "k_t")
 
 @dataclass(frozen=True)
 class Nominal:
-    """The starred parameters used for normalisation (Sect. 5): D*, g*, and the sphere mass."""
+    """The starred parameters used for normalisation (Sect. 5): D* (-) and g* (m). `Nominal.of(model)` is the host's
+    own: its nominal D_1* (`ModalModel.D_star`: Table 2's 0.085 % for the seed rig) and the paper's g* = 0.58 mm
+    unless a nominal clearance is given; `Nominal()` alone is the seed paper's."""
 
     D1: float = D1_NOMINAL
     clearance: float = CLEARANCE_NOMINAL
 
+    @classmethod
+    def of(cls, model: "ModalModel", clearance: float | None = None) -> "Nominal":
+        """The host's normalisation: D* = the model's nominal D_1*, g* = `clearance` (m; default the paper's g*)."""
+        return cls(D1=model.D_star, clearance=CLEARANCE_NOMINAL if clearance is None else float(clearance))
 
-def a_noabs_star(model: ModalModel, a_base: float, nominal: Nominal = Nominal()) -> float:
-    """Resonant amplitude without absorber (Sect. 5): phi_tip (phi^T M b) a_base / (2 D*), in m."""
+    def describe(self) -> dict[str, float]:
+        """Its JSON keys: D_star (-), g_star_m (m)."""
+        return {"D_star": self.D1, "g_star_m": self.clearance}
+
+    def text(self) -> str:
+        """One line saying what the amplitudes and levels are normalised by."""
+        return f"normalised by D* = {100 * self.D1:.4g} % (the host's nominal D_1) and g* = {1e3 * self.clearance:.4g} mm"
+
+
+def a_noabs_star(model: ModalModel, a_base: float, nominal: Nominal | None = None) -> float:
+    """Resonant amplitude without absorber (Sect. 5): phi_tip (phi^T M b) a_base / (2 D*), in m; D* the host's nominal
+    damping (`Nominal.of`) unless `nominal` is given."""
+    nominal = Nominal.of(model) if nominal is None else nominal
     return abs(model.phi_tip[0] * model.participation[0]) * a_base / (2.0 * nominal.D1)
 
 
-def a_base_star(model: ModalModel, nominal: Nominal = Nominal()) -> float:
-    """Base amplitude reaching the clearance at the contact (Sect. 5.3): 2 D* g* / (phi_c phi^T M b), in m."""
+def a_base_star(model: ModalModel, nominal: Nominal | None = None) -> float:
+    """Base amplitude reaching the clearance at the contact (Sect. 5.3): 2 D* g* / (phi_c phi^T M b), in m; D* the
+    host's nominal damping and g* the paper's (`Nominal.of`) unless `nominal` is given."""
     check_resonant_mode(model)
+    nominal = Nominal.of(model) if nominal is None else nominal
     return 2.0 * nominal.D1 * nominal.clearance / abs(model.phi_contact * model.participation[0])
 
 
@@ -206,6 +262,24 @@ def check_open_unit(value: float, name: str) -> float:
     if not np.isfinite(value) or not 0.0 < value < 1.0:
         raise SimulationInputError(f"{name} must lie in (0, 1) (a damping ratio, e.g. 0.00085), got {value!r}")
     return value
+
+
+def check_damping_interval(interval: object, nominal: float) -> tuple[float, float]:
+    """A damping interval (low, high) of D_1 (-): two ratios in (0, 1), low <= high, containing the nominal D_1*; one
+    `SimulationInputError` line otherwise."""
+    try:
+        low, high = (float(v) for v in interval)  # type: ignore[union-attr]
+    except (TypeError, ValueError):
+        raise SimulationInputError(f"the damping interval must be two damping ratios [low, high], e.g. [0.00075, "
+                                   f"0.0009], got {interval!r}") from None
+    low = check_open_unit(low, "the damping interval's low end")
+    high = check_open_unit(high, "the damping interval's high end")
+    if low > high:
+        raise SimulationInputError(f"the damping interval [{low:g}, {high:g}] is reversed; give [low, high]")
+    if not low <= nominal <= high:
+        raise SimulationInputError(f"the damping interval [{100 * low:.4g} %, {100 * high:.4g} %] does not contain the "
+                                   f"host's nominal D_1 = {100 * nominal:.4g} %; widen it or correct mode 1's damping ratio")
+    return low, high
 
 
 class SystemArrays(NamedTuple):

@@ -47,13 +47,15 @@ class OrbitSetting:
     higher_damping: float = 1.0
     integrator: str = "exact"
     dt_scale: float = 1.0
-    nominal: Nominal = Nominal()
+    nominal: Nominal | None = None
 
     def __post_init__(self) -> None:
         for name in ("level", "eta", "higher_damping", "dt_scale"):
             value = getattr(self, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
                 raise SimulationInputError(f"orbits: {name} must be a positive number, got {value!r}")
+        if self.nominal is None:  # the host's own normalisation (its nominal D_1*, the paper's g*)
+            object.__setattr__(self, "nominal", Nominal.of(self.model))
         if self.impactor.friction > 0:
             raise SimulationInputError("orbits: dry friction (Appendix C) makes the state include the slider; the "
                                        "orbits are of the frictionless model (drop --mu)")

@@ -310,7 +310,7 @@ def simulate_levels(model, m_a: float, realise: Callable[[int], tuple[float, flo
         for i, level in batch:
             g, k_H, D = realise(i)
             result = sweep(model.with_damping(D), Impactor(mass=m_a, clearance=g, k_H=k_H), float(level), protocol,
-                           reps=reps, seed=seed, nominal=Nominal(clearance=g), progress=False)
+                           reps=reps, seed=seed, nominal=Nominal.of(model, g), progress=False)
             marks = landmarks([result])
             out.append(Outcome(float(marks.apr_samples[0]), float(getattr(result, f"resonant_{output}"))))
         return out

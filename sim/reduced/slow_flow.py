@@ -207,10 +207,11 @@ class SlowFlowModel:
         return np.asarray(b) * self.g / self.a_base_star
 
 
-def slow_flow_model(model: ModalModel, impactor: Impactor, r: float, nominal: Nominal = NOMINAL) -> SlowFlowModel:
+def slow_flow_model(model: ModalModel, impactor: Impactor, r: float, nominal: Nominal | None = None) -> SlowFlowModel:
     """The slow-flow inputs of a modal model and an impactor (its mass and clearance; k_H does not enter: rigid
     walls) with the modal restitution r (Eq. D.1, e.g. the simulator's `restitution_wall`)."""
-    return SlowFlowModel(host_mode(model), float(impactor.mass), float(impactor.clearance), float(r), nominal)
+    return SlowFlowModel(host_mode(model), float(impactor.mass), float(impactor.clearance), float(r),
+                         Nominal.of(model) if nominal is None else nominal)
 
 
 def check_restitution(r: float) -> float:

@@ -83,7 +83,7 @@ def _run_one(model: ModalModel, protocol: SteppedSine, job: BatchJob, seed: int,
 
 
 def run_batch(model: ModalModel, protocol: SteppedSine, jobs: Sequence[BatchJob], *, seed: int,
-              nominal: Nominal = Nominal(), integrator: str | None = "exact", n_jobs: int = 1) -> list[SweepRun]:
+              nominal: Nominal | None = None, integrator: str | None = "exact", n_jobs: int = 1) -> list[SweepRun]:
     """Run every job (one `run_sweep` each, identical to a single run with the same seed and rep).
 
     integrator: overrides protocol.integrator (None keeps it). n_jobs: joblib worker processes

@@ -29,7 +29,7 @@ from typing import Any, Callable, Mapping, Sequence, TextIO
 import numpy as np
 
 from sim.common.errors import ResourceFailure, SimulationInputError
-from sim.model.system import Impactor, ModalModel
+from sim.model.system import Impactor, ModalModel, Nominal
 from sim.stepped_sine.protocol import SteppedSine
 
 #: estimated wall times (s) above which the estimate is printed, and above which it is a warning
@@ -70,15 +70,16 @@ def probe_protocol(protocol: SteppedSine) -> SteppedSine:
     return replace(protocol, n_eta=PROBE_POINTS, sequence="up")
 
 
-def probe_cost(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine) -> float:
-    """Wall seconds per simulated second of the protocol's runs at a_base = level a_base* (Sect. 5) on this machine
-    now: one probe run (`probe_protocol`) through `run_sweep`, timed (the kernels must be loaded:
-    `sim.integration.integrators.warm_up`)."""
+def probe_cost(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine,
+               nominal: Nominal | None = None) -> float:
+    """Wall seconds per simulated second of the protocol's runs at a_base = level a_base* (Sect. 5, a_base* of
+    `nominal`, default the host's) on this machine now: one probe run (`probe_protocol`) through `run_sweep`, timed
+    (the kernels must be loaded: `sim.integration.integrators.warm_up`)."""
     from sim.stepped_sine.protocol import run_sweep
 
     probe = probe_protocol(protocol)
     started = time.perf_counter()
-    run_sweep(model, impactor, level, probe, seed=0, rep=0)
+    run_sweep(model, impactor, level, probe, seed=0, rep=0, nominal=nominal)
     return (time.perf_counter() - started) / simulated_seconds(probe, float(model.omega[0]))
 
 
@@ -87,14 +88,15 @@ def worth_probing(runs: int, simulated_per_run: float) -> bool:
     return runs * simulated_per_run * MAX_COST_PER_SIMULATED_S > ANNOUNCE_AFTER_S
 
 
-def seconds_per_run(model: ModalModel, impactor: Impactor | None, levels: Sequence[float],
-                    protocol: SteppedSine) -> dict[float, float]:
-    """Estimated wall seconds of one run of `protocol` at each of `levels` on one core of this machine now:
-    `simulated_seconds` x `probe_cost` at up to PROBE_LEVELS levels spread over them (the others: the nearest)."""
+def seconds_per_run(model: ModalModel, impactor: Impactor | None, levels: Sequence[float], protocol: SteppedSine,
+                    nominal: Nominal | None = None) -> dict[float, float]:
+    """Estimated wall seconds of one run of `protocol` at each of `levels` (a_base* of `nominal`) on one core of this
+    machine now: `simulated_seconds` x `probe_cost` at up to PROBE_LEVELS levels spread over them (the others: the
+    nearest)."""
     ordered = sorted(set(float(level) for level in levels))
     probed = [ordered[int(round(i))] for i in np.linspace(0, len(ordered) - 1, min(PROBE_LEVELS, len(ordered)))]
-    probe_cost(model, impactor, probed[-1], protocol)  # untimed: what the first runs load (kernels' paths, caches)
-    cost = {level: probe_cost(model, impactor, level, protocol) for level in dict.fromkeys(probed)}
+    probe_cost(model, impactor, probed[-1], protocol, nominal)  # untimed: what the first runs load (kernel paths)
+    cost = {level: probe_cost(model, impactor, level, protocol, nominal) for level in dict.fromkeys(probed)}
     per_run = simulated_seconds(protocol, float(model.omega[0]))
     return {level: per_run * cost[min(cost, key=lambda p: abs(p - level))] for level in ordered}
 

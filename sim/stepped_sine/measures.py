@@ -216,7 +216,8 @@ def linear_tip_amplitude(model: ModalModel, Omega: float | np.ndarray, a_base: f
 
 
 def physical_amplitude(normalised: float | np.ndarray, level: float | np.ndarray, model: ModalModel,
-                       nominal: Nominal = Nominal()) -> float | np.ndarray:
+                       nominal: Nominal | None = None) -> float | np.ndarray:
     """Eq. B.1: a = (a/a_noabs*) (a_base/a_base*) (phi_tip/phi_c) g*, in m."""
     ratio = abs(model.phi_tip[0] / model.phi_contact)
+    nominal = Nominal.of(model) if nominal is None else nominal
     return np.asarray(normalised) * np.asarray(level) * ratio * nominal.clearance

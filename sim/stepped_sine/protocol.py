@@ -347,7 +347,7 @@ def visit_points(model: ModalModel, sys: SystemArrays, a_base: float, protocol: 
 
 
 def run_sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *,
-              seed: int, rep: int, nominal: Nominal = Nominal(),
+              seed: int, rep: int, nominal: Nominal | None = None,
               progress: Callable[[], None] | None = None) -> SweepRun:
     """ONE stepped-sine run from homogeneous initial conditions (Sect. 5.1; protocol.start) at
     a_base = level * a_base* (nominal D*, g*): the points of `visit_points`, each with its hold.
@@ -475,7 +475,7 @@ def aggregate_runs(runs: list[SweepRun]) -> SweepResult:
 
 
 def sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *, reps: int,
-          seed: int, nominal: Nominal = Nominal(), progress: bool | None | Callable[[], None] = None) -> SweepResult:
+          seed: int, nominal: Nominal | None = None, progress: bool | None | Callable[[], None] = None) -> SweepResult:
     """`reps` runs (rep = 0 .. reps-1) of `run_sweep`, aggregated (Sects. 5.1, 5.2).
 
     progress: report the progress on stderr (`sim.common.progress`: a bar on a terminal, plain lines in a log; None:

@@ -57,7 +57,9 @@ def test_table_is_readable(capsys):
     out = capsys.readouterr().out
     assert "117.40" in out and "modal mass ratio" in out and "a_base*" in out
     assert "beam mass (free length without block, Eq. 10): 1.5730 kg (paper: ca. 1.8 kg)" in out
-    assert len(out.splitlines()) == 2 + 9 + 8
+    assert len(out.splitlines()) == 2 + 9 + 10  # + the host line and the sphere line
+    assert "host: D_1* = 0.085 %, interval 0.075-0.09 %; walls steel" in out
+    assert "sphere R = 7.92 mm brass, m_a = 17.7 g, k_H* = 282000 N/mm^1.5 (Eq. 8 on steel)" in out
 
 
 def test_save_then_load_through_the_cli(tmp_path, capsys):

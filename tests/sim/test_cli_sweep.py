@@ -104,7 +104,7 @@ def test_malformed_model_file(tmp_path, capsys):
 
 
 def test_bad_overview_levels(model_file, capsys):
-    for levels, message in (("6,0", "must be positive"), ("8:2:4", "empty or reversed"), ("a,b", "must be numbers")):
+    for levels, message in (("6,0", "must be positive"), ("8:2:4", "empty or reversed"), ("a,b", "must be a level a_base/a_base* like 7.4 or a base amplitude")):
         assert main(["overview", "--levels", levels, *FAST, "--model", model_file]) == 2
         err = capsys.readouterr().err
         assert message in err and len(err.strip().splitlines()) == 1

@@ -105,7 +105,7 @@ class Predictor:
         self.problem, self.objective, self.rig, self._run = problem, objective, rig, run
         self.laws: dict[tuple[float, str], SphereLaw] = {}
         self._predicted: dict[Sphere, DesignPrediction] = {}  # a law never changes once built
-        self._a_star = lambda g: a_base_star(rig, Nominal(clearance=g))  # a_base*(g) (m), Sect. 5.3 with g* -> g
+        self._a_star = lambda g: a_base_star(rig, Nominal.of(rig, g))  # a_base*(g) (m), Sect. 5.3 with g* -> g
         self._a_star_nominal = a_base_star(rig)
 
     @property

@@ -176,6 +176,8 @@ def _metadata(study: Study, model: Any, result: StudyResult, extra: dict) -> Pat
             **extra}
     if hasattr(model, "resolved_protocol"):
         meta["study"]["protocol_resolved"] = model.resolved_protocol()
+    if hasattr(model, "normalisation"):  # what a / a_noabs* and the levels are normalised by (Sect. 5)
+        meta["normalisation"] = model.normalisation()
     path = result.folder / "study.json"
     write_text(path, dumps(meta))
     return path

@@ -35,6 +35,7 @@ from uq.problem.space import Parameter, ParameterSpace, parameter_of, table2_spa
 
 if TYPE_CHECKING:
     from sim.model.parameters import SystemSettings
+    from sim.model.sphere import Sphere
     from sim.model.system import Impactor, ModalModel
     from sim.stepped_sine.protocol import SteppedSine, SweepResult
 
@@ -109,7 +110,10 @@ class IESModel:
     rig; its SHA-256 is part of every task's key;
     rig: the modal model itself, built once by the controlling process (`with_rig`) and shipped to the
     workers: the eigen-solution's last bits depend on the BLAS thread count, which differs between the
-    main process and joblib/Dask workers, and a chaotic response amplifies such bits.
+    main process and joblib/Dask workers, and a chaotic response amplifies such bits;
+    impactor: the study's [impactor] table (radius in m, material, mass in kg, wall_material; `sim.model.sphere`), the
+    paper's sphere on the host's walls when empty; g_star: the nominal clearance g* (m) of the levels (Sect. 5.3; None:
+    the paper's 0.58 mm). The amplitudes are normalised by the host's own D_1* (`sim.model.system.Nominal.of`).
     """
 
     protocol: Mapping[str, Any] = field(default_factory=dict)
@@ -120,6 +124,8 @@ class IESModel:
     rig: "ModalModel | None" = field(default=None, compare=False, repr=False)
     banded_outputs: tuple[str, ...] = ("mean", "max")
     contact_law: str | None = None
+    impactor: Mapping[str, Any] = field(default_factory=dict)
+    g_star: float | None = None
 
     #: the resonant levels, the regime (1 = APR) and the scattering measures of `sim.stepped_sine.measures` at the resonant
     #: mean's eta (Sect. 5.5, Appendix D)
@@ -143,14 +149,42 @@ class IESModel:
         return tuple(row.name for row in optional_parameters())
 
     def default_space(self) -> ParameterSpace:
-        return table2_space()
+        """Table 2's space for this host and sphere (`uq.problem.space.table2_space`): D around the host's D_1* over its
+        damping interval, k_H around the sphere's k_H* (Eq. 8 on the host's walls)."""
+        return table2_space(host=self._host(), sphere=self.sphere())
 
     def optional_parameter(self, name: str) -> Parameter:
         """The default of an optional parameter (`optional_parameters`), before the study's table fills it in: its row
-        of `PARAMETERS` held at its nominal value."""
+        of `PARAMETERS` held at its nominal value (the sphere's mass for m_a)."""
         from sim.model.parameters import PARAMETERS
 
-        return parameter_of(PARAMETERS[name])
+        row = PARAMETERS[name]
+        p = parameter_of(row)
+        sets_mass = row.feeds.field == "mass" and not row.feeds.scale and row.feeds.derive is None
+        return p.fixed_at(self.sphere().mass) if sets_mass else p
+
+    def sphere(self) -> "Sphere":
+        """The study's sphere (`sim.model.sphere.Sphere`) of its [impactor] table, on the host's walls unless the
+        table names them; one StudyError line for a bad value."""
+        from sim.common.errors import SimulationInputError
+        from sim.model.sphere import sphere_of
+
+        try:
+            return sphere_of(**dict(self.impactor), host_wall=self._host().wall_material)
+        except SimulationInputError as exc:
+            raise StudyError(f"[impactor] {exc}") from None
+
+    def normalisation(self) -> dict[str, Any]:
+        """What the outputs are normalised by (Sect. 5): `D_star` (the host's nominal D_1), `g_star_m`, the sentence
+        saying so, and the study's sphere (`sim.model.sphere.Sphere.describe`)."""
+        from sim.model.system import Nominal
+
+        nominal = Nominal.of(self._host(), self.g_star)
+        return {**nominal.describe(), "text": nominal.text(), "sphere": self.sphere().describe()}
+
+    def _host(self) -> "ModalModel":
+        """The host's modal model: the one this model carries, else built (`_rig`)."""
+        return self.rig if self.rig is not None else self._rig()
 
     def version(self) -> str:
         """The simulator's code version (`sim.common.kernel_cache.code_version`: what `ies --version` prints and the
@@ -236,10 +270,11 @@ class IESModel:
     def _settings(self, params: Mapping[str, float]) -> "SystemSettings":
         """What this run's parameters feed (`sim.model.parameters.system_settings`): the sphere of Eqs. 3-6 with its
         mass scaled by [variant] sphere_mass_factor and the study's contact law, then every parameter of the point."""
-        from sim.model.parameters import SPHERE_MASS, SystemSettings, system_settings
+        from sim.model.parameters import SystemSettings, system_settings
 
-        base = SystemSettings(mass=SPHERE_MASS * self.variant.get("sphere_mass_factor", 1.0),
-                              contact_law=self.contact_law)
+        sphere = self.sphere()
+        base = replace(sphere.settings(SystemSettings(contact_law=self.contact_law)),
+                       mass=sphere.mass * self.variant.get("sphere_mass_factor", 1.0))
         return system_settings(params, base)
 
     def simulated_system(self, params: Mapping[str, float]) -> tuple["ModalModel", "Impactor"]:
@@ -247,8 +282,7 @@ class IESModel:
         (`sim.model.system.build_system`, the builder `ies sweep` uses too)."""
         from sim.model.system import build_system
 
-        rig = self.rig if self.rig is not None else self._rig()
-        return build_system(rig, self._settings(params))
+        return build_system(self._host(), self._settings(params))
 
     def stepped_sine(self) -> "SteppedSine":
         """The study's stepped-sine protocol (`sim.stepped_sine.protocol.SteppedSine`)."""
@@ -309,14 +343,20 @@ class IESModel:
             out["variant"] = dict(self.variant)
         if self.modal_file is not None:
             out["modal_model_sha256"] = hashlib.sha256(Path(self.modal_file).read_bytes()).hexdigest()
+        if self.impactor:  # the paper's sphere is not in the key (keys from before the choice)
+            out["impactor"] = dict(self.impactor)
+        if self.g_star is not None:
+            out["g_star"] = self.g_star
         return out
 
     def __call__(self, params: Mapping[str, float], level: float, rep: int, seed: int) -> dict[str, Any]:
         """One run: its own resonant levels (outputs) and the per-point measures (trace) for aggregation."""
+        from sim.model.system import Nominal
         from sim.stepped_sine.protocol import aggregate_runs, run_sweep
 
         model, impactor = self.simulated_system(params)
-        run = run_sweep(model, impactor, level, self._stepped_sine(), seed=seed, rep=rep)
+        run = run_sweep(model, impactor, level, self._stepped_sine(), seed=seed, rep=rep,
+                        nominal=Nominal.of(model, self.g_star))
         own = aggregate_runs([run])
         trace = {key: getattr(run, key).tolist() for key in _TRACE}
         trace["scattering"] = {name: values.tolist() for name, values in run.scattering.items()}
@@ -476,18 +516,22 @@ class FunctionModel:
 
 def make_model(spec: str, *, protocol: Mapping[str, Any] | None = None, parameters: tuple[str, ...] = (),
                modal_model: str | Path | None = None, variant: Mapping[str, float] | None = None,
-               outputs: tuple[str, ...] = (), contact_law: str | None = None) -> ResponseModel:
+               outputs: tuple[str, ...] = (), contact_law: str | None = None, impactor: Mapping[str, Any] | None = None,
+               g_star: float | None = None) -> ResponseModel:
     """The model named by a study's ``model`` key ("ies", "ishigami" or "module:function"); modal_model: a
     modal-model file replacing the built-in rig of "ies"; variant: the [variant] table of "ies"; outputs: the
     outputs of "ies" whose bands and indices the study computes (default: the resonant mean and max);
-    contact_law: the normal contact law of "ies" (a name in `sim.model.contact_law.LAWS`; None: its default)."""
+    contact_law: the normal contact law of "ies" (a name in `sim.model.contact_law.LAWS`; None: its default);
+    impactor: the sphere of "ies" (`IESModel.impactor`); g_star: its nominal clearance g* (m) of the levels."""
     if spec == "ies":
         unknown = [name for name in outputs if name not in IESModel.outputs]
         if unknown:
             raise StudyError(f"[study] unknown output(s) {', '.join(unknown)}; known: {', '.join(IESModel.outputs)}")
         return IESModel(dict(protocol or {}), modal_file=None if modal_model is None else str(modal_model),
                         variant=dict(variant or {}), **({"banded_outputs": tuple(outputs)} if outputs else {}),
-                        contact_law=contact_law)
+                        contact_law=contact_law, impactor=dict(impactor or {}), g_star=g_star)
+    if impactor or g_star is not None:
+        raise StudyError("[impactor] and [excitation] g_star only apply to model = \"ies\" (the simulator)")
     from sim.model.contact_law import DEFAULT_LAW
 
     if contact_law not in (None, DEFAULT_LAW):

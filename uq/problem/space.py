@@ -15,7 +15,7 @@ import json
 import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Iterable, Mapping
+from typing import TYPE_CHECKING, Iterable, Mapping
 
 import numpy as np
 
@@ -23,6 +23,10 @@ from sim.common.errors import SimulationInputError
 from sim.model.parameters import (K_H_BEST_ESTIMATE_FACTOR, K_H_NOMINAL, PARAMETERS, UncertainParameter,
                                   column_name, table2_parameters)
 from uq.errors import StudyError
+
+if TYPE_CHECKING:
+    from sim.model.sphere import Sphere
+    from sim.model.system import ModalModel
 
 # Table 2 of the seed paper (SI units) is the table2 rows of `sim.model.parameters.PARAMETERS`, the one vocabulary of
 # the paper's quantities (names, units, nominal values, intervals, bounds, plausible ranges, CSV columns).
@@ -170,21 +174,38 @@ def parameter_of(row: UncertainParameter) -> Parameter:
                      positive=row.positive)
 
 
-def table2_space(k_H_max: float | None = None) -> ParameterSpace:
+def table2_space(k_H_max: float | None = None, *, host: "ModalModel | None" = None,
+                 sphere: "Sphere | None" = None) -> ParameterSpace:
     """The default IES space of Table 2 (D, g, k_H: the table2 rows of `PARAMETERS`), optionally with a calibrated
-    upper bound for k_H."""
-    params = tuple(parameter_of(row) for row in table2_parameters())
-    space = ParameterSpace(params, {"k_H_best_estimate": K_H_BEST_ESTIMATE})
-    if k_H_max is None:
-        return space
-    return ParameterSpace(tuple(replace(p, max=float(k_H_max)) if p.name == "k_H" else p for p in params), space.extras)
+    upper bound for k_H. With a `host` (`sim.model.system.ModalModel`), D's nominal value is its D_1* and its interval
+    the host's (`ModalModel.damping_box`); with a `sphere` (`sim.model.sphere.Sphere`), k_H's nominal value is its
+    k_H* (Eq. 8 with its wall), its interval Table 2's factors on it (1 .. 1.52) and the best estimate 1.25 k_H*
+    (extras `k_H_star`, `k_H_best_estimate`). The seed rig and the paper's sphere give Table 2 to the last bit."""
+    params = []
+    for row in table2_parameters():
+        p = parameter_of(row)
+        if row.name == "D" and host is not None:
+            low, high = host.damping_box()[0]
+            p = replace(p, nominal=host.D_star, min=low, max=high)
+        elif row.name == "k_H" and sphere is not None:
+            low, high = row.spread.ends(sphere.k_H_star)
+            p = replace(p, nominal=sphere.k_H_star, min=low, max=high)
+        params.append(p)
+    k_H_star = K_H_STAR if sphere is None else sphere.k_H_star
+    extras = {"k_H_best_estimate": K_H_BEST_ESTIMATE_FACTOR * k_H_star}
+    if k_H_star != K_H_STAR:
+        extras["k_H_star"] = k_H_star
+    if k_H_max is not None:
+        params = [replace(p, max=float(k_H_max)) if p.name == "k_H" else p for p in params]
+    return ParameterSpace(tuple(params), extras)
 
 
 _RATIO = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*\*?\s*k_H\*\s*$")
 
 
-def resolve_k_H(value: object, *, base_dir: Path | None = None) -> float:
-    """A k_H value in N/m^1.5 from a number, a ratio string like ``"1.25 k_H*"``, or a calibration.
+def resolve_k_H(value: object, *, base_dir: Path | None = None, k_H_star: float = K_H_STAR) -> float:
+    """A k_H value in N/m^1.5 from a number, a ratio string like ``"1.25 k_H*"`` (of `k_H_star`: the study's sphere's
+    Eq. 8 value, Table 2's 282e3 N/mm^1.5 for the paper's), or a calibration.
 
     A calibration is a path to the JSON object printed by ``ies calibrate --json`` (key ``k_H``, in
     N/m^1.5), written as ``"calibrated:PATH"`` (PATH relative to `base_dir`).
@@ -196,7 +217,7 @@ def resolve_k_H(value: object, *, base_dir: Path | None = None) -> float:
     if isinstance(value, str):
         match = _RATIO.match(value)
         if match:
-            return float(match.group(1)) * K_H_STAR
+            return float(match.group(1)) * k_H_star
         if value.startswith("calibrated:"):
             path = Path(value.split(":", 1)[1])
             if base_dir is not None and not path.is_absolute():
@@ -210,13 +231,13 @@ def resolve_k_H(value: object, *, base_dir: Path | None = None) -> float:
                      "a ratio like \"1.25 k_H*\" or \"calibrated:FILE.json\" (the output of `ies calibrate --json`)")
 
 
-def resolve_value(name: str, value: object, *, base_dir: Path | None = None) -> object:
+def resolve_value(name: str, value: object, *, base_dir: Path | None = None, k_H_star: float = K_H_STAR) -> object:
     """A parameter value of a study file in SI units: k_H through `resolve_k_H`, a row's value with its unit ("0.58
     mm", `sim.model.parameters.UncertainParameter.parse`); a number of a row checked against the row's physical
     bounds, as on the command line (`UncertainParameter.problem`); other values unchanged (checked by `Parameter`)."""
     row = PARAMETERS.get(name)
     if name == "k_H":
-        value = resolve_k_H(value, base_dir=base_dir)
+        value = resolve_k_H(value, base_dir=base_dir, k_H_star=k_H_star)
     elif row is not None and row.quantity is not None and isinstance(value, str):
         try:
             value = row.parse(value)

@@ -17,12 +17,17 @@ Layout (every table and key is optional except where noted; SI units)::
     contact_law = "hertz"        # model "ies": "hertz" (Eq. 4) or "hertz-damped" (Eq. 10, r_cont,diss from
                                  # [parameters.r_cont], default 0.99; a table there implies "hertz-damped")
 
+    [impactor]                   # optional, model "ies": the sphere (`sim.model.sphere`; default the paper's: R =
+    radius = "5 mm"              # 7.92 mm brass, 17.7 g); k_H's nominal value is its k_H* (Eq. 8 with both bodies'
+    material = "steel"           # E and nu), "1.25 k_H*" its multiples; mass = "4 g" (hollow or weighed);
+    wall_material = "aluminium"  # default: the host's [host] wall_material, else steel
+
     [variant]                    # optional, model "ies": modelling choices the paper leaves open
     sphere_mass_factor = 1.537   # (uq/studies/fidelity/README.md): the sphere's effective mass in x over m_a (rolling: 1.4 on a
     higher_mode_damping = 0.001  # flat floor, 1.537 on the groove's edges); the damping ratio of modes 5..N
 
-    [parameters.D]               # listed parameters are varied; unlisted ones stay nominal.
-    nominal = 0.00085            # missing keys default to Table 2 (model "ies")
+    [parameters.D]               # listed parameters are varied; unlisted ones stay nominal. Missing keys default
+    nominal = 0.00085            # to Table 2 (model "ies"), D to the host's D_1* and damping interval
     min = 0.00075
     max = 0.00090
     [parameters.k_H]             # N/m^1.5, or "1.52 k_H*", or "calibrated:calib.json"
@@ -34,7 +39,8 @@ Layout (every table and key is optional except where noted; SI units)::
     nominal = 0.07               # with [parameters.k_t] (N/m, or "22kN/mm") the tangential stiffness
 
     [excitation]                 # passed to the stepped-sine protocol (sim.stepped_sine.protocol.SteppedSine)
-    levels = [5.3, 6.7, 7.4]     # a_base / a_base* (Sect. 5.3; nominal D*, g*)
+    levels = [5.3, 6.7, 7.4]     # a_base / a_base* (Sect. 5.3; D* the host's nominal D_1, g* below)
+    g_star = "0.58 mm"           # the nominal clearance g* of a_base* (default the paper's 0.58 mm)
     eta = { start = 0.95, stop = 1.01, n = 25 }   # Omega / omega_1*
     repetition = "leg"           # "leg" or "run": what counts as one repetition sample (sim.stepped_sine.protocol)
     start = "base-velocity"      # initial conditions of each run: "rest" or "base-velocity" (sim.stepped_sine.protocol)
@@ -71,15 +77,16 @@ from sim.model.parameters import PARAMETERS
 from uq.errors import StudyError
 from uq.problem.cluster_settings import ClusterSettings, parse_cluster_table
 from uq.problem.models import ResponseModel, make_model
-from uq.problem.space import Parameter, ParameterSpace, resolve_k_H, resolve_value
+from uq.problem.space import K_H_STAR, Parameter, ParameterSpace, resolve_k_H, resolve_value
 
 #: the tables every study may have; the method's own table is named after its kind (`Method.kind`)
 COMMON_TABLES = {
     "study": {"name", "kind", "model", "modal_model", "seed", "repetitions", "output", "outputs", "contact_law"},
     "variant": {"sphere_mass_factor", "higher_mode_damping"},
+    "impactor": {"radius", "material", "mass", "wall_material"},
     "parameters": None,  # one sub-table per parameter
     "excitation": {"levels", "eta", "wait", "hold", "sequence", "integrator", "perturbation", "perturb", "repetition",
-                   "start", "dt_scale"},
+                   "start", "dt_scale", "g_star"},
     "cluster": None,  # checked by uq.problem.cluster_settings.parse_cluster_table
 }
 _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
@@ -146,6 +153,8 @@ class Study:
     variant: Mapping[str, float] = field(default_factory=dict)
     outputs: tuple[str, ...] = ()
     contact_law: str = "hertz"
+    impactor: Mapping[str, Any] = field(default_factory=dict)
+    g_star: float | None = None
     #: where the study runs ([cluster], uq.engine.cluster); not part of its results, so left out of to_dict and the key
     cluster: ClusterSettings | None = None
     #: whether it was read with --allow-implausible (values of implausible magnitude computed as given)
@@ -155,7 +164,7 @@ class Study:
         """The study's response model (`uq.problem.models.make_model`)."""
         return make_model(self.model, protocol=self.protocol, parameters=tuple(self.space.names),
                           modal_model=self.modal_model, variant=self.variant, outputs=self.outputs,
-                          contact_law=self.contact_law)
+                          contact_law=self.contact_law, impactor=self.impactor, g_star=self.g_star)
 
     def context(self) -> Context:
         """What its method's settings are read against (`Context`)."""
@@ -181,6 +190,8 @@ class Study:
             "repetitions": self.repetitions, "output": str(self.output), "source": self.source,
             "levels": list(self.levels), "protocol": dict(self.protocol), "parameters": self.space.to_dict(),
             "variant": dict(self.variant), "outputs": list(self.outputs), "contact_law": self.contact_law,
+            **({"impactor": dict(self.impactor)} if self.impactor else {}),  # the paper's sphere: keys as before
+            **({"g_star_m": self.g_star} if self.g_star is not None else {}),
         }
 
 
@@ -192,8 +203,9 @@ def with_calibration(study: Study, k_H_cal: float) -> Study:
     line: a crater stiffens the contact."""
     from uq.problem.space import K_H_BEST_ESTIMATE, K_H_STAR
 
-    if k_H_cal < K_H_STAR:
-        raise StudyError(f"the calibrated k_H = {k_H_cal:.4g} N/m^1.5 is below k_H* = {K_H_STAR:.4g}; a crater should "
+    k_H_star = study.space.extras.get("k_H_star", K_H_STAR)
+    if k_H_cal < k_H_star:
+        raise StudyError(f"the calibrated k_H = {k_H_cal:.4g} N/m^1.5 is below k_H* = {k_H_star:.4g}; a crater should "
                          "stiffen the contact: check the calibration or use --no-calibration")
     space = study.space
     k = space["k_H"]
@@ -326,10 +338,20 @@ def parse_study(data: Mapping[str, Any], methods: Mapping[str, Any], *, base_dir
         raise StudyError("[variant] only applies to model = \"ies\" (the simulator)")
     if not 0 < variant.get("higher_mode_damping", 0.5) < 1:
         raise StudyError(f"[variant] higher_mode_damping must lie in (0, 1), got {variant['higher_mode_damping']}")
-
-    space = _parse_parameters(data.get("parameters"), model_spec, base_dir, allow_implausible)
-
+    impactor = _parse_impactor(data.get("impactor", {}))
     exc = dict(data.get("excitation", {}))
+    g_star = _parse_g_star(exc.pop("g_star", None), allow_implausible)
+    if (impactor or g_star is not None) and model_spec != "ies":
+        raise StudyError("[impactor] and [excitation] g_star only apply to model = \"ies\" (the simulator)")
+    table = data.get("parameters")
+    names = table or {}
+    if model_spec == "ies":
+        by_key = {row.study_key: name for name, row in PARAMETERS.items()}
+        names = {by_key.get(key, key): spec for key, spec in names.items()}
+    host_model = make_model(model_spec, parameters=tuple(names), modal_model=modal_model, variant=variant,
+                            impactor=impactor, g_star=g_star)
+    space = _parse_parameters(table, model_spec, base_dir, host_model, allow_implausible)
+
     levels_raw = exc.pop("levels", [1.0] if model_spec != "ies" else None)
     if levels_raw is None:
         raise StudyError("[excitation] levels is missing: give a_base / a_base* values, e.g. levels = [5.3, 6.7, 7.4]")
@@ -353,13 +375,14 @@ def parse_study(data: Mapping[str, Any], methods: Mapping[str, Any], *, base_dir
     study = Study(name=name, kind=kind, method=method, settings=settings, table=dict(table), model=model_spec,
                   space=space, levels=levels, repetitions=reps, seed=seed, output=output, protocol=protocol,
                   source=source, modal_model=modal_model, variant=variant, outputs=tuple(outputs),
-                  contact_law=contact_law, cluster=cluster, allow_implausible=allow_implausible)
+                  contact_law=contact_law, impactor=impactor, g_star=g_star, cluster=cluster,
+                  allow_implausible=allow_implausible)
     for _, one in method.substudies(study):
         _parse_contact_law({"contact_law": contact_law}, one.space)  # every value of a series in range
     model = study.make_model()  # unknown model -> one line now
     from sim.model.contact_law import DEFAULT_LAW
 
-    if modal_model is not None or variant or contact_law != DEFAULT_LAW:
+    if modal_model is not None or variant or contact_law != DEFAULT_LAW or impactor:
         model.check()  # an unreadable modal file -> one line now
     if "friction" in space.names:  # every mu of the study: >= 0, and > 0 needs ode3 and the floor values
         k_t = space["k_t"].min if "k_t" in space.names else model.optional_parameter("k_t").nominal
@@ -456,15 +479,56 @@ def _parse_contact_law(head: Mapping[str, Any], space: ParameterSpace) -> str:
     return law
 
 
+def _parse_impactor(table: Any) -> dict[str, Any]:
+    """The [impactor] table (`sim.model.sphere.sphere_of`'s arguments, SI): radius and mass as numbers (m, kg) or with
+    their unit ("5 mm", "4 g"), material and wall_material as names or "E=...GPa,nu=...[,density=...]"; checked by
+    building the sphere (one StudyError line)."""
+    from sim.common.errors import SimulationInputError
+    from sim.common.units import MASS, RADIUS, parse_quantity
+    from sim.model.sphere import sphere_of
+
+    out: dict[str, Any] = {}
+    try:
+        for key, quantity in (("radius", RADIUS), ("mass", MASS)):
+            if key in table:
+                out[key] = parse_quantity(table[key], quantity)
+        for key in ("material", "wall_material"):
+            if key in table:
+                if not isinstance(table[key], str):
+                    raise StudyError(f"[impactor] {key} must be a name like \"steel\" or \"E=200GPa,nu=0.29"
+                                     f"{',density=7850kg/m3' if key == 'material' else ''}\", got {table[key]!r}")
+                out[key if key == "material" else "wall"] = table[key]
+        sphere_of(**out)
+    except SimulationInputError as exc:
+        raise StudyError(f"[impactor] {exc}") from None
+    return out
+
+
+def _parse_g_star(value: Any, allow_implausible: bool = False) -> float | None:
+    """[excitation] g_star: the nominal clearance g* (m, or with its unit) of the levels, None when not given; an
+    implausible magnitude refused unless `allow_implausible` (`check_plausible`)."""
+    if value is None:
+        return None
+    from sim.common.errors import SimulationInputError
+
+    try:
+        g_star = PARAMETERS["g"].check(PARAMETERS["g"].parse(value))
+    except SimulationInputError as exc:
+        raise StudyError(f"[excitation] g_star: {exc}") from None
+    check_plausible("[excitation] g_star", "g", g_star, value, allow_implausible)
+    return g_star
+
+
 def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir: Path,
-                      allow_implausible: bool) -> ParameterSpace:
-    """The parameter space of [parameters.KEY] tables; for the simulator KEY is a row's study key in
-    `sim.model.parameters.PARAMETERS` (its name in the space, CSV columns and messages is the row's name); a value of
-    implausible magnitude is refused unless `allow_implausible` (`check_plausible`)."""
+                      model: ResponseModel | None = None, allow_implausible: bool = False) -> ParameterSpace:
+    """The parameter space of [parameters.KEY] tables against `model`'s default space (for the simulator: Table 2 for
+    its host and sphere); for the simulator KEY is a row's study key in `sim.model.parameters.PARAMETERS` (its name in
+    the space, CSV columns and messages is the row's name); a value of implausible magnitude is refused unless
+    `allow_implausible` (`check_plausible`)."""
     if table is not None and model_spec == "ies":
         by_key = {row.study_key: name for name, row in PARAMETERS.items()}
         table = {by_key.get(key, key): spec for key, spec in table.items()}
-    model = make_model(model_spec, parameters=tuple(table or {}))
+    model = make_model(model_spec, parameters=tuple(table or {})) if model is None else model
     default = model.default_space()
     if default is None:  # a user's function: every parameter must be given in full
         if not table:
@@ -486,6 +550,7 @@ def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir
             raise StudyError(f"unknown parameter '{pname}' for model '{model_spec}'; known: "
                              f"{', '.join((*default.names, *optional))}")
     extras = dict(default.extras)
+    k_H_star = extras.get("k_H_star", K_H_STAR)  # "1.25 k_H*" of the study's sphere
     params = []
     listed_optional = [model.optional_parameter(name) for name in optional if name in table]
     for p in (*default.parameters, *listed_optional):
@@ -497,14 +562,14 @@ def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir
         for key in ("nominal", "min", "max"):
             # an optional parameter's missing bound is its nominal value (a fixed value needs nominal only)
             fallback = spec.get("nominal", p.nominal) if p in listed_optional else getattr(p, key)
-            values[key] = resolve_value(p.name, spec.get(key, fallback), base_dir=base_dir)
+            values[key] = resolve_value(p.name, spec.get(key, fallback), base_dir=base_dir, k_H_star=k_H_star)
             if key in spec:
                 check_plausible(f"[parameters.{PARAMETERS[p.name].study_key if p.name in PARAMETERS else p.name}] {key}",
                                 p.name, values[key], spec[key], allow_implausible)
         if "best_estimate" in spec:
             if p.name != "k_H":
                 raise StudyError(f"[parameters.{p.name}] best_estimate is only defined for k_H")
-            extras["k_H_best_estimate"] = resolve_k_H(spec["best_estimate"], base_dir=base_dir)
+            extras["k_H_best_estimate"] = resolve_k_H(spec["best_estimate"], base_dir=base_dir, k_H_star=k_H_star)
             if not extras["k_H_best_estimate"] > 0:
                 raise StudyError("[parameters.k_H] best_estimate must be positive")
         params.append(Parameter(p.name, values["nominal"], values["min"], values["max"], p.unit, p.label,

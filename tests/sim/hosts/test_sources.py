@@ -44,8 +44,10 @@ def test_ies_modes_shows_and_saves_the_toy_source(toy_row: HostSource, tmp_path,
     data = json.loads(capsys.readouterr().out)
     assert data["n_modes"] == 3 and data["frequencies_hz"] == pytest.approx([20.0, 80.0, 180.0])
     assert data["source"] == "toy beam at 20 Hz" and "rig" not in data
-    # a_base* = 2 D* g* / (phi_c phi^T M b) (Sect. 5.3) with phi_c = 2, phi^T M b = 0.8
-    assert data["a_base_star"] == pytest.approx(2 * 0.00085 * 0.58e-3 / (2.0 * 0.8))
+    # a_base* = 2 D* g* / (phi_c phi^T M b) (Sect. 5.3) with phi_c = 2, phi^T M b = 0.8, D* the host's own D_1
+    D_star = data["damping_ratios"][0]
+    assert data["D_star"] == D_star and data["g_star_m"] == 0.58e-3
+    assert data["a_base_star"] == pytest.approx(2 * D_star * 0.58e-3 / (2.0 * 0.8))
     assert main(["modes", "--model", str(saved), "--json"]) == 0
     back = json.loads(capsys.readouterr().out)
     assert back["frequencies_hz"] == pytest.approx(data["frequencies_hz"])

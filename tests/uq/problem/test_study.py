@@ -204,3 +204,65 @@ def test_the_wheel_ships_every_study_and_modal_file():
     missing = [str(p) for p in shipped if not any(len(p.parts) == len(PurePosixPath(g).parts) and p.match(g)
                                                   for g in globs)]
     assert len(SHIPPED_FILES) > 40 and not missing
+
+
+def test_the_papers_study_space_is_table_2_to_the_last_bit(tmp_path):
+    """The host and sphere descriptions change nothing for the rig and the paper's sphere: the space of a study
+    without [impactor] is Table 2's rows exactly (and so are its tasks' keys)."""
+    from sim.model.parameters import table2_parameters
+
+    study = load_study(write(tmp_path, MINIMAL + "[parameters.D]\n[parameters.g]\n[parameters.k_H]\n"))
+    for row in table2_parameters():
+        p = study.space[row.name]
+        assert (p.nominal, p.min, p.max) == (row.nominal, *row.interval)
+    assert study.space.extras == table2_space().extras and "impactor" not in study.to_dict()
+
+
+def test_a_study_of_ones_own_host_and_sphere(tmp_path, capsys):
+    """[impactor] gives k_H's nominal value by Eq. 8 (steel on the host's aluminium walls), "1.25 k_H*" is relative to
+    it; D's default interval is the host's [host] damping_interval around its own D_1*; g_star sets a_base*."""
+    from sim.hosts.modal_file import save_modal_model
+    from sim.hosts.rig import seed_rig_model
+    from sim.model.materials import WALL_MATERIALS
+    from sim.model.sphere import sphere_of
+    from sim.model.system import ModalModel
+
+    rig = seed_rig_model()
+    fields = {k: getattr(rig, k) for k in ("frequencies_hz", "phi_wall_left", "phi_wall_right", "phi_tip", "participation")}
+    d = rig.damping_ratios.copy()
+    d[0] = 0.001
+    save_modal_model(ModalModel(**fields, damping_ratios=d, damping_interval=(0.0009, 0.0012),
+                                wall=WALL_MATERIALS["aluminium"]), tmp_path / "host.toml")
+    text = MINIMAL.replace('kind = "interval"', 'kind = "interval"\nmodal_model = "host.toml"') + """
+g_star = "1 mm"
+[impactor]
+radius = "5 mm"
+material = "steel"
+[parameters.D]
+[parameters.k_H]
+best_estimate = "1.25 k_H*"
+"""
+    study = load_study(write(tmp_path, text))
+    k_H_star = sphere_of(5e-3, "steel", wall="aluminium").k_H_star
+    assert study.space["k_H"].nominal == k_H_star and study.space["k_H"].max == pytest.approx(428 / 282 * k_H_star)
+    assert study.space.extras["k_H_best_estimate"] == pytest.approx(1.25 * k_H_star)
+    D = study.space["D"]
+    assert (D.nominal, D.min, D.max) == (0.001, 0.0009, 0.0012)
+    assert study.g_star == 1e-3 and study.impactor == {"radius": 5e-3, "material": "steel"}
+    model = study.make_model().with_rig()
+    system_model, impactor = model.simulated_system(study.space.nominal())
+    assert impactor.mass == pytest.approx(4 / 3 * np.pi * 5e-3**3 * 7810.0) and impactor.k_H == k_H_star
+    assert model.describe()["impactor"] == {"radius": 5e-3, "material": "steel"} and model.describe()["g_star"] == 1e-3
+
+
+@pytest.mark.parametrize("table, message", [
+    ('[impactor]\nmaterial = "gold"', "[impactor] unknown sphere material 'gold'"),
+    ('[impactor]\nwall_material = "wood"', "[impactor] unknown wall material 'wood'"),
+    ('[impactor]\nradius = "5 mm"\nmaterial = "steel"\nmass = "1 g"', "disagrees with a solid steel sphere"),
+    ('[impactor]\ncolour = "red"', "unknown key 'colour' in [impactor]"),
+])
+def test_a_bad_impactor_table_is_one_line(tmp_path, capsys, table, message):
+    path = write(tmp_path, MINIMAL + table)
+    assert main(["interval", str(path), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1 and not (tmp_path / "out").exists()
