@@ -207,7 +207,7 @@ def _reproduce_figure(args: argparse.Namespace, figure: str, study: Any, client:
     folder = out / figure
     print(f"{figure}: {study.source} -> {folder}/")
     result = run_study(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet,
-                       allow_large=args.allow_large)
+                       allow_large=args.allow_large, paper_figure=figure)
     paths = study.method.figures(result.folder)
     if row.traced:
         from uq.methods.response import series_traces

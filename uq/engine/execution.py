@@ -80,11 +80,13 @@ def study_key(study: Study, model: Any) -> str:
 
 
 def run_study(study: Study, *, out: Path | None = None, jobs: int | None = 1, scheduler: str | None = None,
-              resume: bool = False, progress: bool = True, client: Any = None,
-              allow_large: bool = False) -> StudyResult:
+              resume: bool = False, progress: bool = True, client: Any = None, allow_large: bool = False,
+              paper_figure: str | None = None) -> StudyResult:
     """Run a study with its method: every (point, level, repetition) of its plan through the task store (cached,
     resumable; serially, on local workers or on Dask), then its analysis, and write its files into `out` (default:
-    the study's [study] output). A study of sub-studies (`Method.substudies`) runs each into a sub-folder."""
+    the study's [study] output). A study of sub-studies (`Method.substudies`) runs each into a sub-folder.
+    paper_figure: the paper's figure the study reproduces (`ies reproduce`), kept in study.json: its figures carry
+    the paper's names (`uq.outputs.paper_figures`)."""
     method = study.method
     parts = method.substudies(study)
     if parts:
@@ -99,13 +101,13 @@ def run_study(study: Study, *, out: Path | None = None, jobs: int | None = 1, sc
     folder = Path(out or study.output)
     try:
         return _run(study, model, plan, folder, jobs=jobs, scheduler=scheduler, resume=resume, progress=progress,
-                    client=client, allow_large=allow_large)
+                    client=client, allow_large=allow_large, paper_figure=paper_figure)
     finally:
         release_output(folder)  # the lock prepare_output took, once the last file is written
 
 
 def _run(study: Study, model: Any, plan: Plan, folder: Path, *, jobs: int | None, scheduler: str | None, resume: bool,
-         progress: bool, client: Any, allow_large: bool) -> StudyResult:
+         progress: bool, client: Any, allow_large: bool, paper_figure: str | None) -> StudyResult:
     """`run_study` of one study from its output folder on: the kernels, the cost estimate (refused above an hour
     unless `allow_large`), the tasks, the analysis and the files."""
     method = study.method
@@ -142,7 +144,8 @@ def _run(study: Study, model: Any, plan: Plan, folder: Path, *, jobs: int | None
     result.files.append(_netcdf(study, model, folder, plan, records, stats, regimes, analysis))
     result.summary = {"tasks": len(records), "ran": ran, "reused": len(records) - ran, "failed_runs": failed,
                       "wall_time_s": elapsed, "points": len(plan.points), **analysis.summary}
-    result.files.append(_metadata(study, model, result, {"summary": result.summary, **analysis.metadata}))
+    result.files.append(_metadata(study, model, result, {"summary": result.summary, **analysis.metadata,
+                                                          **({"paper_figure": paper_figure} if paper_figure else {})}))
     return result
 
 
