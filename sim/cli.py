@@ -498,6 +498,11 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
     model, impactor = build_system(args)
     nominal = nominal_of(args, model)
     levels = [level_of(value, model, nominal) for value in levels]
+    lyapunov = getattr(args, "lyapunov", False)
+    if lyapunov:
+        from sim.stepped_sine.protocol import check_lyapunov_holds
+
+        check_lyapunov_holds(model, protocol)
     if args.plot:
         check_writable(args.plot, "--plot")
     total = len(levels) * args.reps * len(protocol.legs) * protocol.n_eta
@@ -511,7 +516,7 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
                            allow_large=args.allow_large)
         with progress(total, label, "pt", enabled=long_run, leave=False) as bar:
             results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed, nominal=nominal,
-                             progress=bar.update) for level in levels]
+                             progress=bar.update, lyapunov=lyapunov) for level in levels]
         yield folder, protocol, model, impactor, results
 
 
@@ -550,12 +555,15 @@ def add_sweep_arguments(parser: argparse.ArgumentParser) -> None:
                         help="excitation level a_base/a_base* (-), a_base* = 2 D* g*/(phi_c phi^T M b) with the host's "
                              "nominal D* and g* (--g-star); or the base amplitude with its unit, e.g. 3.3um")
     add_simulation_arguments(parser, default_reps=5, figure="Fig. 5", stem="sweep")
+    parser.add_argument("--lyapunov", action="store_true",
+                        help="each hold's largest Lyapunov exponent and dynamics (periodic, quasi-periodic, chaotic) "
+                             "as columns beside the regime (sim.stepped_sine.dynamics; about 0.2 s more per point)")
 
 
 def sweep_command(args: argparse.Namespace) -> int:
     """`ies sweep`: one stepped-sine frequency response (Sects. 5.1, 5.2; Fig. 5)."""
     from sim.plots.figures import plot_sweep, sweep_title
-    from sim.stepped_sine.tables import SWEEP_COLUMNS, sweep_rows
+    from sim.stepped_sine.tables import sweep_columns, sweep_rows
 
     started = time.perf_counter()
     with simulation(args, [args.level], label="sweep") as (folder, protocol, model, impactor, (result,)):
@@ -563,14 +571,17 @@ def sweep_command(args: argparse.Namespace) -> int:
         data = result.to_dict()
         data.update(wall_time_s=time.perf_counter() - started, seed=args.seed, reps=args.reps,
                     **system_data(model, impactor, nominal))
-        written = write_results(folder, "sweep", SWEEP_COLUMNS, sweep_rows(result), data)
+        written = write_results(folder, "sweep", sweep_columns(result), sweep_rows(result), data)
     lines = [f"# a_base/a_base* = {result.level:g}: {result.n_runs} runs, {result.n_samples} samples, "
              f"{protocol.integrator}, {data['wall_time_s']:.1f} s",
              f"# {nominal.text()}; a_base = {result.a_base * 1e6:.4g} um",
-             f"{'eta':>7} {'mean':>8} {'max':>8} {'cv':>6} {'imp/T':>6}  regime"]
+             f"{'eta':>7} {'mean':>8} {'max':>8} {'cv':>6} {'imp/T':>6}  regime"
+             + ("  lyapunov/T  dynamics" if result.dynamics is not None else "")]
     for i, eta in enumerate(result.eta):
         lines.append(f"{eta:7.4f} {result.mean[i]:8.4f} {result.max[i]:8.4f} {result.cv[i]:6.3f} "
-                     f"{result.impacts_per_period[i]:6.2f}  {result.regime_per_eta[i]}")
+                     f"{result.impacts_per_period[i]:6.2f}  {result.regime_per_eta[i]}"
+                     + (f"{'':<{6 - len(result.regime_per_eta[i])}} {result.lyapunov_per_period[i]:11.4g}  "
+                        f"{result.dynamics[i]}" if result.dynamics is not None else ""))
     lines.append(f"resonant mean {result.resonant_mean:.4f} at eta {result.eta_resonant_mean:.4f} ({result.regime}); "
                  f"resonant max {result.resonant_max:.4f} at eta {result.eta_resonant_max:.4f}")
     return report(args, data, written, lambda path: plot_sweep(data, path, sweep_title(data)), "\n".join(lines))
@@ -607,16 +618,16 @@ def overview_command(args: argparse.Namespace) -> int:
 
 def add_trace_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of `ies trace`."""
-    from sim.analysis.trace import DEFAULT_FS, DEFAULT_PERIODS
+    from sim.analysis.trace import DEFAULT_FS, DEFAULT_PERIODS, LYAPUNOV_PERIODS
 
     parser.add_argument("--level", type=level_option, required=True, metavar="L",
                         help="excitation level a_base/a_base* (-), or the base amplitude with its unit, e.g. 3.3um")
     parser.add_argument("--eta", required=True, metavar="ETA|START:STOP:N",
                         help="eta = Omega/omega_1 of the traced point, or a grid: the run visits it as ies sweep does "
                              "(--sequence) and traces its last point")
-    parser.add_argument("--periods", type=positive_int, default=DEFAULT_PERIODS, metavar="N",
+    parser.add_argument("--periods", type=positive_int, default=None, metavar="N",
                         help=f"excitation periods recorded from the start of the traced point's hold (default "
-                             f"{DEFAULT_PERIODS})")
+                             f"{DEFAULT_PERIODS}, {LYAPUNOV_PERIODS} with --lyapunov)")
     parser.add_argument("--fs", type=float, default=DEFAULT_FS, metavar="HZ",
                         help=f"sampling rate in Hz (default {DEFAULT_FS:g}, the paper's); rounded to a whole number "
                              "of samples per excitation period (the JSON's fs is the rate used)")
@@ -628,12 +639,20 @@ def add_trace_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--plot", type=figure_file, metavar="FILE",
                         help="write Figs. 4 (tip response, amplitudes, mean and max) and 9a (tip velocity, impacts) "
                              "as two panels of one figure")
+    parser.add_argument("--lyapunov", action="store_true",
+                        help="the largest Lyapunov exponent over the recorded periods (per period, with its "
+                             "convergence) and the dynamics: periodic, quasi-periodic or chaotic (sim.stepped_sine.dynamics)")
+    parser.add_argument("--poincare", action="store_true",
+                        help="the Poincare section (the tip once per period) and the per-period amplitudes' spectrum: "
+                             "poincare.png in --out and 'poincare' in trace.json")
 
 
 def trace_command(args: argparse.Namespace) -> int:
     """`ies trace`: time histories of one stepped-sine point (Sects. 5.1, 5.5; Figs. 4, 9a)."""
-    from sim.analysis.trace import SAMPLE_COST_S, check_trace_settings, record_trace, trace_samples, write_trace
+    from sim.analysis.trace import (DEFAULT_PERIODS, LYAPUNOV_PERIODS, SAMPLE_COST_S, check_nature_settings,
+                                    check_trace_settings, record_trace, trace_nature, trace_samples, write_trace)
     from sim.plots.figures import plot_trace
+    from sim.plots.dynamics import plot_poincare
     from sim.common.files import check_writable, dumps, report_written, write_or_fallback
     from sim.integration.integrators import warm_up
     from sim.stepped_sine.cost import ANNOUNCE_AFTER_S, check_estimate, check_trace_memory, estimate, probe_cost, \
@@ -644,7 +663,10 @@ def trace_command(args: argparse.Namespace) -> int:
     model, impactor = build_system(args)
     nominal = nominal_of(args, model)
     level = level_of(args.level, model, nominal)
+    if args.periods is None:
+        args.periods = LYAPUNOV_PERIODS if args.lyapunov else DEFAULT_PERIODS
     check_trace_settings(model, protocol, args.periods, args.fs)  # before the kernels compile
+    check_nature_settings(args.periods, args.lyapunov, args.poincare)
     samples = trace_samples(model, protocol, args.periods, args.fs)
     check_trace_memory(samples, model.n_modes, "lower --periods or --fs")
     if args.plot:
@@ -659,12 +681,15 @@ def trace_command(args: argparse.Namespace) -> int:
                            "--wait/--hold", allow_large=args.allow_large)
         trace = record_trace(model, impactor, level, protocol, periods=args.periods, fs=args.fs, seed=args.seed,
                              nominal=nominal)
+        nature = trace_nature(trace, model, impactor, protocol, lyapunov=args.lyapunov, poincare=args.poincare,
+                              seed=args.seed)
         settings = {"integrator": protocol.integrator, "seed": args.seed, "protocol": dataclasses.asdict(protocol),
                     "fs_requested": args.fs, **system_data(model, impactor, nominal)}
         plot = Path(args.plot) if args.plot else None
         data, written = write_or_fallback(
             lambda where: write_trace(where, trace, settings, plot if where == folder or plot is None else where / plot.name,
-                                      started, draw=plot_trace), folder, "trace")
+                                      started, draw=plot_trace, nature=nature, draw_poincare=plot_poincare),
+            folder, "trace")
     if args.json:
         print(dumps(data))
         report_written(written, json_mode=True)
@@ -675,6 +700,10 @@ def trace_command(args: argparse.Namespace) -> int:
     print(f"# {nominal.text()}")
     print(f"a/a_noabs*: mean {data['mean']:.4f}, max {data['max']:.4f}, cv {data['cv']:.3f}; "
           f"{data['impacts_per_period']:.2f} contact onsets per period, {len(data['impacts'])} impacts between samples")
+    if args.lyapunov:
+        from sim.analysis.trace import nature_line
+
+        print(nature_line(data))
     report_written(written)
     return 0
 
@@ -693,7 +722,8 @@ def orbits_command(args: argparse.Namespace) -> int:
     """`ies orbits`: periodic orbits with their stability and bifurcations (`sim.orbits`)."""
     from sim.orbits.cli import run
 
-    return run(args, build_system, output_folder, system_data)
+    return run(args, build_system, output_folder, system_data, nominal_of=nominal_of, level_value=level_value,
+               level_of=level_of)
 
 
 # ---- ies cache -------------------------------------------------------------------------------------------------

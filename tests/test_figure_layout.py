@@ -506,6 +506,21 @@ def draw_sweep(tmp: Path) -> None:
     sim.plots.figures.plot_sweep(sweep_data(7.4, "APR"), tmp / "fig5.png", sim.plots.figures.sweep_title(sweep_data(7.4, "APR")))
 
 
+def draw_dynamics(tmp: Path) -> None:
+    """`ies trace --poincare`'s figure (a cloud and a broad spectrum) and `ies sweep --lyapunov`'s markers."""
+    import sim.plots.dynamics
+
+    rng = np.random.default_rng(1)
+    a = 0.29 + 0.01 * rng.standard_normal(400)
+    section = {"q_tip": 0.15 + 0.02 * rng.standard_normal(401), "v_tip": 0.25 + 0.03 * rng.standard_normal(401),
+               "frequency_per_period": np.fft.rfftfreq(400), "amplitude_spectrum": np.abs(np.fft.rfft(a - a.mean())) ** 2}
+    sim.plots.dynamics.plot_poincare({"level": 7.4, "eta_actual": 0.978, "dynamics": "chaotic",
+                                      "lyapunov_per_period": 7.3, "poincare": section}, tmp / "poincare.png")
+    data = sweep_data(7.4, "APR")
+    data["dynamics"] = ["chaotic" if i % 3 else "periodic" for i in range(len(data["eta"]))]
+    sim.plots.figures.plot_sweep(data, tmp / "fig5-dynamics.png", sim.plots.figures.sweep_title(data))
+
+
 def draw_overview_command(tmp: Path) -> None:
     data = overview()
     data.update(sweeps=[{"protocol": {"sequence": "down", "integrator": "exact"}}], reps=3)
@@ -676,7 +691,7 @@ def draw_measured(tmp: Path) -> None:
                    damping_interval(mode, 0.58e-3, 0.95e-3, (0.3e-3, 1e-3)))
 
 
-FIGURES = {"response (fig5, fig6, figD2, figD3)": draw_response, "measured host (figA1, figB2)": draw_measured, "orbits": draw_orbits, "design (map, curves)": draw_design, "sweep": draw_sweep, "overview": draw_overview_command,
+FIGURES = {"response (fig5, fig6, figD2, figD3)": draw_response, "measured host (figA1, figB2)": draw_measured, "orbits": draw_orbits, "dynamics": draw_dynamics, "design (map, curves)": draw_design, "sweep": draw_sweep, "overview": draw_overview_command,
            "interval (fig7, fig8, nominal-levels)": draw_interval, "interval of r (figD3)": draw_interval_restitution,
            "sobol": draw_sobol, "series (fig11, figC1, compare)": draw_series, "trace": draw_trace,
            "motion": draw_motion, "modal-fit (fig9b)": draw_modal_fit, "calibrate": draw_calibrate,

@@ -10,7 +10,7 @@ from sim.analysis.cli import IMPACTS_JSON, MODAL_FIT_JSON
 from sim.analysis.trace import TRACE_CSV, TRACE_JSON
 from sim.common.outputs import OutputFile, describe
 from sim.measured.tables import TABLES as MEASURED_TABLES
-from sim.orbits.tables import ORBITS_CSV
+from sim.orbits.tables import ORBITS_CSV, START_ATTEMPTS_JSON
 from sim.stepped_sine.tables import OVERVIEW_CSV, OVERVIEW_JSON, SWEEP_CSV, SWEEP_JSON
 from uq.design.results import DESIGN_CSV, DESIGN_JSON, DESIGN_LEVELS_CSV
 from uq.methods import kinds
@@ -46,7 +46,7 @@ SECTIONS: tuple[tuple[str, tuple[OutputFile, ...]], ...] = (
                                                               RESULTS_NC)),
     ("Several response studies side by side (`ies compare`)", (COMPARE_CSV,)),
     ("Designs (`ies design`)", (DESIGN_CSV, DESIGN_LEVELS_CSV, DESIGN_JSON)),
-    ("Periodic orbits (`ies orbits`)", (ORBITS_CSV,)),
+    ("Periodic orbits (`ies orbits`)", (ORBITS_CSV, START_ATTEMPTS_JSON)),
     ("The measured host (`ies identify`, `ies linearity`)", MEASURED_TABLES),
 )
 

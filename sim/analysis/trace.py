@@ -23,6 +23,9 @@ import numpy as np
 from sim.common.errors import SimulationInputError
 from sim.common.outputs import Column, OutputFile
 from sim.integration.energy import Ledger
+from sim.stepped_sine.dynamics import (check_record, classify, largest_lyapunov, linear_host_exponent, one_period,
+                                       periodicity, state_scales)
+from sim.stepped_sine.dynamics import poincare as poincare_section
 from sim.stepped_sine.measures import SCATTERING_MEASURES, hold_measures, point_measures
 from sim.stepped_sine.protocol import SteppedSine, check_level, simulated_system, visit_points
 from sim.analysis.signals import Signal, SimulatedContacts, simulated_contacts, simulated_signal
@@ -65,6 +68,20 @@ TRACE_JSON = OutputFile("trace.json", "ies trace --out DIR, also --json", "The c
            "the stretch's scattering measures, as the columns of sweep.csv"),
     Column("columns, units", "", "trace.csv's column names and their units"),
     Column("wall_time_s", "s", "the command's wall time"),
+    Column("lyapunov_per_period", "-", "with --lyapunov: the largest Lyapunov exponent, natural log per excitation "
+           "period, over the recorded periods (`sim.stepped_sine.dynamics`)"),
+    Column("lyapunov_standard_error", "-", "its standard error (batch means)"),
+    Column("lyapunov_convergence", "-", "the running estimate over the record after its transient, one per period"),
+    Column("lyapunov_transient_periods, lyapunov_periods_needed", "-", "the periods left out at the record's start; "
+           "the record that would bring the error below 5 % of the exponent (or 2e-3)"),
+    Column("lyapunov_converged", "", "true when the error is that small"),
+    Column("lyapunov_linear_host", "-", "without impactor: mode 1's decay -2 pi D_1/eta per period, what the exponent "
+           "of the linear host is; null with the sphere"),
+    Column("dynamics", "", "with --lyapunov: periodic, quasi-periodic or chaotic"),
+    Column("dynamics_period", "-", "k of a periodic response that repeats after k periods (null otherwise)"),
+    Column("poincare", "", "with --poincare: q_tip, v_tip (the tip's displacement and velocity / Omega at phase 0 "
+           "over a_noabs*, one per period), frequency_per_period, amplitude_spectrum (the per-period amplitudes' "
+           "power spectrum, mean removed)"),
 ))
 #: The columns of the trace's CSV, in order
 COLUMNS = TRACE_CSV.names
@@ -171,6 +188,68 @@ def record_trace(model: ModalModel, impactor: Impactor | None, level: float, pro
                  a_noabs=a_noabs, eta=eta, eta_actual=eta_actual, Omega=Omega, ledger=ledger)
 
 
+#: Recorded periods with --lyapunov when --periods is not given, and the least that --poincare draws.
+LYAPUNOV_PERIODS = 400
+POINCARE_MIN_PERIODS = 8
+
+
+def check_nature_settings(periods: int, lyapunov: bool, poincare: bool) -> None:
+    """One line (SimulationInputError) for a record too short for --lyapunov (`sim.stepped_sine.dynamics.
+    check_record`, naming the length needed) or --poincare (POINCARE_MIN_PERIODS), before anything is simulated."""
+    if lyapunov:
+        check_record(periods)
+    if poincare and periods < POINCARE_MIN_PERIODS:
+        raise SimulationInputError(f"--poincare draws the state once per period and the spectrum of the per-period "
+                                   f"amplitudes: it needs at least {POINCARE_MIN_PERIODS} periods, got --periods "
+                                   f"{periods}; give --periods {POINCARE_MIN_PERIODS} or more (hundreds show a "
+                                   "section's shape)")
+
+
+def trace_nature(trace: Trace, model: ModalModel, impactor: Impactor | None, protocol: SteppedSine, *,
+                 lyapunov: bool, poincare: bool, seed: int = 0) -> dict[str, Any]:
+    """The JSON keys of the response's nature at the traced point (`sim.stepped_sine.dynamics`; TRACE_JSON):
+    with `lyapunov` the largest exponent over the recorded periods, from the state at the start of the record on the
+    protocol's integrator one period at a time, and the dynamics; with `poincare` the section and the spectrum of
+    the recorded states and amplitudes."""
+    from sim.integration.integrators import get_integrator
+
+    data: dict[str, Any] = {}
+    M = trace.samples_per_period
+    sys = simulated_system(model, impactor)
+    scale = state_scales(model, sys.g)
+    if lyapunov:
+        run = one_period(get_integrator(protocol.integrator, dt_scale=protocol.dt_scale), trace.Omega, trace.a_base, sys,
+                         protocol.integrator)
+        result = largest_lyapunov(run, trace.states[0], trace.amplitudes.size, scale, host_only=impactor is None,
+                                  seed=seed)
+        period = periodicity(trace.states[::M], scale)
+        data.update(lyapunov_per_period=result.per_period, lyapunov_standard_error=result.standard_error,
+                    lyapunov_convergence=result.running, lyapunov_transient_periods=result.transient,
+                    lyapunov_periods_needed=result.periods_needed, lyapunov_converged=result.converged,
+                    lyapunov_linear_host=(linear_host_exponent(model, trace.eta_actual) if impactor is None else None),
+                    dynamics=classify(result, period, float(np.mean(trace.impacts)) if impactor is not None else 0.0),
+                    dynamics_period=period)
+    if poincare:
+        data["poincare"] = poincare_section(trace.states[::M], trace.amplitudes, model, trace.Omega, trace.a_noabs)
+    return data
+
+
+def nature_line(data: dict[str, Any]) -> str:
+    """The line `ies trace --lyapunov` prints: the exponent with its error and convergence, the dynamics, and for the
+    host alone that it is linear and what its exponent is."""
+    line = (f"largest Lyapunov exponent {data['lyapunov_per_period']:.4g} +- {data['lyapunov_standard_error']:.2g} "
+            f"per period over {data['periods'] - data['lyapunov_transient_periods']} periods: {data['dynamics']}")
+    if data.get("dynamics_period"):
+        line += f" ({data['dynamics_period']} T)"
+    if data.get("lyapunov_linear_host") is not None:
+        line += (f"; the host alone is linear: its exponent is mode 1's decay, -2 pi D_1/eta = "
+                 f"{data['lyapunov_linear_host']:.4g} per period")
+    if not data["lyapunov_converged"]:
+        line += (f"; not converged: about {data['lyapunov_periods_needed']} periods would bring its error below 5 % "
+                 f"(--periods {data['lyapunov_periods_needed']})")
+    return line
+
+
 def trace_rows(trace: Trace) -> np.ndarray:
     """The CSV table of a trace: one row per sample, the columns of `COLUMNS`."""
     return np.column_stack([trace.signal[name] for name in COLUMNS])
@@ -221,18 +300,21 @@ def impact_list(trace: Trace) -> dict[str, Any]:
 
 
 def write_trace(folder: Path, trace: Trace, settings: dict[str, Any], plot: str | Path | None = None,
-                started: float | None = None, *, draw: Callable[..., None] | None = None
+                started: float | None = None, *, draw: Callable[..., None] | None = None,
+                nature: dict[str, Any] | None = None, draw_poincare: Callable[..., None] | None = None
                 ) -> tuple[dict[str, Any], list[Path | str]]:
     """Write trace.csv and trace.json into `folder` (and Figs. 4 / 9a to `plot`), all or nothing; returns (the JSON
     data, the paths written). started: time.perf_counter() at the command's start (for wall_time_s); draw: the
     figure's drawing function draw(data, t, q_tip, v_tip, path) (`sim.plots.figures.plot_trace`), handed in by the
-    caller with `plot` (the analysis imports no figure code: the figures sit above it)."""
+    caller with `plot` (the analysis imports no figure code: the figures sit above it); nature: the keys of
+    `trace_nature`, added to trace.json; draw_poincare(data, path): with nature's "poincare", the figure
+    poincare.png in `folder` (`sim.plots.dynamics.plot_poincare`)."""
     from sim.common.files import dumps, write_csv, write_text
 
     if plot and draw is None:
         raise ValueError("write_trace: a plot needs its drawing function (draw=sim.plots.figures.plot_trace)")
 
-    data = trace_data(trace, settings)
+    data = {**trace_data(trace, settings), **(nature or {})}
     written: list[Path | str] = []
     try:
         written.append(write_csv(folder / "trace.csv", COLUMNS, trace_rows(trace)))
@@ -242,6 +324,9 @@ def write_trace(folder: Path, trace: Trace, settings: dict[str, Any], plot: str 
         if plot:
             draw(data, trace.signal.t, trace.signal["q_tip"], trace.signal["v_tip"], plot)
             written.append(plot)
+        if draw_poincare is not None and "poincare" in data:
+            draw_poincare(data, folder / "poincare.png")
+            written.append(folder / "poincare.png")
     except BaseException:
         for path in written:  # all or nothing
             Path(path).unlink(missing_ok=True)

@@ -10,6 +10,7 @@ registers the command and hands in what it shares (the system builder, the outpu
 from __future__ import annotations
 
 import argparse
+import math
 import time
 from pathlib import Path
 from typing import Any, Callable
@@ -37,8 +38,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from sim.orbits.starts import DEFAULT_RESTITUTION
 
     parser.add_argument("--level", required=True, metavar="L1,L2,..|LO:HI",
-                        help="excitation levels a_base/a_base* (-), e.g. 7.4 or 5,7.4,9; with --level-curve the range "
-                             "LO:HI of the level")
+                        help="excitation levels a_base/a_base* (-) or base amplitudes with their unit, e.g. 7.4, "
+                             "5,7.4,9 or 3.3um; with --level-curve the range LO:HI of the level")
     parser.add_argument("--eta", default="0.95:1.0", metavar="LO:HI",
                         help="range of eta = Omega/omega_1 (default 0.95:1.0); with --level-curve ignored")
     parser.add_argument("--level-curve", dest="level_curve", type=float, default=None, metavar="ETA",
@@ -53,16 +54,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"the slow flow's modal restitution r for the slow-flow start (default {DEFAULT_RESTITUTION})")
     parser.add_argument("--max-period", dest="max_period", type=_period_multiple, default=2, metavar="K",
                         help="largest period multiple k of a kT orbit found by period doubling (default 2, at most 8)")
-    parser.add_argument("--switches", type=count, default=2, metavar="N",
+    parser.add_argument("--switches", type=count, default=None, metavar="N",
                         help="branch switchings at symmetry-breaking and period-doubling points, those nearest to a "
-                             "stable orbit first (default 2; 0: the start's branch only)")
+                             "stable orbit first (default: every located one, within the response's budget; 0: the "
+                             "start's branch and the direct-simulation searches only)")
     parser.add_argument("--integrator", default=DEFAULT_INTEGRATOR, choices=tuple(INTEGRATORS),
                         help=f"time integrator of the shooting (default {DEFAULT_INTEGRATOR}; the others for checks)")
     scaled = " and ".join(name for name, record in INTEGRATORS.items() if record.dt_scale)
     parser.add_argument("--dt-scale", dest="dt_scale", type=float, default=1.0, metavar="X",
                         help=f"{scaled} step as a multiple of the paper's 2 pi/(15 omega_9) (default 1)")
     parser.add_argument("--sweep", metavar="DIR",
-                        help="an `ies sweep --out DIR` folder whose stepped-sine points are drawn on the orbits")
+                        help="an `ies sweep --out DIR` folder whose stepped-sine points are drawn on the orbits of its "
+                             "level (one of --level's), with their dynamics when it was run with --lyapunov")
     parser.add_argument("--out", required=True, metavar="DIR",
                         help="write orbits.csv, results.nc, orbits.json and orbits.png (or --plot) into DIR")
     parser.add_argument("--plot", type=figure_file, default=None, metavar="FILE",
@@ -72,24 +75,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print orbits.json's object instead of the text summary")
 
 
-def _levels(text: str, curve: bool) -> tuple[list[float], tuple[float, float] | None]:
-    """(levels, level range): a list of levels, or with --level-curve the range LO:HI."""
-    from sim.stepped_sine.protocol import check_level
-
+def _levels(text: str, curve: bool, value: Callable[[str], float]) -> tuple[list[float], tuple[float, float] | None]:
+    """(levels, level range): a list of levels, or with --level-curve the range LO:HI; each a level a_base/a_base* or
+    a base amplitude with its unit (3.3um), read by `value` (`sim.cli.level_value`)."""
     if curve:
         parts = text.split(":")
-        try:
-            lo, hi = (float(p) for p in parts)
-        except ValueError:
-            raise SimulationInputError(f"--level with --level-curve must be a range LO:HI like 5:9, got {text!r}") from None
-        return [], (check_level(lo), check_level(hi))
-    try:
-        values = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise SimulationInputError(f"--level must be numbers like 7.4 or 5,7.4,9, got {text!r}") from None
+        if len(parts) != 2:
+            raise SimulationInputError(f"--level with --level-curve must be a range LO:HI like 5:9, got {text!r}")
+        return [], (value(parts[0]), value(parts[1]))
+    values = [value(v) for v in text.split(",") if v.strip()]
     if not values:
         raise SimulationInputError("--level is empty; give at least one excitation level, e.g. 7.4")
-    return [check_level(v) for v in values], None
+    return values, None
 
 
 def _eta_range(text: str) -> tuple[float, float]:
@@ -103,58 +100,89 @@ def _eta_range(text: str) -> tuple[float, float]:
     return lo, hi
 
 
+def _sweep_for(folder: str, levels: list[float], curve: bool) -> dict:
+    """The stepped-sine points of `--sweep DIR` (`sim.orbits.figures.read_sweep`), refused in one line when there are
+    none, when they are of another level than every one of --level's (they would be drawn on nothing), or with
+    --level-curve (its axis is the level, a sweep's is eta)."""
+    from sim.orbits.figures import read_sweep
+
+    sweep = read_sweep(folder)
+    if sweep is None:
+        raise SimulationInputError(f"--sweep {folder}: no sweep.csv there; give a folder written by `ies sweep --out DIR`")
+    if curve:
+        raise SimulationInputError(f"--sweep {folder}: a stepped sine runs over eta, the level curve (--level-curve) "
+                                   "over the level; drop --sweep or --level-curve")
+    level = float(sweep["level"][0])
+    if not math.isfinite(level):
+        raise SimulationInputError(f"--sweep {folder}: its sweep.json names no level; give a folder written by "
+                                   "`ies sweep --out DIR`")
+    if not any(math.isclose(level, other, rel_tol=1e-9) for other in levels):
+        raise SimulationInputError(f"--sweep {folder} is a stepped sine at level {level:g}, not at --level "
+                                   f"{','.join(f'{v:g}' for v in levels)}: add {level:g} to --level or give a sweep of "
+                                   "one of them")
+    return sweep
+
+
 def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], tuple[Any, Any]],
-        output_folder: Callable[..., Any], system_data: Callable[[Any, Any], dict]) -> int:
-    """`ies orbits` (module docstring): build the system (`sim.cli.build_system`), compute every level's (or the
-    eta's) orbits, then write the files into the output folder (`sim.cli.output_folder`) and print the summary."""
+        output_folder: Callable[..., Any], system_data: Callable[..., dict], *,
+        nominal_of: Callable[[argparse.Namespace, Any], Any], level_value: Callable[[str], float],
+        level_of: Callable[[float, Any, Any], float]) -> int:
+    """`ies orbits` (module docstring): build the system (`sim.cli.build_system`) and its normalisation
+    (`sim.cli.nominal_of`: the host's own D_1*, --g-star), read the levels (`sim.cli.level_value`, `level_of`: a level
+    or a base amplitude with its unit), compute every level's (or the eta's) orbits, then write the files into the
+    output folder (`sim.cli.output_folder`) and print the summary."""
     import sys
 
     from tqdm import tqdm
 
     from sim.common.files import check_writable, dumps, report_written, write_or_fallback
     from sim.integration.integrators import warm_up
-    from sim.orbits.figures import plot_orbits, read_sweep
-    from sim.orbits.response import check_range, orbit_response
+    from sim.orbits.figures import plot_orbits
+    from sim.orbits.response import StartFailed, check_range, orbit_response
     from sim.orbits.setting import OrbitSetting
     from sim.orbits.shooting import OrbitNotConverged
-    from sim.orbits.tables import ORBITS_COLUMNS, orbit_rows, orbit_table, response_summary, write_orbit_files
+    from sim.orbits.tables import (ORBITS_COLUMNS, orbit_rows, orbit_table, response_summary, write_orbit_files,
+                                   write_start_attempts)
 
     started = time.perf_counter()
     if args.no_impactor:
         raise SimulationInputError("ies orbits needs the sphere: without it the host is linear and its only orbit is "
                                    "the analytic frequency response (ies sweep --no-impactor)")
     curve = args.level_curve is not None
-    levels, level_range = _levels(args.level, curve)
+    levels, level_range = _levels(args.level, curve, level_value)
     eta_range = check_range("eta", _eta_range(args.eta)) if not curve else None
-    if curve:
-        check_range("eta", (args.level_curve, args.level_curve * (1 + 1e-9)))
-        check_range("level", level_range)
-    sweep = None
-    if args.sweep is not None:
-        sweep = read_sweep(args.sweep)
-        if sweep is None:
-            raise SimulationInputError(f"--sweep {args.sweep}: no sweep.csv there; give a folder written by "
-                                       "`ies sweep --out DIR`")
     if args.plot:
         check_writable(args.plot, "--plot")
     model, impactor = build_system(args)
+    nominal = nominal_of(args, model)
+    levels = [level_of(v, model, nominal) for v in levels]
+    if curve:
+        level_range = tuple(level_of(v, model, nominal) for v in level_range)
+        check_range("eta", (args.level_curve, args.level_curve * (1 + 1e-9)))
+        check_range("level", level_range)
+    sweep = _sweep_for(args.sweep, levels, curve) if args.sweep is not None else None
     if not (args.dt_scale > 0):
         raise SimulationInputError(f"--dt-scale must be positive, got {args.dt_scale!r}")
+    # every setting is built (and refused) before the kernels compile: friction, a bad level, ...
+    if curve:
+        todo = [(OrbitSetting(model, impactor, level_range[0], args.level_curve, integrator=args.integrator,
+                              dt_scale=args.dt_scale, nominal=nominal), "level", level_range)]
+    else:
+        todo = [(OrbitSetting(model, impactor, level, 0.5 * sum(eta_range), integrator=args.integrator,
+                              dt_scale=args.dt_scale, nominal=nominal), "eta", eta_range) for level in levels]
     with output_folder(args.out, args.force) as folder:
         warm_up(args.integrator, law=impactor.contact_law.law.name)
         responses = []
         with tqdm(desc="orbits", unit="orbit", disable=not sys.stderr.isatty(), leave=False, file=sys.stderr) as bar:
-            if curve:
-                base = OrbitSetting(model, impactor, level_range[0], args.level_curve, integrator=args.integrator,
-                                    dt_scale=args.dt_scale)
-                todo = [(base, "level", level_range)]
-            else:
-                todo = [(OrbitSetting(model, impactor, level, 0.5 * sum(eta_range), integrator=args.integrator,
-                                      dt_scale=args.dt_scale), "eta", eta_range) for level in levels]
             for base, name, bounds in todo:
-                response = orbit_response(base, name, bounds, start=args.start, at=args.at,
-                                          max_period=args.max_period, switches=args.switches,
-                                          restitution=args.restitution, progress=bar.update)
+                try:
+                    response = orbit_response(base, name, bounds, start=args.start, at=args.at,
+                                              max_period=args.max_period, switches=args.switches,
+                                              restitution=args.restitution, progress=bar.update)
+                except StartFailed as failure:  # keep what it tried, say what else to try
+                    written = write_or_fallback(lambda where: [write_start_attempts(where, failure)], folder,
+                                                "orbits")
+                    raise OrbitNotConverged(f"{failure}; wrote {written[0]}") from None
                 responses.append(response)
         if all(r.impacts and not r.branches for r in responses):  # nothing found anywhere: say why, write nothing
             where = (f"level {responses[-1].base.level:g}" if not curve else f"eta {args.level_curve:g}")
@@ -164,7 +192,7 @@ def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], t
                     "levels": levels if not curve else None, "level_range": level_range,
                     "eta_range": eta_range, "level_curve_eta": args.level_curve, "start": args.start,
                     "max_period": args.max_period, "switches": args.switches, "restitution": args.restitution,
-                    "integrator": args.integrator, "dt_scale": args.dt_scale, **system_data(model, impactor),
+                    "integrator": args.integrator, "dt_scale": args.dt_scale, **system_data(model, impactor, nominal),
                     "wall_time_s": time.perf_counter() - started}
         rows = orbit_rows(responses)
         panels = []
@@ -172,7 +200,7 @@ def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], t
             cols = {name: [r[j] for r in rows if (r[0] == response.base.level if not curve else True)]
                     for j, name in enumerate(ORBITS_COLUMNS)}
             level_sweep = (sweep if sweep is not None and not curve
-                           and abs(float(sweep["level"][0]) - response.base.level) < 1e-9 else None)
+                           and math.isclose(float(sweep["level"][0]), response.base.level, rel_tol=1e-9) else None)
             title = (f"$a_\\mathrm{{base}}/a_\\mathrm{{base}}^* = {response.base.level:g}$" if not curve
                      else f"$\\eta = {response.base.eta:g}$")
             panels.append((cols, title, response.bounds, level_sweep))

@@ -41,7 +41,8 @@ import numpy as np
 
 from sim.common.errors import SimulationDiverged, SimulationInputError
 from sim.orbits.setting import OrbitSetting, Parameter, parameter
-from sim.orbits.shooting import (NOISE_FLOOR, TOLERANCE, MapValue, PeriodicOrbit, ShootingMap, make_orbit, newton_matrix)
+from sim.orbits.shooting import (NOISE_FLOOR, TOLERANCE, MapValue, PeriodicOrbit, ShootingMap, fd_step, make_orbit,
+                                 newton_matrix)
 
 #: Corrector iterations before a step is refused.
 MAX_CORRECTOR = 24
@@ -74,20 +75,37 @@ MAX_POINTS = 1500
 @dataclass
 class BranchPoint:
     """One point of a branch: the orbit, its continuation coordinate (`Parameter.to_coordinate` of the value),
-    the unit tangent in the scaled unknowns (length 2n + 3) and the bifurcation label of the point ("" for none;
-    `sim.orbits.bifurcations`)."""
+    the unit tangent in the scaled unknowns (length 2n + 3), the bifurcation label of the point ("" for none;
+    `sim.orbits.bifurcations`), a note on it, and how well it is located (|mu| - 1 at a multiplier crossing, the
+    smallest free-flight gap over g at a grazing; NaN for no label)."""
 
     orbit: PeriodicOrbit
     coordinate: float
     tangent: np.ndarray
     label: str = ""
     note: str = ""
+    location_error: float = math.nan
+
+
+@dataclass
+class Unlocated:
+    """A change of stability or of the impacts between two points of a branch that could not be located (`what`:
+    one line; `sim.orbits.bifurcations`)."""
+
+    what: str
+    before: BranchPoint
+    after: BranchPoint
+
+    def __str__(self) -> str:
+        return self.what
 
 
 @dataclass
 class Branch:
     """A branch of kT orbits continued in `parameter` (`sim.orbits.setting.Parameter`): its points in the order of
-    the arclength, where it came from (`origin`) and why it ended (`stop`)."""
+    the arclength, where it came from (`origin`), why it ended (`stop`), and the changes of stability or of the
+    impacts between two of its points that could not be located (`unlocated`; not labelled, `sim.orbits.bifurcations`);
+    rejoins: for a switched branch that came back through its parent, the parameter values between which it did."""
 
     parameter: Parameter
     k: int
@@ -95,6 +113,8 @@ class Branch:
     points: list[BranchPoint] = field(default_factory=list)
     origin: str = ""
     stop: str = ""
+    unlocated: list[Unlocated] = field(default_factory=list)
+    rejoins: tuple[float, float] | None = None
 
     def values(self) -> np.ndarray:
         """The parameter's value at every point."""
@@ -102,21 +122,27 @@ class Branch:
 
 
 class Continuer:
-    """The arclength machinery of one branch family: a base setting, the parameter, the period multiple k and
-    whether orbits are solved as symmetric ones (module docstring). `evaluations` counts the integrator runs."""
+    """The arclength machinery of one branch family: a base setting, the parameter (a name of
+    `sim.orbits.setting.PARAMETERS` or a `Parameter`), the period multiple k and whether orbits are solved as
+    symmetric ones (module docstring). `evaluations` counts the integrator runs. map_factory(setting, k, system=...)
+    builds the map (`ShootingMap`; another map with its interface for systems other than Eqs. 3-7: the toy systems
+    of the bifurcation tests)."""
 
-    def __init__(self, base: OrbitSetting, parameter_name: str, k: int, symmetric: bool) -> None:
+    def __init__(self, base: OrbitSetting, parameter_name: str | Parameter, k: int, symmetric: bool, *,
+                 map_factory: Callable[..., ShootingMap] = ShootingMap) -> None:
         self.base = base
-        self.parameter = parameter(parameter_name)
+        self.parameter = parameter_name if isinstance(parameter_name, Parameter) else parameter(parameter_name)
         self.k = k
         self.symmetric = symmetric
         self.scale = base.scales()
         self.n = self.scale.size
+        self.map_factory = map_factory
         self._maps: dict[float, ShootingMap] = {}
         self._map: ShootingMap | None = None
         self._map_key = math.nan
         self._system = base.system()
         self.evaluations = 0
+        self.fd_step: float | None = None  # the Jacobians' step, chosen at the branch's first point (`fd_step`)
 
     # -- the unknowns ---------------------------------------------------------------------------------------
     def unknowns(self, orbit: PeriodicOrbit) -> np.ndarray:
@@ -134,17 +160,21 @@ class Continuer:
         key = float(coordinate)
         if self.parameter.name in EXCITATION:  # one map, moved to each excitation (the system stays)
             if self._map is None:
-                self._map = ShootingMap(self._setting(key), self.k, system=self._system)
+                self._map = self.map_factory(self._setting(key), self.k, system=self._system)
                 self._map_key = key
             elif self._map_key != key:
                 self._map.retarget(self._setting(key))
                 self._map_key = key
-            return self._map
-        if key not in self._maps:
-            if len(self._maps) > 8:
-                self._maps.pop(next(iter(self._maps)))
-            self._maps[key] = ShootingMap(self._setting(key), self.k)
-        return self._maps[key]
+            chosen = self._map
+        else:
+            if key not in self._maps:
+                if len(self._maps) > 8:
+                    self._maps.pop(next(iter(self._maps)))
+                self._maps[key] = self.map_factory(self._setting(key), self.k)
+            chosen = self._maps[key]
+        if self.fd_step is not None:
+            chosen.fd_step = self.fd_step
+        return chosen
 
     def _setting(self, key: float) -> OrbitSetting:
         """The setting at the continuation coordinate `key`; SimulationDiverged where it is not a valid one."""
@@ -168,7 +198,8 @@ class Continuer:
         lam = self.coordinate(u)
         shooting = self.shooting(lam)
         before = shooting.evaluations
-        end, half = shooting.jacobian(u[:-1] * self.scale, base=None if base is None else base[1])
+        end, half = shooting.jacobian(u[:-1] * self.scale, base=None if base is None else base[1],
+                                      one_side=base is None)  # the corrector's iterations: plain differences
         self.evaluations += shooting.evaluations - before
         du = np.zeros_like(u)
         du[-1] = LAMBDA_STEP
@@ -219,6 +250,12 @@ class Continuer:
         """The first point of a branch through a converged orbit, its tangent along `direction` (+1: increasing
         parameter) or `tangent` when given (branch switching), and its augmented Jacobian rows."""
         u = self.unknowns(orbit)
+        if self.fd_step is None:
+            shooting = self.shooting(self.coordinate(u))
+            before = shooting.evaluations
+            self.fd_step = fd_step(shooting, orbit.state, self.symmetric)
+            shooting.fd_step = self.fd_step
+            self.evaluations += shooting.evaluations - before
         r, value = self.residual(u)
         A, jac = self.jacobian(u)
         shooting = self.shooting(self.coordinate(u))
@@ -307,7 +344,7 @@ class Continuer:
         weights = (s - s1) * (s - s2) / (s1 * s2), s * (s - s2) / (s1 * (s1 - s2)), s * (s - s1) / (s2 * (s2 - s1))
         return weights[0] * um2 + weights[1] * um1 + weights[2] * u0
 
-    def advance(self, current: BranchPoint, A: np.ndarray, h: float, *, fix_coordinate: float | None = None,
+    def advance(self, current: BranchPoint, A: np.ndarray | None, h: float, *, fix_coordinate: float | None = None,
                 history: list[np.ndarray] | None = None, strict: bool = True) -> tuple[BranchPoint, np.ndarray, int] | None:
         """One predictor-corrector step of length h from `current`: (point, its augmented Jacobian rows, +1 if the step
         was easy, -1 if hard, else 0), or None if refused (module docstring)."""
@@ -347,21 +384,26 @@ def _closes(continuer: Continuer, first: BranchPoint, previous: BranchPoint, new
     return float(np.linalg.norm(a + s * ab - c)) < 0.1 * length
 
 
-def continue_branch(start: PeriodicOrbit, parameter_name: str, bounds: tuple[float, float], *, direction: float = 1.0,
-                    tangent: np.ndarray | None = None, step: float = INITIAL_STEP, min_step: float = MIN_STEP,
-                    max_step: float = MAX_STEP, max_points: int = MAX_POINTS, origin: str = "",
+def continue_branch(start: PeriodicOrbit, parameter_name: str | Parameter, bounds: tuple[float, float], *,
+                    direction: float = 1.0, tangent: np.ndarray | None = None, step: float = INITIAL_STEP,
+                    min_step: float = MIN_STEP, max_step: float = MAX_STEP, max_points: int = MAX_POINTS,
+                    origin: str = "",
                     detect: Callable[["Continuer", Branch, BranchPoint, BranchPoint, np.ndarray], list] | None = None,
-                    progress: Callable[[], None] | None = None) -> Branch:
-    """Continue the branch through `start` in the parameter `parameter_name` between `bounds` (parameter values)
-    along `direction` (+1 increasing) or along `tangent` (scaled unknowns; branch switching), with the step control
-    of the module docstring. `detect(continuer, branch, previous, new, A_previous)` may insert located bifurcation
-    points between two accepted points and returns them (`sim.orbits.bifurcations.detect`)."""
-    par = parameter(parameter_name)
+                    progress: Callable[[], None] | None = None,
+                    stop: Callable[[BranchPoint], str | None] | None = None,
+                    map_factory: Callable[..., ShootingMap] = ShootingMap) -> Branch:
+    """Continue the branch through `start` in the parameter `parameter_name` (or a `Parameter`) between `bounds`
+    (parameter values) along `direction` (+1 increasing) or along `tangent` (scaled unknowns; branch switching), with
+    the step control of the module docstring. `detect(continuer, branch, previous, new, A_previous)` may insert
+    located bifurcation points between two accepted points and returns them (`sim.orbits.bifurcations.detect`);
+    `stop(point)` ends the branch before the first point for which it returns a reason (that becomes `Branch.stop`);
+    map_factory: as `Continuer`."""
+    par = parameter_name if isinstance(parameter_name, Parameter) else parameter(parameter_name)
     lo, hi = sorted(float(b) for b in bounds)
     value = par.get(start.setting)
     if not lo <= value <= hi:
         raise SimulationInputError(f"orbits: the start's {par.name} = {value:g} lies outside the range {lo:g}:{hi:g}")
-    continuer = Continuer(start.setting, parameter_name, start.k, start.symmetric)
+    continuer = Continuer(start.setting, par, start.k, start.symmetric, map_factory=map_factory)
     current, A = continuer.start(start, direction, tangent)
     branch = Branch(par, start.k, start.symmetric, [current], origin=origin)
     lam_lo, lam_hi = par.to_coordinate(lo), par.to_coordinate(hi)
@@ -393,11 +435,18 @@ def continue_branch(start: PeriodicOrbit, parameter_name: str, bounds: tuple[flo
                 break
             continue
         new, A_new, ease = outcome
-        if detect is not None:
-            branch.points.extend(detect(continuer, branch, current, new, A))
-        branch.points.append(new)
+        found = detect(continuer, branch, current, new, A) if detect is not None else []
+        reason = None
+        for point in [*found, new]:
+            reason = stop(point) if stop is not None else None
+            if reason:
+                break
+            branch.points.append(point)
         if progress is not None:
             progress()
+        if reason:
+            branch.stop = reason
+            break
         if len(branch.points) > 10 and _closes(continuer, branch.points[0], current, new):
             branch.stop = "closed loop (an isola: the branch came back to its start)"
             break

@@ -1,12 +1,22 @@
 """The figure of `ies orbits`: the periodic orbits' frequency response (or level curve), one panel per level (or
 eta), in the workbench's layout (`sim.common.figure_style`: legend beside the axes, mathtext units).
 
-Each branch is drawn solid where its orbits are stable and dashed where not (the linear orbits grey); located
-bifurcations are marked (MARKERS); where no branch has a stable orbit, the range is shaded: there the response
-cannot settle on a periodic orbit of period <= k T and is modulated (or chaotic); the stepped-sine points of a
-sweep folder (`--sweep DIR`: sweep.csv of `ies sweep --out DIR`, mean with its range over the samples) are drawn
-on top. It draws plain columns (`sim.orbits.tables.ORBITS_COLUMNS` as arrays), so it can be redrawn from
-orbits.csv.
+How to read it. Each branch (one colour, named by how it was found) is drawn solid where its orbits are stable and
+dashed where they are unstable, as the legend's first two entries say; the linear orbits (no impact) are grey and
+dotted. Markers sit on located bifurcations only (MARKERS: |mu| within 1e-4 of 1, a grazing's gap within 1e-9 g;
+a change that could not be located has none). The shaded ranges are where no stable orbit of period <= k T was
+found, neither by continuation and branch switching nor by the direct simulations at every change of stability
+(`sim.orbits.searches`): there the response a stepped sine sees cannot be one of these orbits and is modulated,
+quasi-periodic or chaotic. The stepped-sine points of a sweep folder (`--sweep DIR`, of the panel's level: sweep.csv
+of `ies sweep --out DIR`, mean with its range over the samples) are drawn on top, their marker saying their dynamics
+when the sweep measured it (`ies sweep --lyapunov`: periodic, quasi-periodic, chaotic). A point inside the shading is
+not a contradiction: it is an attractor that is not a periodic orbit (chaotic on the rig at 7.4, whose largest
+Lyapunov exponent there is 5-8 per period).
+
+The branches share one colour and one legend entry per kind (the start's, those of symmetry breaking, of period
+doubling, the searches' finds) and period; an entry is drawn as its branches are: a line when one has two or more
+points in the panel's range, the marker of a single orbit, none when nothing of them lies in the range. It draws plain columns
+(`sim.orbits.tables.ORBITS_COLUMNS` as arrays), so it can be redrawn from orbits.csv.
 """
 from __future__ import annotations
 
@@ -22,6 +32,8 @@ MARKERS = {"fold": ">", "symmetry-breaking": "D", "period-doubling": "s", "neima
            "branch-point": "+", "grazing": "x"}
 #: bins of the range in which the shading looks for a stable orbit
 SHADE_BINS = 400
+#: the stepped sine's markers by dynamics (`sim.stepped_sine.dynamics`), "" when the sweep did not measure it
+DYNAMICS_MARKERS = {"periodic": "o", "quasi-periodic": "s", "chaotic": "^", "": "o"}
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -57,55 +69,96 @@ def draw_orbits(ax: Any, columns: Mapping[str, np.ndarray], *, parameter: str = 
     x_all = np.asarray(columns[parameter], dtype=float)
     lo, hi = bounds if bounds is not None else (float(x_all.min()), float(x_all.max()))
     branch_ids = np.asarray(columns["branch"], dtype=int)
+    amp = np.asarray(columns["amplitude"], dtype=float)
     xs, sts = [], []
-    colour = 0
-    drawn_kind: set[str] = set()
+    colours: dict[str, str] = {}  # one colour and one legend entry per kind of branch and period
+    entries: list[tuple[Any, str]] = []
+    impacting = (np.asarray(columns["impacts_per_period"], dtype=float) > 0) & (x_all >= lo) & (x_all <= hi)
+    if impacting.any():  # the line styles first: the legend lists the labelled artists in the order drawn
+        ax.plot([], [], ls="-", color="k", lw=1.4, label="stable orbits (solid)")
+        ax.plot([], [], ls="--", color="k", lw=0.9, label="unstable orbits (dashed)")
+    kinds = np.array([f"{branch_kind(str(o))} ({int(k)} T)" for o, k in zip(np.asarray(columns["origin"]),
+                                                                          np.asarray(columns["period_multiple"]))])
+    stable_all = np.asarray(columns["stable"], dtype=int) == 1
     for b in np.unique(branch_ids):
         sel = branch_ids == b
-        x = x_all[sel]
-        y = np.asarray(columns["amplitude"], dtype=float)[sel]
+        x, y = x_all[sel], amp[sel]
         stable = np.asarray(columns["stable"], dtype=int)[sel] == 1
         linear = np.asarray(columns["impacts_per_period"], dtype=float)[sel] == 0
         origin = str(np.asarray(columns["origin"])[sel][0])
         k = int(np.asarray(columns["period_multiple"], dtype=int)[sel][0])
+        shown = (x >= lo) & (x <= hi)
         if linear.all():
-            ax.plot(x, y, ls=":", color="0.5", lw=1.0, label="linear orbits (sphere at rest; unstable)")
+            if shown.sum() >= 2:
+                line, = ax.plot(x, y, ls=":", color="0.5", lw=1.0)
+                entries.append((line, "linear orbits (sphere at rest; unstable)"))
             continue
         xs.append(x)
         sts.append(stable)
-        c = f"C{colour % 10}"
-        colour += 1
-        name = f"{origin} ({k} T)"
+        if not shown.any():  # nothing of it in the range: no line, no entry
+            continue
+        name = f"{branch_kind(origin)} ({k} T)"
+        first = name not in colours
+        c = colours.setdefault(name, f"C{len(colours) % 10}")
         for start, stop in _runs(stable):
             seg = slice(max(start - 1, 0) if not stable[start] else start, stop)
-            ax.plot(x[seg], y[seg], ls="-" if stable[start] else "--", color=c, lw=1.4 if stable[start] else 0.9,
-                    label=name if name not in drawn_kind else None)
-            drawn_kind.add(name)
+            ax.plot(x[seg], y[seg], ls="-" if stable[start] else "--", color=c, lw=1.4 if stable[start] else 0.9)
+        if shown.sum() == 1:  # one orbit: its marker, in the legend too
+            ax.plot(x[shown], y[shown], ls="none", marker=".", ms=6, color=c, label=name if first else None)
+        elif first:  # solid when some orbit of this kind is stable, else dashed
+            ax.plot([], [], ls="-" if stable_all[kinds == name].any() else "--", color=c, lw=1.4, label=name)
     labels = np.asarray(columns["bifurcation"]).astype(str)
-    amp = np.asarray(columns["amplitude"], dtype=float)
     for label, marker in MARKERS.items():
-        sel = labels == label
+        sel = (labels == label) & (x_all >= lo) & (x_all <= hi)
         if sel.any():
-            ax.plot(x_all[sel], amp[sel], ls="none", marker=marker, ms=5, mfc="none", mec="k", mew=0.8, label=label)
+            points, = ax.plot(x_all[sel], amp[sel], ls="none", marker=marker, ms=5, mfc="none", mec="k", mew=0.8)
+            entries.append((points, label))
     edges, covered = stable_cover(xs, sts, lo, hi)
     shaded = False
     for start, stop in _runs(covered):
         if not covered[start]:
-            ax.axvspan(edges[start], edges[stop], color="0.92", lw=0, zorder=0,
-                       label=None if shaded else f"no stable orbit of period <= {max_period} T: modulated response")
+            patch = ax.axvspan(edges[start], edges[stop], color="0.92", lw=0, zorder=0)
+            if not shaded:
+                entries.append((patch, f"no stable orbit of period <= {max_period} T found (continuation, "
+                                       "switching, searches)"))
             shaded = True
     if sweep is not None and parameter == "eta":
-        mean = np.asarray(sweep["mean"], dtype=float)
-        err = np.vstack([mean - np.asarray(sweep["mean_lo"], dtype=float),
-                         np.asarray(sweep["mean_hi"], dtype=float) - mean])
-        ax.errorbar(np.asarray(sweep["eta"], dtype=float), mean, yerr=err, fmt="o", ms=3, color="k", lw=0.8,
-                    capsize=2, label="stepped sine: mean and range")
+        entries.extend(_draw_sweep(ax, sweep))
     ax.set_xlim(lo, hi)
     ax.set_ylim(bottom=0.0)
     ax.set_xlabel(ETA_LABEL if parameter == "eta" else LEVEL_LABEL)
     ax.set_ylabel(RESPONSE_LABEL)
     if title:
         ax.set_title(title, fontsize=9)
+    for handle, label in entries:
+        handle.set_label(label)
+
+
+def branch_kind(origin: str) -> str:
+    """The kind of a branch from its origin (orbits.csv): "slow-flow start", "symmetry breaking", "period
+    doubling", "simulation" (a search's find), ...: the words before " at " or " from "."""
+    return origin.split(" at ")[0].split(" from ")[0]
+
+
+def _draw_sweep(ax: Any, sweep: Mapping[str, np.ndarray]) -> list[tuple[Any, str]]:
+    """The stepped sine's means with their range over the samples, one marker per dynamics (DYNAMICS_MARKERS);
+    the legend entries, naming the sweep's level."""
+    eta = np.asarray(sweep["eta"], dtype=float)
+    mean = np.asarray(sweep["mean"], dtype=float)
+    err = np.vstack([mean - np.asarray(sweep["mean_lo"], dtype=float), np.asarray(sweep["mean_hi"], dtype=float) - mean])
+    level = float(np.asarray(sweep.get("level", [np.nan]), dtype=float)[0])
+    at = f" at level {level:g}" if np.isfinite(level) else ""
+    dynamics = np.asarray(sweep.get("dynamics", [""] * eta.size)).astype(str)
+    entries = []
+    bars = ax.errorbar(eta, mean, yerr=err, fmt="none", color="k", lw=0.8, capsize=2)
+    for kind in dict.fromkeys(dynamics):
+        sel = dynamics == kind
+        points, = ax.plot(eta[sel], mean[sel], ls="none", marker=DYNAMICS_MARKERS.get(kind, "o"), ms=3.5, color="k",
+                          mfc="k" if kind != "quasi-periodic" else "none")
+        entries.append((points, f"stepped sine{at}: mean" + (f", {kind}" if kind else " and range")))
+    if any(dynamics):
+        entries.append((bars, "stepped sine: range over the samples"))
+    return entries
 
 
 def plot_orbits(panels: Sequence[tuple[Mapping[str, np.ndarray], str, tuple[float, float],
@@ -123,6 +176,8 @@ def plot_orbits(panels: Sequence[tuple[Mapping[str, np.ndarray], str, tuple[floa
             draw_orbits(ax, columns, parameter=parameter, bounds=bounds, sweep=sweep, max_period=max_period,
                         title=panel_title)
             legend_beside(ax)
+        # one y range for the shared scale, from 0 to the highest data of any panel (a sweep's points included)
+        axes[0, 0].set_ylim(0.0, 1.05 * max(ax.dataLim.y1 for ax in axes[:, 0]))
         if title:
             fig.suptitle(title, fontsize=10)
         save_figure(fig, path)
@@ -131,8 +186,8 @@ def plot_orbits(panels: Sequence[tuple[Mapping[str, np.ndarray], str, tuple[floa
 
 
 def read_sweep(folder: str | os.PathLike) -> dict[str, np.ndarray] | None:
-    """The columns eta, mean, mean_lo, mean_hi (and the level from sweep.json) of a `ies sweep --out DIR` folder,
-    or None when it has no sweep.csv."""
+    """The columns eta, mean, mean_lo, mean_hi, dynamics ("" where the sweep did not measure it) and the level from
+    sweep.json (NaN without) of a `ies sweep --out DIR` folder, or None when it has no sweep.csv."""
     import csv
     import json
     from pathlib import Path
@@ -143,6 +198,7 @@ def read_sweep(folder: str | os.PathLike) -> dict[str, np.ndarray] | None:
     with table.open(newline="") as handle:
         rows = list(csv.DictReader(handle))
     data = {key: np.array([float(r[key]) for r in rows]) for key in ("eta", "mean", "mean_lo", "mean_hi")}
+    data["dynamics"] = np.array([r.get("dynamics") or "" for r in rows])
     meta = Path(folder) / "sweep.json"
     level = json.loads(meta.read_text()).get("level") if meta.is_file() else None
     data["level"] = np.array([np.nan if level is None else float(level)])

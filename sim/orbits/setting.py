@@ -28,6 +28,7 @@ import numpy as np
 from sim.common.errors import SimulationInputError
 from sim.model.contact_law import ContactLaw
 from sim.model.system import Impactor, ModalModel, Nominal, SystemArrays, a_base_star, a_noabs_star, system_arrays
+from sim.stepped_sine.dynamics import state_scales
 
 
 @dataclass(frozen=True)
@@ -57,8 +58,8 @@ class OrbitSetting:
         if self.nominal is None:  # the host's own normalisation (its nominal D_1*, the paper's g*)
             object.__setattr__(self, "nominal", Nominal.of(self.model))
         if self.impactor.friction > 0:
-            raise SimulationInputError("orbits: dry friction (Appendix C) makes the state include the slider; the "
-                                       "orbits are of the frictionless model (drop --mu)")
+            raise SimulationInputError("orbits: dry friction (--friction, Appendix C) makes the slider part of the "
+                                       "state; the orbits are of the frictionless model: drop --friction")
 
     @property
     def Omega(self) -> float:
@@ -103,13 +104,9 @@ class OrbitSetting:
     def scales(self) -> np.ndarray:
         """The unit of each state component in the shooting's scaled variables (`sim.orbits.shooting`): mode j's
         displacement g / max(|phi_l,j|, |phi_r,j|, |phi_tip,j|) (m sqrt(kg); a motion of g at the walls or tip), its
-        velocity that times omega_j, the sphere's g (m) and g omega_1 (m/s). Fixed along a continuation."""
-        m = self.model
-        phi = np.maximum(np.maximum(np.abs(m.phi_wall_left), np.abs(m.phi_wall_right)), np.abs(m.phi_tip))
-        phi = np.where(phi > 0, phi, 1.0)
-        g = self.impactor.clearance
-        s = g / phi
-        return np.concatenate([s, s * m.omega, [g, g * float(m.omega[0])]])
+        velocity that times omega_j, the sphere's g (m) and g omega_1 (m/s) (`sim.stepped_sine.dynamics.state_scales`,
+        which the Lyapunov exponents share). Fixed along a continuation."""
+        return state_scales(self.model, self.impactor.clearance)
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,13 @@ variational equations (tests/sim/orbits/test_orbit_jacobian.py), largest error o
 0.95: the rig with its higher modes damped 100-fold (a stable two-impact orbit) 2e-9 (half map) and 2e-8 (whole
 period), multipliers 1e-8, at steps 1e-6 and 1e-7; the nominal rig (its unstable orbit, |mu| = 11.8), whose map
 over a whole period has huge third derivatives: half map 7e-8 at both steps, whole period 4e-4 at 1e-6 and 4e-6 at
-1e-7 (multipliers 4e-5 and 6e-7), hence FD_STEP = 1e-7; below it the map's noise (~1e-12 g) takes over.
+1e-7 (multipliers 4e-5 and 6e-7), hence FD_STEP = 1e-7; below it the map's noise (~1e-12 g) takes over. Hosts
+with gentler maps want a larger step: on the rig's first mode alone the map's noise (~3e-13 g, where the contact's
+number of collocation steps changes) puts 3e-6 into the Jacobian at 1e-7 and 2e-9 at 1e-4, with no truncation error
+to speak of. `fd_step` therefore picks the step of each branch (`sim.orbits.continuation`) from FD_STEPS: central
+differences at steps a decade apart differ by about a h^2 + 9 n / h (truncation a h^2, noise n / h), and the step
+with the smallest difference to the next one is taken. That matters where the multipliers are ill-conditioned: where
+a complex pair meets on the real axis near the unit circle, an error e in the Jacobian moves them by ~sqrt(e).
 
 Newton's method (`solve_orbit`): the residual in scaled units, the step by least squares (the linear orbit's
 sphere is neutral: its position is free, `sim.orbits.starts`), damped by backtracking on the residual's largest
@@ -74,6 +80,11 @@ NOISE_FLOOR = 1e-7
 #: Newton's method; 1e-8 errs by ~2e-5 (plus the map's noise, ~1e-12 / 1e-8).
 FD_STEP = 1e-7
 FORWARD_STEP = 1e-8
+#: The steps `fd_step` chooses from (module docstring).
+FD_STEPS = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
+#: Differences whose two runs hit the walls a different number of times straddle a grazing: the step shrinks
+#: tenfold down to this, then the difference is taken one-sided, on the side of the orbit's own impacts.
+SMALLEST_STEP = 1e-10
 #: Most Newton iterations of `solve_orbit`.
 MAX_ITERATIONS = 40
 #: Largest period multiple k an orbit may have (a kT orbit's map multiplies the unstable multipliers k-fold).
@@ -83,8 +94,42 @@ MAX_PERIOD_MULTIPLE = 8
 SIGNIFICANT_SHARE = 0.1
 
 
+#: Samples per period of the highest mode with which `ShootingMap.clearance` looks for the gap's minima.
+GAP_SAMPLES = 12
+
+
+def flight_gaps(y: np.ndarray, t0: float, Omega: float, a_base: float, sys: SystemArrays,
+                tau: float = 0.0) -> tuple[float, float]:
+    """(left, right) gaps between the sphere and the walls (m; > 0 apart, the closing functions of Eqs. 4-6 with
+    the sign turned) at time t0 + tau of the excitation period from the state y at phase time t0 (s), the flight
+    in between free (no contact): each mode the harmonic particular solution S_j (Eq. 7) plus its damped homogeneous
+    deviation, the sphere at constant absolute velocity (u_a = z - a_base cos(Omega t)). The closed form the exact
+    integrator's free flight takes (`sim.integration.exact`), written here again on purpose: the grazing condition
+    is then checked by code that is not the integrator's."""
+    n = sys.omega.size
+    w, D = sys.omega, sys.D
+    S = sys.gamma * a_base * Omega**2 / (w**2 - Omega**2 + 2j * D * w * Omega)
+    e0 = np.exp(1j * Omega * t0)
+    x0 = y[:n] - np.real(S * e0)
+    v0 = y[n:2 * n] - np.real(1j * Omega * S * e0)
+    sigma = D * w
+    wd = w * np.sqrt(1.0 - D**2)
+    x = np.exp(-sigma * tau) * (x0 * np.cos(wd * tau) + (v0 + sigma * x0) / wd * np.sin(wd * tau))
+    s = x + np.real(S * e0 * np.exp(1j * Omega * tau))
+    z0 = y[2 * n] + a_base * math.cos(Omega * t0)
+    zd = y[2 * n + 1] - a_base * Omega * math.sin(Omega * t0)
+    u = z0 + zd * tau - a_base * math.cos(Omega * (t0 + tau))
+    return float(sys.g + u - sys.phi_l @ s), float(sys.phi_r @ s - u + sys.g)
+
+
 class OrbitNotConverged(SimulationDiverged):
-    """Newton's method did not reach a periodic orbit from the start given (exit code 3 on the command line)."""
+    """Newton's method did not reach a periodic orbit from the start given (exit code 3 on the command line);
+    `state` and `residual`: its last iterate (SI) and that iterate's residual (units of g), when it got that far."""
+
+    def __init__(self, message: str, state: np.ndarray | None = None, residual: float = math.nan) -> None:
+        super().__init__(message)
+        self.state = state
+        self.residual = residual
 
 
 class MapValue(NamedTuple):
@@ -99,8 +144,11 @@ class MapValue(NamedTuple):
 
 class ShootingMap:
     """The k-period map P_k and the half map of one `OrbitSetting` on its integrator (module docstring), with its
-    scaled residual and finite-difference Jacobian. `evaluations` counts the integrator runs. system: the setting's
-    `SystemArrays` when the caller has them (`OrbitSetting.system`)."""
+    scaled residual and finite-difference Jacobian. `evaluations` counts the integrator runs of this map, `runs`
+    (of the class) those of every map in the process: the work budget of `sim.orbits.response`. system: the
+    setting's `SystemArrays` when the caller has them (`OrbitSetting.system`)."""
+
+    runs = 0
 
     def __init__(self, setting: OrbitSetting, k: int = 1, *, system: SystemArrays | None = None) -> None:
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= MAX_PERIOD_MULTIPLE:
@@ -117,6 +165,8 @@ class ShootingMap:
         self._prepared = (PreparedExact(self.k, self.Omega, self.a_base, self.sys, samples=2)
                           if setting.integrator == "exact" else None)
         self.evaluations = 0
+        self.fd_step = FD_STEP
+        self.shrunk = False  # the last Jacobian's differences shrank at a grazing (`jacobian`)
 
     @property
     def size(self) -> int:
@@ -140,6 +190,7 @@ class ShootingMap:
         k = self.k
         state = np.array(y, dtype=np.float64)
         self.evaluations += 1
+        ShootingMap.runs += 1
         if self._prepared is not None:
             amplitudes, impacts, record = self._prepared.advance(state)
             return MapValue(state, record[k], amplitudes, impacts)
@@ -153,25 +204,82 @@ class ShootingMap:
         image = -value.half if symmetric else value.end
         return (image - y) / self.scale, value
 
-    def jacobian(self, y: np.ndarray, step: float = FD_STEP,
-                 base: MapValue | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """(DP_k, DF_half) in scaled variables, each (size, size): by central differences (module docstring), or by
-        forward differences from `base` = the map's value at y when given (half the runs, error O(step) instead of
-        O(step^2): for Newton's iterations, not for multipliers)."""
+    def jacobian(self, y: np.ndarray, step: float | None = None, base: MapValue | None = None, *,
+                 one_side: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """(DP_k, DF_half) in scaled variables, each (size, size): by central differences at `step` (default the
+        map's `fd_step`; module docstring), or by forward differences from `base` = the map's value at y when given
+        (half the runs, error O(step) instead of O(step^2): for Newton's iterations, not for multipliers). With
+        `one_side` (for multipliers), a difference whose runs hit the walls a different number of times than y's
+        straddles a grazing: its step shrinks tenfold at a time (to SMALLEST_STEP, then one-sided, on the side of y's
+        own impacts), and `shrunk` says so afterwards: such a Jacobian is that of one side of the grazing, and less
+        accurate (the map's noise over a small step). Newton's iterations far from an orbit want the plain
+        differences (one_side False): there the steps would shrink to noise for nothing."""
+        step = self.fd_step if step is None else step
         n = self.size
         end = np.empty((n, n))
         half = np.empty((n, n))
+        at_y = (base if base is not None else self(y)) if one_side else None  # whose impacts both runs must have
+        self.shrunk = False
         for i in range(n):
-            delta = np.zeros(n)
-            delta[i] = step * self.scale[i]
-            if base is not None:  # forward differences: a smaller step for the same accuracy (module docstring)
-                delta *= FORWARD_STEP / step
-            plus = self(y + delta)
-            minus = self(y - delta) if base is None else base
-            width = FORWARD_STEP if base is not None else 2.0 * step
-            end[:, i] = (plus.end - minus.end) / width / self.scale
-            half[:, i] = (plus.half - minus.half) / width / self.scale
+            h = FORWARD_STEP if base is not None else step
+            while True:
+                delta = np.zeros(n)
+                delta[i] = h * self.scale[i]
+                plus = self(y + delta)
+                minus = self(y - delta) if base is None else base
+                if (at_y is None or np.array_equal(plus.impacts, at_y.impacts)
+                        and np.array_equal(minus.impacts, at_y.impacts) or h <= SMALLEST_STEP):
+                    break
+                h /= 10.0  # the differences straddle a grazing: closer to y, on one side of it
+                self.shrunk = True
+            if at_y is None or np.array_equal(plus.impacts, at_y.impacts) and np.array_equal(minus.impacts,
+                                                                                          at_y.impacts):
+                width = h if base is not None else 2.0 * h
+                end[:, i] = (plus.end - minus.end) / width / self.scale
+                half[:, i] = (plus.half - minus.half) / width / self.scale
+                continue
+            # at a grazing: one-sided, on the side of y's own impacts
+            sign, same = (1.0, plus) if np.array_equal(plus.impacts, at_y.impacts) else (-1.0, minus)
+            end[:, i] = sign * (same.end - at_y.end) / h / self.scale
+            half[:, i] = sign * (same.half - at_y.half) / h / self.scale
         return end, half
+
+    def pattern(self, y: np.ndarray) -> tuple[str, float]:
+        """(impact pattern, significant impacts per period) of the orbit through y (`impact_pattern`)."""
+        return impact_pattern(self, y)
+
+    def clearance(self, y: np.ndarray) -> float:
+        """The smallest gap between the sphere and a wall at a local minimum of the gap in free flight over the k
+        periods from y, in units of g (inf when the gap has no such minimum): where it reaches 0 an impact appears,
+        the grazing condition (`sim.orbits.bifurcations`). The samples of a recorded run (GAP_SAMPLES per period of
+        the highest mode at least) find the minima; each is then refined on the closed-form free flight
+        (`flight_gaps`: no integrator involved, to 1e-15 g), so the value is exact to rounding."""
+        from scipy.optimize import minimize_scalar
+
+        setting, sys = self.setting, self.sys
+        ratio = float(np.max(sys.omega)) / self.Omega
+        M = int(min(2**14, max(256, 2 ** math.ceil(math.log2(GAP_SAMPLES * ratio)))))
+        record = np.empty((self.k * M + 1, self.size))
+        state = np.array(y, dtype=np.float64)
+        self._run_step(state, self.k, self.Omega, self.a_base, sys, record)
+        self.evaluations += 1
+        dt = setting.period / M
+        best = math.inf
+        n = sys.omega.size
+        s, u = record[:, :n], record[:, 2 * n]
+        for wall, gap in enumerate((sys.g + u - s @ sys.phi_l, s @ sys.phi_r - u + sys.g)):  # as `flight_gaps`
+            inner = np.flatnonzero((gap[1:-1] > 0) & (gap[1:-1] <= gap[:-2]) & (gap[1:-1] <= gap[2:])
+                                   & (gap[:-2] > 0) & (gap[2:] > 0)) + 1
+            for i in inner[np.argsort(gap[inner])[:3]]:  # the three lowest minima: the sampled order may be off
+                t0 = (i - 1) * dt
+
+                def at(tau: float, row: np.ndarray = record[i - 1], t0: float = t0) -> float:
+                    return flight_gaps(row, t0, self.Omega, self.a_base, sys, tau)[wall]
+
+                found = minimize_scalar(at, bounds=(0.0, 2.0 * dt), method="bounded",
+                                        options={"xatol": 1e-12 * dt})
+                best = min(best, float(found.fun) / sys.g, float(gap[i]) / sys.g)
+        return best
 
     def safe_residual(self, y: np.ndarray, symmetric: bool) -> tuple[float, np.ndarray | None, MapValue | None]:
         """(largest scaled residual component, residual, value); inf and None where the integrator fails."""
@@ -181,6 +289,16 @@ class ShootingMap:
             return math.inf, None, None
         norm = float(np.max(np.abs(r)))
         return (norm if math.isfinite(norm) else math.inf), r, value
+
+
+def fd_step(shooting: ShootingMap, y: np.ndarray, symmetric: bool) -> float:
+    """The central differences' step for the Jacobians of the orbits near y (module docstring: of FD_STEPS the one
+    whose Jacobian differs least from the next smaller step's; DF_half for a symmetric orbit, else DP_k)."""
+    which = 1 if symmetric else 0
+    jacobians = [shooting.jacobian(y, step)[which] for step in FD_STEPS]
+    largest = max(float(np.max(np.abs(J))) for J in jacobians) or 1.0
+    differences = [float(np.max(np.abs(a - b))) / largest for a, b in zip(jacobians, jacobians[1:])]
+    return FD_STEPS[int(np.argmin(differences))]
 
 
 def newton_matrix(end: np.ndarray, half: np.ndarray, symmetric: bool) -> np.ndarray:
@@ -212,7 +330,10 @@ class PeriodicOrbit:
     case: an impulse below SIGNIFICANT_SHARE of the largest, e.g. a graze or a same-wall rebound), "" without an
     impact log (ode3); significant: significant impacts per period (-); multipliers: Floquet multipliers of
     P_k (sorted by decreasing modulus); half_multipliers: those of G (symmetric orbits) or None; residual: the
-    final Newton residual (scaled, units of g); jacobian: (DP_k, DF_half) scaled, kept for branch switching.
+    final Newton residual (scaled, units of g); jacobian: (DP_k, DF_half) scaled, kept for branch switching;
+    half_state: the state at k T / 2 (SI), which tells a switched branch from its parent
+    (`sim.orbits.bifurcations.switch_branch`); at_grazing: the Jacobian's differences had to shrink to stay on one
+    side of a grazing (`ShootingMap.jacobian`): the multipliers are those of one side and less accurate.
     """
 
     setting: OrbitSetting
@@ -227,6 +348,8 @@ class PeriodicOrbit:
     pattern: str = ""
     significant: float = math.nan
     jacobian: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+    half_state: np.ndarray | None = field(default=None, repr=False)
+    at_grazing: bool = False
 
     @property
     def amplitude(self) -> float:
@@ -288,13 +411,16 @@ def make_orbit(shooting: ShootingMap, y: np.ndarray, symmetric: bool, value: Map
     """The `PeriodicOrbit` through the converged state y: its multipliers (from `jacobian` or a new one), impact
     pattern and per-period amplitudes."""
     r, value = shooting.residual(y, symmetric, value)
-    end, half = jacobian if jacobian is not None else shooting.jacobian(y)
+    if jacobian is None:
+        jacobian = shooting.jacobian(y)
+    end, half = jacobian
     mu, lam = multipliers(end, half, symmetric)
-    pattern, significant = impact_pattern(shooting, y)
+    pattern, significant = shooting.pattern(y)
     return PeriodicOrbit(setting=shooting.setting, k=shooting.k, symmetric=symmetric, state=np.array(y, float),
                          amplitudes=value.amplitudes.copy(), impacts=value.impacts.copy(), multipliers=mu,
                          half_multipliers=lam, residual=float(np.max(np.abs(r))), pattern=pattern,
-                         significant=significant, jacobian=(end, half))
+                         significant=significant, jacobian=(end, half), half_state=np.array(value.half, float),
+                         at_grazing=bool(getattr(shooting, "shrunk", False)))
 
 
 def solve_orbit(setting: OrbitSetting, guess: np.ndarray, *, k: int = 1, symmetric: bool | None = None,
@@ -315,12 +441,10 @@ def solve_orbit(setting: OrbitSetting, guess: np.ndarray, *, k: int = 1, symmetr
     if r is None:
         raise OrbitNotConverged("orbits: the integrator fails from the start state itself; start closer to the "
                                 "orbit (a simulated state, --start slow-flow) or at a lower level")
-    jacobian = None
     for _ in range(max_iterations):
         if norm < tolerance:
             break
-        jacobian = shooting.jacobian(y)
-        A = newton_matrix(*jacobian, symmetric)
+        A = newton_matrix(*shooting.jacobian(y, one_side=False), symmetric)
         step = np.linalg.lstsq(A, -r, rcond=1e-12)[0] * shooting.scale
         damping = 1.0
         while damping >= 1.0 / 1024:
@@ -335,10 +459,10 @@ def solve_orbit(setting: OrbitSetting, guess: np.ndarray, *, k: int = 1, symmetr
             raise OrbitNotConverged(f"orbits: Newton's method stalled at residual {norm:.2e} g (tolerance "
                                     f"{tolerance:.0e}) at eta {setting.eta:g}, level {setting.level:g}; start closer: "
                                     "--start slow-flow (continuation from damped higher modes), a state simulated "
-                                    "at this point, or a neighbouring orbit")
-        y, norm, r, value, jacobian = trial, t_norm, t_r, t_value, None
+                                    "at this point, or a neighbouring orbit", y, norm)
+        y, norm, r, value = trial, t_norm, t_r, t_value
     else:
         raise OrbitNotConverged(f"orbits: no convergence in {max_iterations} Newton steps (residual {norm:.2e} g) at "
                                 f"eta {setting.eta:g}, level {setting.level:g}; start closer (--start slow-flow, a "
-                                "simulated state) or lower the level")
-    return make_orbit(shooting, y, symmetric, value, jacobian)
+                                "simulated state) or lower the level", y, norm)
+    return make_orbit(shooting, y, symmetric, value)  # its multipliers from differences on one side of a grazing

@@ -7,6 +7,7 @@ relative to the base per excitation period, over a_noabs* at the same level, so 
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -47,8 +48,19 @@ ORBITS_CSV = OutputFile("orbits.csv", "ies orbits --out DIR", "One row per perio
     Column("note", "", "loses stability / gains stability at a located multiplier crossing; the impacts before and "
            "after a grazing"),
     Column("residual", "-", "the shooting residual's largest component in units of the clearance g"),
+    Column("location_error", "-", "how well a labelled point is located: | |mu| - 1 | of the multiplier that crosses "
+           "(below 1e-4), or the smallest free-flight gap over g at a grazing (below 1e-9); empty without a label"),
 ))
 ORBITS_COLUMNS = ORBITS_CSV.names
+START_ATTEMPTS_JSON = OutputFile("start-attempts.json", "ies orbits --start simulation, when no start converges",
+                                 "What the failed start tried, for a start of your own (`sim.orbits.response`); the "
+                                 "command exits with code 3.", (
+    Column("level, eta", "a_base/a_base*, -", "where the start was tried"),
+    Column("attempts", "", "one per period multiple k: k, residual (units of g: the last Newton iterate's), why "
+           "(Newton's method's last words), start and last (the simulated state it started from and its last iterate, "
+           "SI: s_1..s_n (m sqrt(kg)), s_1'..s_n' (m sqrt(kg)/s), u_a (m), u_a' (m/s); null where it failed at once)"),
+    Column("suggestion", "", "what to try instead"),
+))
 #: CF units and long names of the columns in results.nc (units as UDUNITS strings, "1" dimensionless).
 NC_UNITS = {"a/a_noabs*": "1", "a_base/a_base*": "1", "-": "1", "m": "m", "": ""}
 
@@ -68,7 +80,24 @@ def _row(point: BranchPoint, b: int, branch: Branch, i: int) -> tuple:
     s = orbit.setting
     return (s.level, b, branch.origin, i, s.eta, orbit.amplitude, orbit.amplitude_max, orbit.amplitude_m, orbit.k,
             int(orbit.symmetric), orbit.impacts_per_period, orbit.significant, orbit.pattern, orbit.max_multiplier,
-            0 if orbit.linear else outside_count(orbit), int(orbit.stable), point.label, point.note, orbit.residual)
+            0 if orbit.linear else outside_count(orbit), int(orbit.stable), point.label, point.note, orbit.residual,
+            point.location_error if point.label else math.nan)
+
+
+def stable_ranges(branch: Branch) -> list[list[float]]:
+    """The parameter ranges [lo, hi] of a branch's stretches of stable orbits, in branch order (a stable stretch
+    of one orbit is [x, x])."""
+    ranges, current = [], None
+    for point in branch.points:
+        value = branch.parameter.get(point.orbit.setting)
+        if point.orbit.stable:
+            current = [value, value] if current is None else [min(current[0], value), max(current[1], value)]
+        elif current is not None:
+            ranges.append(current)
+            current = None
+    if current is not None:
+        ranges.append(current)
+    return ranges
 
 
 def response_summary(response: OrbitResponse) -> dict:
@@ -87,15 +116,19 @@ def response_summary(response: OrbitResponse) -> dict:
                          "range": [float(values.min()), float(values.max())],
                          "amplitude_range": [min(p.orbit.amplitude for p in branch.points),
                                              max(p.orbit.amplitude for p in branch.points)],
+                         "max_multiplier_range": [min(p.orbit.max_multiplier for p in branch.points),
+                                                  max(p.orbit.max_multiplier for p in branch.points)],
                          "patterns": sorted({p.orbit.pattern for p in branch.points}),
                          "stable_points": len(stable),
                          "stable_range": ([min(branch.parameter.get(p.orbit.setting) for p in stable),
                                            max(branch.parameter.get(p.orbit.setting) for p in stable)] if stable else None),
-                         "labels": labels})
+                         "stable_ranges": stable_ranges(branch),
+                         "labels": labels, "unlocated": [str(u) for u in branch.unlocated]})
     return {"level": response.base.level if response.parameter == "eta" else None,
             "eta": response.base.eta if response.parameter == "level" else None,
             "parameter": response.parameter, "range": list(response.bounds), "impacts": response.impacts,
-            "branches": branches, "notes": response.notes}
+            "branches": branches, "searches": [search.note for search in response.searches],
+            "notes": response.notes}
 
 
 def write_orbit_files(folder: Path, responses: Sequence[OrbitResponse], settings: dict) -> list[Path]:
@@ -148,21 +181,43 @@ def write_results_nc(path: Path, responses: Sequence[OrbitResponse], rows: list[
 
 
 def orbit_table(response: OrbitResponse) -> str:
-    """The text `ies orbits` prints for one level or eta: one line per branch and per located bifurcation."""
+    """The text `ies orbits` prints for one level or eta: one line per branch (its stretches of stable orbits, not
+    their hull), one per located point that changes the stability (or is a fold or grazing), the counts of the
+    other labels, the changes that could not be located, and the notes (searches among them)."""
     head = (f"level {response.base.level:g}" if response.parameter == "eta" else f"eta {response.base.eta:g}")
     lines = [f"# {head}: {response.parameter} {response.bounds[0]:g}:{response.bounds[1]:g}"]
     for b, branch in enumerate(response.all_branches):
         values = branch.values()
         amp = [p.orbit.amplitude for p in branch.points]
-        stable = [branch.parameter.get(p.orbit.setting) for p in branch.points if p.orbit.stable]
+        ranges = stable_ranges(branch)
         patterns = ",".join(sorted({p.orbit.pattern or "-" for p in branch.points}))
-        stab = (f"stable for {response.parameter} {min(stable):.4f}..{max(stable):.4f}" if stable else "unstable")
+        stab = ("stable for " + response.parameter + " " + ", ".join(f"{lo:.4f}..{hi:.4f}" for lo, hi in ranges)
+                if ranges else "unstable")
         lines.append(f"branch {b} ({branch.origin}; {branch.k} T{', symmetric' if branch.symmetric else ''}): "
                      f"{len(branch.points)} orbits, {response.parameter} {values.min():.4f}..{values.max():.4f}, "
                      f"a/a_noabs* {min(amp):.4f}..{max(amp):.4f}, impacts {patterns}, {stab}")
+        counts: dict[str, int] = {}
         for p in branch.points:
             if p.label and (p.label in ("fold", "grazing") or p.note):
                 lines.append(f"  {p.label} at {response.parameter} {branch.parameter.get(p.orbit.setting):.5f}: "
                              f"a/a_noabs* {p.orbit.amplitude:.4f}{', ' + p.note if p.note else ''}")
+            elif p.label:
+                counts[p.label] = counts.get(p.label, 0) + 1
+        if counts:
+            lines.append("  also located (unstable on both sides): "
+                         + ", ".join(f"{n} {label}" for label, n in sorted(counts.items())))
+        lines.extend(f"  not located: {u}" for u in branch.unlocated)
     lines.extend(f"note: {note}" for note in response.notes)
     return "\n".join(lines)
+
+
+def write_start_attempts(folder: Path, failure: Any) -> Path:
+    """start-attempts.json (START_ATTEMPTS_JSON) of a failed "simulation" start (`sim.orbits.response.StartFailed`),
+    written atomically."""
+    setting = failure.setting
+    data = {"level": setting.level, "eta": setting.eta,
+            "attempts": [{"k": a.k, "residual": a.residual, "why": a.why, "start": a.start, "last": a.last}
+                         for a in failure.attempts],
+            "suggestion": "--start slow-flow (the slow flow's two-impact orbit), another --at, or a larger --max-period; "
+                          "ies trace --lyapunov at this point tells whether the response is periodic at all"}
+    return write_text(folder / "start-attempts.json", dumps(data) + "\n")

@@ -119,6 +119,10 @@ def draw_sweep(ax: Any, data: Mapping[str, Any], title: str, *, right_mm: bool =
                     label="mean: range of the runs")
     ax.plot(eta, data["max"], "s--", color="C3", ms=2.5, lw=1.0, label="max")
     ax.plot(eta, data["mean"], "o-", color="C0", ms=2.5, lw=1.0, label="mean")
+    if data.get("dynamics"):  # ies sweep --lyapunov: periodic / quasi-periodic / chaotic on the mean
+        from sim.plots.dynamics import draw_dynamics
+
+        draw_dynamics(ax, eta, data["mean"], data["dynamics"])
     ax.set_xlabel(ETA_LABEL)
     ax.set_ylabel(RESPONSE_LABEL)
     ax.set_title(title, fontsize=9)

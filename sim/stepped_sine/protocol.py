@@ -169,7 +169,9 @@ class SweepRun:
     mean, max, min, std: per-period amplitudes over the hold / a_noabs*; impacts_per_period: contact
     onsets per period over the hold; hold_periods: hold length in periods; scattering: per point the
     energy scattering and impact measures (`sim.stepped_sine.measures.SCATTERING_MEASURES` -> array; NaN where not available).
-    level = a_base/a_base*; a_base, a_noabs (m); wall_time_s of the run.
+    level = a_base/a_base*; a_base, a_noabs (m); wall_time_s of the run; lyapunov, dynamics: per point the largest
+    Lyapunov exponent over the hold (per period) and periodic / quasi-periodic / chaotic (`sim.stepped_sine.dynamics`),
+    None when not measured.
     """
 
     eta: np.ndarray
@@ -190,6 +192,8 @@ class SweepRun:
     impactor: Impactor | None
     wall_time_s: float = 0.0
     scattering: dict[str, np.ndarray] = field(default_factory=dict)
+    lyapunov: np.ndarray | None = None
+    dynamics: list[str] | None = None
 
     @property
     def cv(self) -> np.ndarray:
@@ -246,6 +250,9 @@ class SweepResult:
     extra: dict = field(default_factory=dict)
     scattering: dict[str, np.ndarray] = field(default_factory=dict)
     scattering_samples: dict[str, np.ndarray] = field(default_factory=dict)
+    lyapunov_per_period: np.ndarray | None = None
+    dynamics: list[str] | None = None
+    lyapunov_samples: np.ndarray | None = None
 
     def resonant_spread(self, output: str) -> tuple[float, float, float]:
         """(lo, hi, standard error) of the resonant level `output` ("mean" or "max"): the range of its repetition
@@ -268,6 +275,9 @@ class SweepResult:
         out["protocol"] = asdict(self.protocol)
         out["regime_cv_threshold"] = REGIME_CV_THRESHOLD
         out.update(scattering_keys(self.scattering))
+        if self.lyapunov_per_period is not None:
+            out.update(lyapunov_per_period=self.lyapunov_per_period, dynamics=self.dynamics,
+                       lyapunov_samples=self.lyapunov_samples)
         out.update(self.extra)
         return out
 
@@ -348,12 +358,13 @@ def visit_points(model: ModalModel, sys: SystemArrays, a_base: float, protocol: 
 
 def run_sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *,
               seed: int, rep: int, nominal: Nominal | None = None,
-              progress: Callable[[], None] | None = None) -> SweepRun:
+              progress: Callable[[], None] | None = None, lyapunov: bool = False) -> SweepRun:
     """ONE stepped-sine run from homogeneous initial conditions (Sect. 5.1; protocol.start) at
     a_base = level * a_base* (nominal D*, g*): the points of `visit_points`, each with its hold.
 
     impactor None simulates the host structure alone. The random frequency offsets come only from
-    ``np.random.default_rng([seed, rep])`` (module docstring). `progress` is called after every point.
+    ``np.random.default_rng([seed, rep])`` (module docstring). `progress` is called after every point. lyapunov:
+    also each hold's largest Lyapunov exponent and dynamics (`hold_dynamics`).
     """
     from sim.integration.integrators import get_integrator
 
@@ -367,13 +378,17 @@ def run_sweep(model: ModalModel, impactor: Impactor | None, level: float, protoc
     started = time.perf_counter()
     y = np.zeros(2 * model.n_modes + 2)
     rows: list[tuple] = []
+    natures: list[tuple[float, str]] = []
     for leg_index, eta, eta_actual, Omega in visit_points(model, sys, a_base, protocol, y, seed=seed, rep=rep):
         n_hold = protocol.periods(Omega)[1]
         ledger = Ledger()
+        start = y.copy()
         amplitudes, impacts = run_step(y, n_hold, Omega, a_base, sys, None, ledger=ledger)
         m = point_measures(amplitudes, impacts, a_noabs, ledger)
         rows.append((eta, eta_actual, leg_index, m.mean, m.max, m.min, m.std, m.impacts_per_period, n_hold,
                      *(getattr(m.scattering, name) for name in SCATTERING_MEASURES)))
+        if lyapunov:
+            natures.append(hold_dynamics(model, impactor, sys, protocol, start, n_hold, Omega, a_base, seed=seed))
         if progress is not None:
             progress()
     cols = list(zip(*rows))
@@ -383,7 +398,38 @@ def run_sweep(model: ModalModel, impactor: Impactor | None, level: float, protoc
         min=as_f(5), std=as_f(6), impacts_per_period=as_f(7), hold_periods=np.array(cols[8], dtype=int),
         level=level, a_base=a_base, a_noabs=a_noabs, seed=seed, rep=rep, protocol=protocol, impactor=impactor,
         wall_time_s=time.perf_counter() - started,
-        scattering={name: as_f(9 + i) for i, name in enumerate(SCATTERING_MEASURES)})
+        scattering={name: as_f(9 + i) for i, name in enumerate(SCATTERING_MEASURES)},
+        lyapunov=np.array([n[0] for n in natures]) if lyapunov else None,
+        dynamics=[n[1] for n in natures] if lyapunov else None)
+
+
+def hold_dynamics(model: ModalModel, impactor: Impactor | None, sys: SystemArrays, protocol: SteppedSine,
+                  start: np.ndarray, n_hold: int, Omega: float, a_base: float, *, seed: int = 0) -> tuple[float, str]:
+    """(largest Lyapunov exponent per period, dynamics) of one hold of n_hold periods from its start state
+    (`sim.stepped_sine.dynamics`: the exponent over the hold, the states once per period for its periodicity)."""
+    from sim.integration.integrators import get_integrator
+    from sim.stepped_sine.dynamics import classify, largest_lyapunov, one_period, periodicity, state_scales
+
+    scale = state_scales(model, sys.g)
+    run = one_period(get_integrator(protocol.integrator, dt_scale=protocol.dt_scale), Omega, a_base, sys,
+                     protocol.integrator)
+    states, onsets = [], []
+    result = largest_lyapunov(run, start, n_hold, scale, host_only=impactor is None, seed=seed,
+                              on_period=lambda i, y, a, n: (states.append(y), onsets.append(n)))
+    impacts = float(np.mean(onsets)) if impactor is not None else 0.0
+    return result.per_period, classify(result, periodicity(np.array(states), scale), impacts)
+
+
+def check_lyapunov_holds(model: ModalModel, protocol: SteppedSine) -> None:
+    """One line (SimulationInputError) when a hold of the protocol is too short for a Lyapunov exponent
+    (`sim.stepped_sine.dynamics.MIN_PERIODS`), before anything is simulated."""
+    from sim.stepped_sine.dynamics import MIN_PERIODS
+
+    shortest = protocol.periods(float(model.omega[0]) * protocol.eta[0] * (1.0 - protocol.perturbation))[1]
+    if shortest < MIN_PERIODS:
+        need = MIN_PERIODS * 2.0 * math.pi / (float(model.omega[0]) * protocol.eta[0])
+        raise SimulationInputError(f"--lyapunov takes each hold's exponent: a hold of {shortest} periods is too short "
+                                   f"(at least {MIN_PERIODS}); give --hold {math.ceil(need * 10) / 10:g} s or more")
 
 
 _SAMPLED = ("mean", "max", "std", "impacts_per_period", "hold_periods")
@@ -460,6 +506,7 @@ def aggregate_runs(runs: list[SweepRun]) -> SweepResult:
     impacts = stack["impacts_per_period"].mean(axis=0)
     regimes = [str(r) for r in classify_regime(cv, impacts)]
     i_mean, i_max = int(np.argmax(mean)), int(np.argmax(mx))
+    natures = _dynamics_average(runs, grid)
     return SweepResult(
         eta=grid, mean=mean, mean_lo=stack["mean"].min(axis=0), mean_hi=stack["mean"].max(axis=0),
         mean_std=stack["mean"].std(axis=0), max=mx, max_lo=stack["max"].min(axis=0), max_hi=stack["max"].max(axis=0),
@@ -471,12 +518,40 @@ def aggregate_runs(runs: list[SweepRun]) -> SweepResult:
         impacts_samples=stack["impacts_per_period"], n_samples=len(samples), n_runs=len(runs), level=first.level, a_base=first.a_base, a_noabs=first.a_noabs,
         protocol=first.protocol, wall_time_s=float(sum(r.wall_time_s for r in runs)),
         scattering={name: _scattering_average(scattering[name], name) for name in SCATTERING_MEASURES},
-        scattering_samples=scattering)
+        scattering_samples=scattering, **natures)
+
+
+def _dynamics_average(runs: list[SweepRun], grid: np.ndarray) -> dict:
+    """The SweepResult fields of the runs' Lyapunov exponents (none when they were not measured): per eta the mean
+    exponent over every visit of it (legs and runs: `lyapunov_samples` one row per visit) and the dynamics most of
+    them had (a tie goes to the less regular: chaotic, then quasi-periodic)."""
+    if any(run.lyapunov is None for run in runs):
+        return {}
+    from sim.stepped_sine.dynamics import DYNAMICS
+
+    exponents: dict[float, list[float]] = {float(e): [] for e in grid}
+    kinds: dict[float, list[str]] = {float(e): [] for e in grid}
+    for run in runs:
+        for eta, value, kind in zip(run.eta, run.lyapunov, run.dynamics):
+            nearest = float(grid[int(np.argmin(np.abs(grid - eta)))])
+            exponents[nearest].append(float(value))
+            kinds[nearest].append(kind)
+    visits = max(len(v) for v in exponents.values())
+    samples = np.full((visits, grid.size), np.nan)
+    for j, eta in enumerate(grid):
+        values = exponents[float(eta)]
+        samples[:len(values), j] = values
+    order = {kind: -i for i, kind in enumerate(DYNAMICS)}  # ties: the later in DYNAMICS wins
+    dynamics = [max(set(k), key=lambda kind: (k.count(kind), -order.get(kind, 0))) if k else ""
+                for k in (kinds[float(e)] for e in grid)]
+    return {"lyapunov_per_period": np.nanmean(samples, axis=0), "dynamics": dynamics, "lyapunov_samples": samples}
 
 
 def sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: SteppedSine, *, reps: int,
-          seed: int, nominal: Nominal | None = None, progress: bool | None | Callable[[], None] = None) -> SweepResult:
-    """`reps` runs (rep = 0 .. reps-1) of `run_sweep`, aggregated (Sects. 5.1, 5.2).
+          seed: int, nominal: Nominal | None = None, progress: bool | None | Callable[[], None] = None,
+          lyapunov: bool = False) -> SweepResult:
+    """`reps` runs (rep = 0 .. reps-1) of `run_sweep`, aggregated (Sects. 5.1, 5.2); lyapunov: with each hold's
+    largest Lyapunov exponent and dynamics.
 
     progress: report the progress on stderr (`sim.common.progress`: a bar on a terminal, plain lines in a log; None:
     only if the sweep is long), or a callable called after every point (the caller's own report).
@@ -491,7 +566,8 @@ def sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: 
     started = time.perf_counter()
     with report(total, f"sweep {level:g}", "pt", enabled=not callable(progress) and bool(progress), leave=False) as bar:
         runs = [run_sweep(model, impactor, level, protocol, seed=seed, rep=rep, nominal=nominal,
-                          progress=progress if callable(progress) else bar.update) for rep in range(int(reps))]
+                          progress=progress if callable(progress) else bar.update, lyapunov=lyapunov)
+                for rep in range(int(reps))]
     result = aggregate_runs(runs)
     result.wall_time_s = time.perf_counter() - started
     return result

@@ -32,6 +32,12 @@ SCATTERING = (
     Column("dissipation_friction", "-", "energy dissipated by dry friction at the floor (Appendix C), share of the input"),
 )
 SCATTERING_COLUMNS = tuple(c.name for c in SCATTERING)
+#: the response's nature (`sim.stepped_sine.dynamics`), in sweep.csv after the regime only with `ies sweep --lyapunov`
+NATURE = (
+    Column("lyapunov_per_period", "-", "only with --lyapunov: the largest Lyapunov exponent over the hold, natural log "
+           "per excitation period, averaged over the samples (`sim.stepped_sine.dynamics`)"),
+    Column("dynamics", "", "only with --lyapunov: periodic, quasi-periodic or chaotic (most of the samples)"),
+)
 SWEEP_CSV = OutputFile("sweep.csv", "ies sweep --out DIR", "One row per eta of the grid. Amplitudes are averaged over the "
                        "samples (the repetitions); the scattering columns are NaN-aware averages.", (
     Column("eta", "-", "eta = Omega/omega* of the grid point, the frequency the holds were measured at"),
@@ -44,9 +50,16 @@ SWEEP_CSV = OutputFile("sweep.csv", "ies sweep --out DIR", "One row per eta of t
     Column("cv", "-", "std/mean of the per-period amplitudes over the hold, averaged (the regime measure)"),
     Column("impacts_per_period", "-", "contact onsets at either wall per excitation period, averaged"),
     Column("regime", "", "APR (cv <= 0.1), SMR (cv > 0.1) or linear (no contact)"),
+    *NATURE,
     *SCATTERING))
-#: sweep.csv: one row per eta of the grid (`SweepResult` arrays)
-SWEEP_COLUMNS = SWEEP_CSV.names
+#: sweep.csv's columns: without --lyapunov (also the columns of a response study's sweeps.csv), and with it
+NATURE_COLUMNS = tuple(c.name for c in NATURE)
+SWEEP_COLUMNS = tuple(name for name in SWEEP_CSV.names if name not in NATURE_COLUMNS)
+
+
+def sweep_columns(result: SweepResult) -> tuple[str, ...]:
+    """sweep.csv's columns of a frequency response: SWEEP_CSV's, the NATURE columns only when it measured them."""
+    return SWEEP_CSV.names if result.dynamics is not None else SWEEP_COLUMNS
 OVERVIEW_CSV = OutputFile("overview.csv", "ies overview --out DIR; response studies", "One row per excitation level; "
                           "the scattering columns are taken at `eta_resonant_mean`.", (
     Column("level", "a_base/a_base*", "the excitation level"),
@@ -73,6 +86,8 @@ SWEEP_JSON = OutputFile("sweep.json", "ies sweep --out DIR, also --json", "The a
     Column("a_noabs", "m", "a_noabs*, the linear resonant amplitude at this excitation (nominal D*)"),
     Column("mean_std, max_std", "a/a_noabs*", "standard deviation over the samples, per eta"),
     Column("regime_per_eta", "", "the `regime` column"),
+    Column("lyapunov_samples", "-", "with --lyapunov: the exponents of every visit of each eta (visits x eta; NaN "
+           "where an eta has fewer visits)"),
     Column("resonant_mean, resonant_max", "a/a_noabs*", "the largest mean and max over eta"),
     Column("eta_resonant_mean, eta_resonant_max", "-", "where they are reached"),
     Column("regime", "", "the regime at `eta_resonant_mean`"),
@@ -109,11 +124,12 @@ def _scattering_column(column: str) -> str:
 
 
 def sweep_rows(result: SweepResult) -> list[list[Any]]:
-    """The rows of sweep.csv (SWEEP_COLUMNS) of one frequency response."""
+    """The rows of sweep.csv (`sweep_columns`) of one frequency response."""
     n = result.eta.size
-    columns = [result.regime_per_eta if name == "regime" else
+    natures = {"lyapunov_per_period": result.lyapunov_per_period, "dynamics": result.dynamics}
+    columns = [result.regime_per_eta if name == "regime" else natures[name] if name in natures else
                result.scattering.get(_scattering_column(name), [float("nan")] * n) if name in SCATTERING_COLUMNS else
-               getattr(result, name) for name in SWEEP_COLUMNS]
+               getattr(result, name) for name in sweep_columns(result)]
     return [list(row) for row in zip(*columns)]
 
 

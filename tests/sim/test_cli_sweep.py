@@ -161,3 +161,28 @@ def test_every_spread_contains_its_value(tmp_path, model_file, capsys):
     for sweep in json.loads((out / "overview.json").read_text())["sweeps"]:
         for name in ("mean", "max"):
             assert np.all(np.array(sweep[f"{name}_lo"]) <= sweep[name]) and np.all(np.array(sweep[name]) <= sweep[f"{name}_hi"])
+
+
+def test_sweep_lyapunov_adds_the_exponent_and_dynamics_per_eta(tmp_path, model_file, capsys):
+    """--lyapunov: each hold's exponent (mean over the samples) and dynamics as sweep.csv columns beside the regime,
+    the exponents of every visit in sweep.json, a column in the printed table; a hold too short is refused in one
+    line naming the hold needed."""
+    out = tmp_path / "res"
+    args = ["sweep", "--level", "6", "--eta", "0.98:1.0:3", "--wait", "0.05", "--hold", "0.8", "--reps", "2",
+            "--model", model_file, "--lyapunov", "--out", str(out)]
+    assert main(args) == 0
+    printed = capsys.readouterr().out
+    assert "lyapunov/T  dynamics" in printed
+    import csv
+
+    with (out / "sweep.csv").open(newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert all(r["dynamics"] in ("periodic", "quasi-periodic", "chaotic") for r in rows)
+    data = json.loads((out / "sweep.json").read_text())
+    samples = np.array(data["lyapunov_samples"], dtype=float)
+    assert samples.shape == (2, 3)
+    assert [float(r["lyapunov_per_period"]) for r in rows] == pytest.approx(np.mean(samples, axis=0), rel=1e-12)
+    code = main([*args[:8], "0.3", *args[9:-2], "--out", str(tmp_path / "short")])
+    err = capsys.readouterr().err
+    assert code == 2 and "--lyapunov takes each hold's exponent" in err and "--hold" in err
+    assert not (tmp_path / "short").exists()

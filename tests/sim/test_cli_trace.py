@@ -89,3 +89,40 @@ def test_bad_trace_settings_write_nothing(tmp_path, model_file, capsys, args, ph
     err = capsys.readouterr().err
     assert code == 2 and phrase in err and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
     assert not (tmp_path / "t").exists()
+
+
+def test_lyapunov_and_poincare_of_a_trace(tmp_path, model_file, capsys):
+    """--lyapunov (default 400 periods) and --poincare: the exponent with its convergence over the record in the
+    JSON, the dynamics, the section's points (one per period and the last state) and poincare.png written; the host
+    alone (--no-impactor) gives mode 1's decay -2 pi D_1 / eta per period and says the host is linear."""
+    out = tmp_path / "t"
+    assert main(["trace", "--level", "6", "--eta", "0.99", "--lyapunov", "--poincare", "--fs", "4000", *FAST,
+                 "--model", model_file, "--out", str(out), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["periods"] == 400 and (out / "poincare.png").is_file()
+    assert len(data["lyapunov_convergence"]) == 400 - data["lyapunov_transient_periods"]
+    assert data["lyapunov_convergence"][-1] == pytest.approx(np.mean(data["lyapunov_convergence"][-1:]), rel=1e-12)
+    assert data["dynamics"] in ("periodic", "quasi-periodic", "chaotic") and data["lyapunov_linear_host"] is None
+    assert len(data["poincare"]["q_tip"]) == 401 and len(data["poincare"]["frequency_per_period"]) == 201
+    host = tmp_path / "host"
+    assert main(["trace", "--level", "6", "--eta", "0.99", "--lyapunov", "--periods", "200", "--fs", "4000", *FAST,
+                 "--no-impactor", "--model", model_file, "--out", str(host)]) == 0
+    printed = capsys.readouterr().out
+    assert "the host alone is linear" in printed and "periodic" in printed
+    data = json.loads((host / "trace.json").read_text())
+    assert data["lyapunov_per_period"] == pytest.approx(-2 * math.pi * 0.00085 / data["eta_actual"], rel=0.01)
+    assert data["lyapunov_linear_host"] == pytest.approx(-2 * math.pi * 0.00085 / data["eta_actual"], rel=1e-12)
+
+
+@pytest.mark.parametrize("args, phrase", [
+    (["--lyapunov", "--periods", "20"], ("at least 80 excitation periods", "got --periods 20", "give --periods 80")),
+    (["--poincare", "--periods", "1"], ("at least 8 periods", "got --periods 1", "give --periods 8")),
+])
+def test_a_record_too_short_for_the_nature_is_refused(tmp_path, model_file, capsys, args, phrase):
+    """One line naming the length needed, exit 2, nothing written."""
+    out = tmp_path / "t"
+    code = main(["trace", "--level", "6", "--eta", "0.99", *FAST, "--model", model_file, "--out", str(out), *args])
+    err = capsys.readouterr().err
+    assert code == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert all(words in err for words in phrase), err
+    assert not out.exists()

@@ -87,11 +87,75 @@ def test_a_sweep_folder_without_a_sweep_is_refused(tmp_path, model_file, capsys)
     assert not out.exists()
 
 
-def test_a_start_that_does_not_converge_names_the_residual_and_what_to_try(tmp_path, model_file, capsys):
-    """A stepped-sine start in the strongly modulated response (no periodic orbit near): exit 3, nothing written."""
+def test_a_start_that_does_not_converge_writes_what_it_tried_and_suggests_another(tmp_path, model_file, capsys):
+    """A stepped-sine start in the strongly modulated response (no periodic orbit near): exit 3, one line naming the
+    best residual and another start; start-attempts.json holds each k's start state, last iterate and residual."""
     out = tmp_path / "res"
     code = main(["orbits", "--model", model_file, "--level", "7.4", "--eta", "0.99:1.0", "--start", "simulation",
                  "--at", "1.0", "--max-period", "1", "--out", str(out)])
-    line = one_line(capsys, code, 3, "residual", "start closer")
+    line = one_line(capsys, code, 3, "residual", "--start slow-flow", "start-attempts.json")
     assert "numerical failure" in line
+    assert sorted(p.name for p in out.iterdir()) == ["start-attempts.json"]
+    data = json.loads((out / "start-attempts.json").read_text())
+    (attempt,) = data["attempts"]
+    assert attempt["k"] == 1 and attempt["residual"] > 1e-7 and len(attempt["start"]) == 8
+    assert data["level"] == 7.4 and "--start slow-flow" in data["suggestion"]
+
+
+def test_friction_is_refused_before_any_compilation(tmp_path, capsys, monkeypatch):
+    """--friction with the ode3 integrator (which takes friction) on the built-in rig (which has the floor's mode
+    values): refused in one line naming --friction, before the kernels are warmed up (compiled), nothing written."""
+    import sim.integration.integrators as integrators
+
+    def no_compiling(*args, **kwargs):
+        raise AssertionError("compiled before refusing")
+
+    monkeypatch.setattr(integrators, "warm_up", no_compiling)
+    out = tmp_path / "res"
+    code = main(["orbits", "--level", "7.4", "--friction", "0.07", "--integrator", "ode3", "--out", str(out)])
+    line = one_line(capsys, code, 2, "--friction")
+    assert "--mu" not in line
     assert not out.exists()
+
+
+def test_a_sweep_of_another_level_is_refused(tmp_path, model_file, capsys):
+    """A sweep folder of level 6 with --level 7.4: one line naming both levels, nothing written; with
+    --level-curve a sweep is refused too."""
+    sweep = tmp_path / "sweep6"
+    sweep.mkdir()
+    (sweep / "sweep.csv").write_text("eta,mean,mean_lo,mean_hi\n0.97,0.1,0.09,0.11\n")
+    (sweep / "sweep.json").write_text(json.dumps({"level": 6.0}))
+    out = tmp_path / "res"
+    code = main(["orbits", "--model", model_file, "--level", "7.4", "--sweep", str(sweep), "--out", str(out)])
+    one_line(capsys, code, 2, "level 6", "--level 7.4")
+    code = main(["orbits", "--model", model_file, "--level", "5:9", "--level-curve", "0.97", "--sweep", str(sweep),
+                 "--out", str(out)])
+    one_line(capsys, code, 2, "--level-curve")
+    assert not out.exists()
+
+
+def test_the_rigs_first_mode_alone_has_its_stable_asymmetric_orbit_on_the_diagram(tmp_path, capsys):
+    """The issue's case: the rig's first mode alone (`ies modes --n-modes 1 --save`) at level 7.4. The symmetric
+    two-impact orbit loses its stability at a located symmetry breaking (eta 0.9553, not a Neimark-Sacker point),
+    and the stable asymmetric period-T orbit beyond it (eta 0.95707, a/a_noabs* 0.08789, |mu| 0.99966; a direct
+    simulation from the perturbed symmetric orbit settles on it) is on the diagram as stable. The independent
+    reference for |mu|: DOP853 on the variational equations gives 0.99965711 for this orbit."""
+    one = tmp_path / "one.toml"
+    assert main(["modes", "--n-modes", "1", "--save", str(one)]) == 0
+    out = tmp_path / "res"
+    assert main(["orbits", "--model", str(one), "--level", "7.4", "--eta", "0.953:0.958", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "symmetry-breaking at eta 0.9552" in printed and "loses stability" in printed
+    with (out / "orbits.csv").open(newline="") as handle:
+        rows = [r for r in csv.DictReader(handle) if r["origin"] != "linear solution"]
+    breaking = [r for r in rows if r["bifurcation"] == "symmetry-breaking"]
+    assert breaking and float(breaking[0]["location_error"]) < 1e-4
+    asymmetric = sorted((float(r["eta"]), float(r["amplitude"]), r) for r in rows
+                        if r["symmetric"] == "0" and r["period_multiple"] == "1")
+    below = [a for a in asymmetric if a[0] <= 0.95707]
+    above = [a for a in asymmetric if a[0] > 0.95707]
+    assert below and above
+    (x0, y0, r0), (x1, y1, r1) = max(below, key=lambda a: a[0]), min(above, key=lambda a: a[0])
+    assert x1 - x0 < 2e-3 and r0["stable"] == r1["stable"] == "1"
+    assert y0 + (0.95707 - x0) / (x1 - x0) * (y1 - y0) == pytest.approx(0.08789, abs=2e-4)
+    assert 0.9995 < float(r0["max_multiplier"]) < 1.0

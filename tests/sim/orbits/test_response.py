@@ -41,22 +41,31 @@ def test_where_the_stepped_sine_is_almost_periodic_it_is_on_a_stable_orbit(rig):
 
 
 def test_the_two_impact_orbit_loses_stability_where_the_slow_flow_says(rig):
-    """The same host: continued in eta, the symmetric two-impact orbit loses its stability through a located
-    Neimark-Sacker point between 0.955 and 0.96, where the one-mode Newton model's exact orbit is stable and
-    unstable (`sim.reduced.slow_flow.exact_orbit`, r = the law's restitution)."""
+    """The same host: continued in eta, the symmetric two-impact orbit loses its stability where the one-mode Newton
+    model's exact orbit does (`sim.reduced.slow_flow.exact_orbit`, r = the law's restitution; its crossing bisected
+    here to 1e-4 in eta), and the same way: the complex pair of the half map meets on the negative real axis and one
+    real multiplier leaves through -1, a symmetry breaking (not a Neimark-Sacker point), located to |mu| within
+    1e-4 of 1."""
 
     model, impactor = one_mode(rig), Impactor(contact_law=ContactLaw("hertz-damped", 0.86))
     r = restitution(float(xi_of_r_cont(0.86)))
     reference = slow_flow_model(model, impactor, r)
-    stable = {}
-    for eta in (0.955, 0.96):
+
+    def exact(eta: float):
         guess = sorted(periodic_orbits(reference, 7.4, eta), key=lambda o: -o.A_wall)[0]
-        stable[eta] = exact_orbit(reference, 7.4, eta, guess).stable
-    assert stable == {0.955: True, 0.96: False}
+        return exact_orbit(reference, 7.4, eta, guess)
+
+    lo, hi = 0.955, 0.96
+    assert exact(lo).stable and not exact(hi).stable
+    while hi - lo > 1e-4:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if exact(mid).stable else (lo, mid)
+    crossing = min(exact(hi).multipliers, key=lambda m: abs(m + 1.0))
+    assert abs(crossing.imag) < 1e-12 and crossing.real < -1.0  # the reference: a real multiplier through -1
     response = orbit_response(OrbitSetting(model, impactor, 7.4, 0.95), "eta", (0.95, 0.97), switches=0,
-                              restitution=r)
+                              searches=False, restitution=r)
     lost = [p for p in response.branches[0].points if p.note == "loses stability"]
-    assert len(lost) == 1 and lost[0].label == "neimark-sacker"
-    assert 0.955 < lost[0].orbit.setting.eta < 0.96
-    assert abs(abs(complex(lost[0].orbit.half_multipliers[0])) - 1.0) < 1e-2 or any(
-        abs(abs(m) - 1.0) < 1e-2 for m in lost[0].orbit.half_multipliers)
+    assert len(lost) == 1 and lost[0].label == "symmetry-breaking"
+    assert lost[0].orbit.setting.eta == pytest.approx(0.5 * (lo + hi), abs=1e-3)  # the models differ by ~1 %
+    assert lost[0].location_error < 1e-4
+    assert abs(abs(min(lost[0].orbit.half_multipliers, key=lambda m: abs(m + 1.0))) ** 2 - 1.0) < 1e-4
