@@ -85,20 +85,25 @@ def parse_quantity(text: str | float, quantity: Quantity) -> float:
 
 def implausible(value: float, quantity: Quantity, typed: str | None = None) -> str | None:
     """None when `value` (SI) lies in the quantity's plausible range; otherwise one sentence saying so and, when the
-    number read in another accepted unit lies in range (0.58 as mm, 0.085 as %), the reading probably meant, e.g.
-    "0.58 m is implausible for a clearance g (above 10 mm); did you mean 0.58mm?" (`typed`: the number as the user
-    typed it, "300e3", kept in that reading)."""
+    number as typed read in another accepted unit lies in range (0.58 as mm, 0.085 as %), the reading probably meant,
+    e.g. "0.58 m is implausible for a clearance g (above 10 mm); did you mean 0.58mm?". typed: the text the value was
+    read from ("300e3", "0.6m", "8.5%"; None: a bare number, the SI value): its number is kept, its own unit is no
+    other reading (8.5% is no slip for 0.085%)."""
     lo, hi = quantity.plausible
     if not math.isfinite(value) or value <= 0 or lo <= value <= hi:
         return None
     side = f"above {quantity.format(hi)}" if value > hi else f"below {quantity.format(lo)}"
     shown = quantity.format(value) if not quantity.si_unit else f"{value:.4g} {quantity.si_unit}"
     message = f"{shown} is implausible for a {quantity.name} ({side})"
+    match = _NUMBER.match(typed) if typed is not None else None
+    number, text, own = (float(match.group(1)), match.group(1), _unit_key(match.group(2))) if match else \
+        (value, f"{value:g}", "")
+    readings = {unit: factor for unit, factor in quantity.units.items() if _unit_key(unit) != own}
+    if own:  # a number typed with a unit: read bare (SI) too
+        readings[""] = 1.0
     centre = math.sqrt(lo * hi)
-    meant = [(unit, value * factor) for unit, factor in quantity.units.items() if lo <= value * factor <= hi]
+    meant = [(unit, number * factor) for unit, factor in readings.items() if lo <= number * factor <= hi]
     if meant:
         unit, _ = min(meant, key=lambda m: abs(math.log(m[1] / centre)))
-        number = typed.strip() if typed is not None and _NUMBER.match(typed) and not _NUMBER.match(typed).group(2) \
-            else f"{value:g}"
-        message += f"; did you mean {number}{unit}?"
+        message += f"; did you mean {text}{unit}?"
     return message

@@ -40,6 +40,9 @@ def test_unit_slips_name_the_reading_probably_meant():
     assert implausible(1e-7, CLEARANCE) == "1e-07 m is implausible for a clearance g (below 10 um)"  # no unit fits
     assert implausible(0.085, DAMPING) == "8.5 % is implausible for a damping ratio (above 5 %); did you mean 0.085%?"
     assert implausible(0.00085, DAMPING) is None and implausible(0.05, DAMPING) is None
+    # a number typed with its unit is no slip of that unit: 8.5% stays 8.5 %, 0.6m may be 0.6mm
+    assert implausible(0.085, DAMPING, "8.5%") == "8.5 % is implausible for a damping ratio (above 5 %)"
+    assert implausible(0.6, CLEARANCE, "0.6m").endswith("did you mean 0.6mm?")
 
 
 def test_a_damping_ratio_takes_percent():
