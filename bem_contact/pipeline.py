@@ -14,7 +14,6 @@ sphere, clearance and k_t come from the one vocabulary, `sim.model.parameters`.
 """
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -239,10 +238,10 @@ def calibrate(settings: CalibrationSettings) -> tuple[Any, GapSource, float]:
     source = gap_source(settings)
     E_star = contact_modulus(STEEL, BRASS)
     deltas = np.round(np.linspace(settings.delta_min_um, settings.delta_max_um, settings.points) * 1e-6, 13)  # m, no float noise
-    from tqdm import tqdm
+    from sim.common.progress import progress
 
-    # progress on stderr for long runs (fine grids); silent when stderr is not a terminal
-    with tqdm(total=2 * len(deltas), desc="contact solves", unit="solve", leave=False, disable=not sys.stderr.isatty()) as bar:
+    # progress on stderr: a bar on a terminal, plain lines in a log when it takes long (fine grids)
+    with progress(2 * len(deltas), "contact solves", "solve", leave=False) as bar:
         grid = DEFAULT_GRID if settings.grid is None else settings.grid
         result = calibrate_k_H(source.gap_at, grid, E_star, deltas, solver=settings.solver, R=SPHERE_RADIUS, on_solve=bar.update)
     return result, source, E_star

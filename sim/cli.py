@@ -165,7 +165,7 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
     (Table 2's D, g, k_H; r_cont, friction, k_t; a contact law's own constant), with its aliases."""
     from sim.hosts.sources import add_host_arguments
     from sim.model.contact_law import DEFAULT_LAW, LAWS
-    from sim.model.parameters import PARAMETERS
+    from sim.model.parameters import ALLOW_IMPLAUSIBLE, PARAMETERS
     from sim.model.sphere import add_sphere_arguments
 
     add_host_arguments(parser)
@@ -181,6 +181,9 @@ def add_system_arguments(parser: argparse.ArgumentParser) -> None:
         if option is not None:
             parser.add_argument(*option.flags, dest=name, type=option.parse or parameter.option_value, default=None,
                                 metavar=option.metavar, help=option.help_text())
+    parser.add_argument(ALLOW_IMPLAUSIBLE, action="store_true",
+                        help="compute with a value whose magnitude is implausible for its quantity (a clearance of "
+                             "0.6 m, a damping ratio of 8.5 %%), refused by default as a unit slip")
 
 
 def add_protocol_arguments(parser: argparse.ArgumentParser, *, default_reps: int) -> None:
@@ -236,9 +239,15 @@ def add_simulation_arguments(parser: argparse.ArgumentParser, *, default_reps: i
 
 
 def add_force_argument(parser: argparse.ArgumentParser) -> None:
-    """--force: write into a non-empty --out folder (its files of the same names are replaced)."""
+    """--force: write into a non-empty --out folder (its files of the same names are replaced); --allow-large: run work
+    estimated above an hour (`sim.stepped_sine.cost`)."""
+    from sim.stepped_sine.cost import LIMIT_S, duration_text
+
     parser.add_argument("--force", action="store_true",
                         help="write into a non-empty --out folder, replacing its files of the same names (default: refuse)")
+    parser.add_argument("--allow-large", action="store_true",
+                        help=f"run work whose cost estimate (measured here before it starts) exceeds "
+                             f"{duration_text(LIMIT_S)} (refused by default)")
 
 
 def parse_grid(text: str, option: str) -> tuple[float, float, int]:
@@ -368,14 +377,19 @@ def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     friction)."""
     from sim.hosts.sources import resolve_host
     from sim.integration.integrators import integrator_named
-    from sim.model.parameters import PARAMETERS, SystemSettings, system_settings
-    from sim.model.system import build_impactor
+    from sim.model.parameters import PARAMETERS, SystemSettings, check_plausible, system_settings
+    from sim.model.system import build_impactor, check_resonant_mode
     from sim.model.system import build_system as build
 
+    values = {name: getattr(args, name, None) for name in PARAMETERS}
+    check_plausible(values, allow=args.allow_implausible)  # a unit slip is refused, not computed with
     integrator = integrator_named(args.integrator)
     model = resolve_host(args).model
+    try:
+        check_resonant_mode(model)  # walls at a node of mode 1: refused before any work
+    except SimulationInputError as exc:
+        raise SimulationInputError(f"{model.source}: {exc}") from None
     sphere = sphere_for(args, model)  # radius, material, mass, walls: the mass and Eq. 8's k_H* the options start from
-    values = {name: getattr(args, name, None) for name in PARAMETERS}
     settings = system_settings(values, sphere.settings(SystemSettings(contact_law=args.contact_law)))
     if args.no_impactor:  # the impactor's values are checked all the same
         build_impactor(settings)
@@ -427,11 +441,13 @@ def build_protocol(args: argparse.Namespace) -> Any:
 
 @contextmanager
 def output_folder(path: str | None, force: bool = False) -> Iterator[Path | None]:
-    """--out DIR, created up front and proved writable (a clear error if it cannot be a folder, holds earlier
-    results and `force` is not given, or the disk refuses a file) and removed again if the command fails before
-    writing anything into it (no empty result folders after a bad input)."""
+    """--out DIR, created up front, proved writable and locked for this run (`sim.common.folder_lock`: a second run
+    into it is refused, naming this one) (a clear error if it cannot be a folder, is in use, holds earlier results and
+    `force` is not given, or the disk refuses a file) and removed again if the command fails before writing anything
+    into it (no empty result folders after a bad input)."""
     from sim.common.errors import ResourceFailure
     from sim.common.files import RESOURCE_ERRNOS, check_writable
+    from sim.common.folder_lock import LOCK_FILE, locked
 
     if path is None:
         yield None
@@ -439,9 +455,6 @@ def output_folder(path: str | None, force: bool = False) -> Iterator[Path | None
     folder = Path(path)
     if folder.exists() and not folder.is_dir():
         raise SimulationInputError(f"--out {folder} exists and is not a folder; choose another path")
-    if folder.is_dir() and not force and any(folder.iterdir()):
-        raise SimulationInputError(f"--out {folder} is not empty (earlier results?); choose another folder or pass "
-                                   "--force to replace its files")
     created = not folder.exists()
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -451,7 +464,11 @@ def output_folder(path: str | None, force: bool = False) -> Iterator[Path | None
                     "computed)") from None
     try:
         check_writable(folder, "--out", folder=True)
-        yield folder
+        with locked(folder):
+            if not force and any(p.name != LOCK_FILE for p in folder.iterdir()):
+                raise SimulationInputError(f"--out {folder} is not empty (earlier results?); choose another folder or "
+                                           "pass --force to replace its files")
+            yield folder
     except BaseException:
         if created and not any(folder.iterdir()):
             folder.rmdir()
@@ -468,15 +485,13 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
     options (Sects. 5.1-5.3), the sweeps run inside `output_folder` so that a failure leaves no empty folder. Levels
     are a_base/a_base* or base amplitudes (`BaseAmplitude`), normalised by the host's own D_1* and --g-star
     (`nominal_of`); each result carries its level.
-    The integrator's kernels are warmed up (compiled on the first run) before one progress bar, `label`, counts
-    the stepped-sine points of every level and repetition (on a terminal; for one level only when it is long)."""
-    import sys
-
-    from tqdm import tqdm
-
+    The integrator's kernels are warmed up (compiled on the first run) before one progress report, `label`, counts
+    the stepped-sine points of every level and repetition (`sim.common.progress`: a bar on a terminal, plain lines in a
+    log; for one level only when it is long)."""
     from sim.common.files import check_writable
+    from sim.common.progress import progress
     from sim.integration.integrators import warm_up
-    from sim.stepped_sine.cost import announce, cost_per_simulated_second, simulated_seconds
+    from sim.stepped_sine.cost import check_estimate, estimate, seconds_per_run, simulated_seconds, worth_probing
     from sim.stepped_sine.protocol import sweep
 
     protocol = build_protocol(args)
@@ -494,12 +509,12 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
     long_run = len(levels) > 1 or total * (protocol.wait + protocol.hold) > LONG_SWEEP_S
     with output_folder(args.out, args.force) as folder:
         warm_up(protocol.integrator, law="hertz" if impactor is None else impactor.contact_law.law.name)
-        per_run = simulated_seconds(protocol, float(model.omega[0]))
-        if len(levels) * args.reps * per_run > LONG_SWEEP_S:  # long enough to be worth the probe (< 1 s)
-            announce(len(levels) * args.reps, per_run, cost_per_simulated_second(model, impactor, max(levels), protocol),
-                     "lower --reps, the --eta points, --wait/--hold or the number of levels")
-        with tqdm(total=total, desc=label, unit="pt", disable=not (long_run and sys.stderr.isatty()), leave=False,
-                  file=sys.stderr, dynamic_ncols=True) as bar:
+        if worth_probing(len(levels) * args.reps, simulated_seconds(protocol, float(model.omega[0]))):
+            cost = seconds_per_run(model, impactor, levels, protocol, nominal)  # measured here, before the first run
+            check_estimate(estimate({level: args.reps for level in levels}, cost),
+                           "lower --reps, the --eta points, --wait/--hold or the number of levels",
+                           allow_large=args.allow_large)
+        with progress(total, label, "pt", enabled=long_run, leave=False) as bar:
             results = [sweep(model, impactor, level, protocol, reps=args.reps, seed=args.seed, nominal=nominal,
                              progress=bar.update, lyapunov=lyapunov) for level in levels]
         yield folder, protocol, model, impactor, results
@@ -640,7 +655,8 @@ def trace_command(args: argparse.Namespace) -> int:
     from sim.plots.dynamics import plot_poincare
     from sim.common.files import check_writable, dumps, report_written, write_or_fallback
     from sim.integration.integrators import warm_up
-    from sim.stepped_sine.cost import announce, check_trace_memory, cost_per_simulated_second, simulated_seconds
+    from sim.stepped_sine.cost import ANNOUNCE_AFTER_S, check_estimate, check_trace_memory, estimate, probe_cost, \
+        simulated_seconds, worth_probing
 
     started = time.perf_counter()
     protocol = build_protocol(args)
@@ -657,11 +673,12 @@ def trace_command(args: argparse.Namespace) -> int:
         check_writable(args.plot, "--plot")
     with output_folder(args.out, args.force) as folder:
         warm_up(protocol.integrator, law="hertz" if impactor is None else impactor.contact_law.law.name)
-        per_run = (simulated_seconds(protocol, float(model.omega[0]))
-                   + args.periods / (protocol.eta[-1] * model.frequencies_hz[0]))  # the recorded periods
-        announce(1, per_run,
-                 cost_per_simulated_second(model, impactor, level, protocol) + samples / per_run * SAMPLE_COST_S,
-                 "lower --periods, --fs, the --eta points or --wait/--hold")
+        simulated = (simulated_seconds(protocol, float(model.omega[0]))
+                     + args.periods / (protocol.eta[-1] * model.frequencies_hz[0]))  # the recorded periods
+        if worth_probing(1, simulated) or samples * SAMPLE_COST_S > ANNOUNCE_AFTER_S:
+            seconds = simulated * probe_cost(model, impactor, level, protocol, nominal) + samples * SAMPLE_COST_S
+            check_estimate(estimate({level: 1}, {level: seconds}), "lower --periods, --fs, the --eta points or "
+                           "--wait/--hold", allow_large=args.allow_large)
         trace = record_trace(model, impactor, level, protocol, periods=args.periods, fs=args.fs, seed=args.seed,
                              nominal=nominal)
         nature = trace_nature(trace, model, impactor, protocol, lyapunov=args.lyapunov, poincare=args.poincare,
@@ -740,7 +757,7 @@ def cache_command(args: argparse.Namespace) -> int:
     from sim.integration import jit
 
     root, chosen_by = kernel_cache.cache_root()
-    current = kernel_cache.folder_name(jit.CACHE_GROUP, jit.fingerprint())
+    current = kernel_cache.folder_name(jit.CACHE_GROUP, kernel_cache.code_version())  # as `ies --version` names it
     if args.clear:
         removed, freed = kernel_cache.clear(root)
         left = kernel_cache.version_folders(root)
@@ -753,7 +770,7 @@ def cache_command(args: argparse.Namespace) -> int:
         return 0
     folders = kernel_cache.version_folders(root)
     now = time.time()
-    data = {"folder": root, "chosen_by": chosen_by, "total_bytes": sum(e.size for e in folders),
+    data = {"folder": root, "chosen_by": chosen_by, "total_bytes": kernel_cache.disk_size(folders),
             "versions": [{"folder": e.path.name, "group": e.group, "bytes": e.size, "files": e.files,
                           "last_used": e.last_used, "current": e.path.name == current} for e in folders]}
     if args.json:
@@ -769,7 +786,8 @@ def cache_command(args: argparse.Namespace) -> int:
               f"{_ago(now - entry.last_used)}")
     if not folders:
         print("  empty: the next run compiles the kernels (once per version of the code)")
-    print(f"total {_megabytes(data['total_bytes'])} in {len(folders)} folder(s); `ies cache --clear` empties it")
+    print(f"total {_megabytes(data['total_bytes'])} on disk in {len(folders)} folder(s) (the versions share the machine "
+          "code of the same kernel sources); `ies cache --clear` empties it")
     return 0
 
 

@@ -52,3 +52,12 @@ def tiny_design(tmp_path: Path, model: str | Path) -> dict:
                      "[excitation]\neta = { start = 0.98, stop = 0.99, n = 2 }\nwait = 0.02\nhold = 0.05\n")
     assert main(["design", str(study), "--jobs", "1", "--quiet", "--no-figures"]) == 0
     return json.loads((tmp_path / "design-out" / "design.json").read_text())
+
+
+def sleepy(params: dict, level: float, rep: int, seed: int) -> float:
+    """A model of a study file (``model = "tests.support:sleepy"``) whose runs take 0.25 s each: a study that is
+    still running when a second process starts."""
+    import time
+
+    time.sleep(0.25)
+    return sum(params.values()) + level

@@ -89,12 +89,17 @@ def test_g_and_k_H_accept_units(tmp_path, model_file, capsys):
     assert captured.err == ""  # plausible: no warning
 
 
-@pytest.mark.parametrize("option, value, meant", [("--g", "0.58", "did you mean 0.58 mm = 0.00058 m?"),
-                                                  ("--k-H", "282e3", "did you mean 282000 N/mm^1.5 = 8.918e+09")])
-def test_implausible_magnitudes_warn_with_the_value_probably_meant(tmp_path, model_file, capsys, option, value, meant):
-    assert main(["sweep", "--level", "6", *FAST, "--model", model_file, "--no-impactor", option, value]) == 0
-    err = capsys.readouterr().err
-    assert err.startswith("warning: ") and meant in err and len(err.splitlines()) == 1
+@pytest.mark.parametrize("option, value, meant", [("--g", "0.58", "did you mean 0.58mm?"),
+                                                  ("--k-H", "282e3", "did you mean 282e3N/mm^1.5?"),
+                                                  ("--D", "0.085", "did you mean 0.085%?")])
+def test_implausible_magnitudes_are_refused_with_the_reading_probably_meant(tmp_path, model_file, capsys, option,
+                                                                              value, meant):
+    out = tmp_path / "out"
+    refused(capsys, main(["sweep", "--level", "6", *FAST, "--model", model_file, "--no-impactor", option, value,
+                          "--out", str(out)]), f"{option} {value}: ", meant, "--allow-implausible")
+    assert not out.exists()
+    assert main(["sweep", "--level", "6", *FAST, "--model", model_file, "--no-impactor", option, value,
+                 "--allow-implausible"]) == 0
 
 
 @pytest.mark.parametrize("option, value", [("--g", "0.58in"), ("--k-H", "282e3 N/cm^1.5")])
@@ -105,9 +110,10 @@ def test_unknown_units_are_refused(tmp_path, model_file, capsys, option, value):
     assert not out.exists()
 
 
-def test_study_files_take_units_and_warn_on_slips(tmp_path, capsys):
-    from uq.problem.space import K_H_STAR
+def test_study_files_take_units_and_refuse_slips(tmp_path, capsys):
+    from uq.errors import StudyError
     from uq.methods import load_study
+    from uq.problem.space import K_H_STAR
 
     path = tmp_path / "s.toml"
     path.write_text("[study]\nkind = 'interval'\n[parameters.g]\nmax = '0.612 mm'\n[parameters.k_H]\n"
@@ -117,9 +123,10 @@ def test_study_files_take_units_and_warn_on_slips(tmp_path, capsys):
     assert capsys.readouterr().err == ""
     path.write_text("[study]\nkind = 'interval'\n[parameters.g]\nnominal = 0.58\nmin = 0.58\nmax = 0.612\n"
                     "[excitation]\nlevels = [6.7]\n")
-    load_study(path)
-    err = capsys.readouterr().err.splitlines()
-    assert len(err) == 3 and all(f"{path}: [parameters.g]" in line and "did you mean" in line for line in err)
+    with pytest.raises(StudyError, match=r"\[parameters.g\] nominal = 0.58: 0.58 m is implausible for a clearance g "
+                                         r"\(above 10 mm\); did you mean 0.58mm\? Give the unit"):
+        load_study(path)
+    assert load_study(path, allow_implausible=True).space["g"].max == 0.612
     assert K_H_STAR == pytest.approx(282e3 * 1e3**1.5)
 
 

@@ -52,8 +52,8 @@ def test_every_written_file_is_0644_under_umask_022(tmp_path, umask_022, capsys)
     modes = modes_of_files(tmp_path)
     expected = {"crater.png", "flat.pdf", "rig.toml", "sweep/sweep.csv", "sweep/sweep.json", "fig5.png",
                 "overview/overview.csv", "overview/overview.json", "fig6.png", "interval/runs.csv",
-                "interval/points.csv", "interval/bands.csv", "interval/study.json", "interval/fig7.png",
-                "interval/fig8.pdf", "scan.stl", "scan.xyz", "calibration.json"}
+                "interval/points.csv", "interval/bands.csv", "interval/study.json",
+                "interval/individual-variation.png", "interval/joint-variation.pdf", "scan.stl", "scan.xyz", "calibration.json"}
     assert expected <= set(modes), sorted(expected - set(modes))
     assert any(name.startswith("interval/tasks/") for name in modes)
     assert not [name for name in modes if os.path.basename(name).startswith(".")], "temporary file left behind"

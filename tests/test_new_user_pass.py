@@ -361,36 +361,41 @@ def test_a_negative_value_with_a_unit_reaches_its_check(tmp_path, model_file, ca
 # ---- work sized to hang: a cost estimate first, --jobs against the cores --------------------------------------
 
 def test_a_long_sweep_says_what_it_will_cost_before_it_starts(tmp_path, model_file, capsys, monkeypatch):
-    monkeypatch.setattr("sim.stepped_sine.cost.cost_per_simulated_second", lambda *a: 0.05)
+    monkeypatch.setattr("sim.stepped_sine.cost.probe_cost", lambda *a: 0.05)
 
     def interrupt(*args, **kwargs):
         raise KeyboardInterrupt
 
     monkeypatch.setattr("sim.stepped_sine.protocol.sweep", interrupt)
-    code = main(["overview", "--levels", "1:10:1000", "--reps", "1000", "--model", model_file])
+    command = ["overview", "--levels", "1:10:1000", "--reps", "1000", "--model", model_file]
+    line = one_line(capsys, main(command), 2, "cost estimate: 1000000 run(s) x ", "h on one core",
+                    "more than the 1.0 h a command runs without --allow-large", "lower --reps")
+    assert main([*command, "--allow-large"]) == 130  # asked for: said, then started
     err = capsys.readouterr().err.splitlines()
-    assert code == 130 and err[0].startswith("warning: cost estimate: 1000000 run(s) x ")
-    assert "h on one core" in err[0] and "lower --reps" in err[0]
+    assert err[0].startswith("warning: cost estimate: 1000000 run(s) x ") and "lower --reps" in err[0]
+    assert line.split("cost estimate: ")[1].split(":")[0] in err[0]
 
 
 def test_the_estimate_is_quiet_for_short_work_and_a_plain_line_for_minutes():
     import io
 
-    from sim.stepped_sine.cost import announce
+    from sim.stepped_sine.cost import Estimate, check_estimate
 
     stream = io.StringIO()
-    assert announce(10, 1.0, 0.01, "hint", stream) == pytest.approx(0.1) and stream.getvalue() == ""
-    announce(100, 10.0, 0.2, "hint", stream)
-    assert stream.getvalue().startswith("cost estimate: 100 run(s)") and "3.3 min" in stream.getvalue()
+    assert check_estimate(Estimate(10, 0.01), "hint", stream=stream) == pytest.approx(0.1) and stream.getvalue() == ""
+    check_estimate(Estimate(100, 2.0), "hint", stream=stream)
+    assert stream.getvalue().startswith("cost estimate: 100 run(s) x 2 s") and "3.3 min" in stream.getvalue()
 
 
 def test_a_trace_at_an_extreme_rate_says_what_it_will_cost(tmp_path, model_file, capsys, monkeypatch):
     monkeypatch.setattr("sim.stepped_sine.cost.available_memory", lambda: 1e15)
     monkeypatch.setattr("sim.analysis.trace.record_trace", lambda *a, **k: (_ for _ in ()).throw(KeyboardInterrupt))
-    code = main(["trace", "--level", "6", "--eta", "0.99", "--wait", "0.02", "--fs", "1e9", "--model", model_file,
-                 "--out", str(tmp_path / "res")])
+    command = ["trace", "--level", "6", "--eta", "0.99", "--wait", "0.02", "--fs", "1e9", "--model", model_file,
+               "--out", str(tmp_path / "res")]
+    one_line(capsys, main(command), 2, "cost estimate: 1 run(s)", "--fs", "--allow-large")
+    assert main([*command, "--allow-large"]) == 130
     err = capsys.readouterr().err.splitlines()
-    assert code == 130 and err[0].startswith("warning: cost estimate: 1 run(s)") and "--fs" in err[0]
+    assert err[0].startswith("warning: cost estimate: 1 run(s)") and "--fs" in err[0]
 
 
 def test_jobs_above_the_cores_warns_and_small_work_runs_serially(monkeypatch):

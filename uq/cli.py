@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import signal
 import sys
 from typing import Sequence
 
@@ -72,21 +73,32 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def version_line() -> str:
-    """``ies-workbench VERSION (simulator code HASH)``: the installed distribution's version and the hash of the
-    simulator's source (the code version in every study's task keys, `uq.problem.models`)."""
+    """``ies-workbench VERSION (simulator code HASH)``: the installed distribution's version and the simulator's code
+    version (`sim.common.kernel_cache.code_version`: in every study's task keys, and the name of the kernel folder
+    ``sim-HASH`` that `ies cache` lists)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    from uq.problem.models import IESModel
+    from sim.common.kernel_cache import code_version
 
     try:
         installed = version("ies-workbench")
     except PackageNotFoundError:
         installed = "(not installed)"
-    return f"ies-workbench {installed} (simulator code {IESModel().version()})"
+    return f"ies-workbench {installed} (simulator code {code_version()})"
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run `ies` with `argv` (default: the process arguments) and return the exit code."""
+    """Run `ies` with `argv` (default: the process arguments) and return the exit code.
+
+    Run as the process's own command (argv None: the console script, ``python -m uq``), Ctrl-C is ignored once the
+    exit code is settled: an interrupt while the interpreter shuts down (joblib's workers, HDF5, matplotlib being torn
+    down) would otherwise end it with a traceback, "Exception ignored", a fatal error or a silent kill after the one
+    line was written. While files are written it is held back until each file is whole (`sim.common.files`)."""
+    def settled(code: int) -> int:
+        if argv is None:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+        return code
+
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -94,7 +106,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(exc.code or 0)
     prog = f"ies {args.command}"
     try:
-        return int(args._run(args) or 0)
+        return settled(int(args._run(args) or 0))
+    except KeyboardInterrupt:
+        settled(130)
+        if getattr(args, "resume", None) is not None:
+            sys.stderr.write(f"{prog}: interrupted; finished results were kept (rerun with --resume)\n")
+        else:
+            sys.stderr.write(f"{prog}: interrupted; no results were written (rerun the command)\n")
+        return 130
     except USER_ERRORS as exc:
         sys.stderr.write(f"{prog}: error: {exc}\n")
         return 2
@@ -123,12 +142,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 3
         sys.stderr.write(f"{prog}: error: {exc.strerror or exc}{where}\n")
         return 2
-    except KeyboardInterrupt:
-        if getattr(args, "resume", None) is not None:
-            sys.stderr.write(f"{prog}: interrupted; finished results were kept (rerun with --resume)\n")
-        else:
-            sys.stderr.write(f"{prog}: interrupted; no results were written (rerun the command)\n")
-        return 130
+    finally:
+        settled(0)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -3,7 +3,7 @@ axes, never on data, at one text size, and the typeset labels and units (mathtex
 from __future__ import annotations
 
 import re
-from typing import Any
+from typing import Any, Sequence
 
 #: legend text size (pt): every legend of the workbench sits beside or below its axes, never on data
 LEGEND_PT = 8.0
@@ -37,11 +37,16 @@ def wrap_label(text: str, width: int = LEGEND_LINE_CHARS) -> str:
     return "\n".join(lines)
 
 
-def legend_beside(ax: Any, *, title: str | None = None, **kwargs: Any) -> Any:
+def legend_beside(ax: Any, *, title: str | None = None, handles_of: Sequence[Any] = (), **kwargs: Any) -> Any:
     """A legend to the right of `ax`, outside the axes (off the data), LEGEND_PT text, its entries and title wrapped to
-    LEGEND_LINE_CHARS; None without entries. When `ax` has a secondary axis on its right (`secondary_mm`) the legend
-    goes to the figure's right margin (constrained layout), beyond that axis's labels."""
-    handles, labels = ax.get_legend_handles_labels()
+    LEGEND_LINE_CHARS; None without entries. handles_of: the panels whose entries it lists, each label once (default
+    `ax`'s own). When `ax` has a secondary axis on its right (`secondary_mm`) the legend goes to the figure's right
+    margin (constrained layout), beyond that axis's labels."""
+    entries: dict[str, Any] = {}
+    for panel in handles_of or (ax,):
+        for handle, label in zip(*panel.get_legend_handles_labels()):
+            entries.setdefault(label, handle)
+    handles, labels = list(entries.values()), list(entries)
     if not handles:
         return None
     labels = [wrap_label(label) for label in labels]

@@ -20,8 +20,10 @@ import json
 import math
 import os
 import secrets
+import signal
 import sys
 import tempfile
+import threading
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Sequence, TypeVar
@@ -53,10 +55,42 @@ def read_text(path: str | os.PathLike, kind: str, fmt: str, hint: str = "") -> s
         raise SimulationInputError(f"{path}: not a text (UTF-8 {fmt}) file") from None
 
 
+#: whether `interrupts_held` holds Ctrl-C back now (in the main thread; nested holds are one)
+_holding = False
+
+
+@contextmanager
+def interrupts_held() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) back while the block runs, and deliver it when the block ends: as KeyboardInterrupt
+    under Python's default handler (or to whatever handler was there). Every writer runs its writing inside one, so
+    that an interrupt never fires inside a file's writer (HDF5, matplotlib, ...), where it leaves a library in a state
+    that can end the interpreter with a fatal error at exit instead of one line. Outside the main thread (where
+    signals cannot be handled) and inside another hold it does nothing."""
+    global _holding
+    if _holding or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: caught.append(signum))
+    _holding = True
+    try:
+        yield
+    finally:
+        _holding = False
+        signal.signal(signal.SIGINT, previous)
+        if caught:
+            if callable(previous):
+                previous(signal.SIGINT, None)  # Python's default handler raises KeyboardInterrupt
+            elif previous == signal.SIG_DFL:
+                os.kill(os.getpid(), signal.SIGINT)
+
+
 @contextmanager
 def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a new empty temporary file beside `path` for the caller to write (by its name); on success it
-    is renamed onto `path`, on any exception it is removed and `path` is left untouched.
+    is renamed onto `path`, on any exception it is removed and `path` is left untouched. Ctrl-C is held back
+    while the file is written and renamed (`interrupts_held`): a file is whole or absent, and an interrupt
+    arrives between files.
 
     Raises FileNotFoundError (folder missing) or IsADirectoryError (`path` is a folder) with a one-line
     message before anything is created.
@@ -68,19 +102,20 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
                                    "choose another path")
     if target.is_dir():
         raise IsADirectoryError(errno.EISDIR, f"cannot write {target}: it is a folder; give a file name")
-    try:
-        tmp = _new_temporary_file(folder, target)
-    except OSError as exc:
-        raise _naming(exc, target) from None
-    try:
-        yield tmp
-        os.replace(tmp, target)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise _naming(exc, target) from None  # the user's file, not the hidden temporary one
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    with interrupts_held():
+        try:
+            tmp = _new_temporary_file(folder, target)
+        except OSError as exc:
+            raise _naming(exc, target) from None
+        try:
+            yield tmp
+            os.replace(tmp, target)
+        except OSError as exc:
+            tmp.unlink(missing_ok=True)
+            raise _naming(exc, target) from None  # the user's file, not the hidden temporary one
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
 
 
 def _naming(exc: OSError, target: Path) -> OSError:
@@ -201,6 +236,31 @@ def write_csv(path: str | os.PathLike, header: Sequence[str], rows: Iterable[Seq
     writer.writerow(header)
     writer.writerows([csv_value(v) for v in row] for row in rows)
     return write_text(path, buffer.getvalue())
+
+
+def read_rows(path: str | os.PathLike) -> list[dict[str, str]]:
+    """The rows of a CSV table as `write_csv` writes it, each a dict by column (cells as text). A file cut short (no
+    line end after its last row, a row with fewer cells than the header) or damaged (a row with more) is one line
+    (SimulationInputError) naming the file and the line, instead of a row whose missing cells read as None."""
+    from sim.common.errors import SimulationInputError
+
+    path = Path(path)
+    text = path.read_text(encoding="utf-8")
+    if not text:
+        raise SimulationInputError(f"{path} is empty (cut short?); rerun the command that wrote it")
+    reader = csv.DictReader(io.StringIO(text))
+    rows = []
+    for row in reader:
+        if None in row or None in row.values():
+            cells = sum(1 for key, value in row.items() if key is not None and value is not None) + len(row.get(None, ()))
+            raise SimulationInputError(f"{path}: line {reader.line_num} has {cells} cells but the header names "
+                                       f"{len(reader.fieldnames or ())} columns (cut short or damaged); rerun the command "
+                                       "that wrote it")
+        rows.append(row)
+    if not text.endswith("\n"):
+        raise SimulationInputError(f"{path}: line {reader.line_num} ends without a line end (the file was cut short); "
+                                   "rerun the command that wrote it")
+    return rows
 
 
 def report_written(paths: Iterable[str | os.PathLike], *, json_mode: bool = False) -> None:

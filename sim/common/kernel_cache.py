@@ -11,11 +11,16 @@ instead, where ROOT is, in this order, the folder named by the environment varia
 own setting), ``$NUMBA_CACHE_DIR/ies-workbench`` where NUMBA_CACHE_DIR is set, or the platform's per-user cache
 folder (``platformdirs.user_cache_dir``: ``$XDG_CACHE_HOME/ies-workbench``, by default
 ``~/.cache/ies-workbench`` on Linux). GROUP is a set of kernels that may embed each other (``sim``: the
-integrators; ``scans``, ``bem_contact``: their own kernels), HASH the SHA-256 of the group's sources. A kernel is
-found again when the sources are the same, wherever they are installed: a reinstall of the same code compiles
-nothing, and an edit of any source of the group gets a new folder (numba's own key follows one file only).
-Nothing is ever written into the installed package. Where ROOT cannot be written, the system's temporary folder
-is used (said once on stderr); where neither can, the kernels are compiled in every process.
+integrators; ``scans``, ``bem_contact``: their own kernels), HASH the SHA-256 of the group's sources: for ``sim``
+the simulator's code version (`code_version`, every source of the package: the hash `ies --version` prints and every
+study task's key holds), for the others their kernels' files. A kernel is found again when the sources are the same,
+wherever they are installed: a reinstall of the same code compiles nothing, and an edit of any source of the group
+gets a new folder (numba's own key follows one file only). The kernels themselves are stamped with the hash of the
+sources they are compiled from (for ``sim`` the kernel files alone, `sim.integration.jit.fingerprint`): a new folder
+of a version whose kernel sources an existing folder was compiled from gets that folder's machine code (hard links,
+`KERNEL_STAMP`), so an edit of the simulator outside its kernels compiles nothing either. Nothing is ever written
+into the installed package. Where ROOT cannot be written, the system's temporary folder is used (said once on
+stderr); where neither can, the kernels are compiled in every process.
 
 A folder not used for PRUNE_AFTER_DAYS days is deleted when another folder of its group is made (an older
 version of the code); `ies cache` shows the folders and their sizes and empties them (`clear`).
@@ -31,6 +36,7 @@ import hashlib
 import inspect
 import os
 import re
+import shutil
 import sys
 import tempfile
 import time
@@ -45,9 +51,24 @@ APP_NAME = "ies-workbench"
 _VERSION_FOLDER = re.compile(r"^(?P<group>[a-z_]+)-(?P<hash>[0-9a-f]{16})$")
 #: file in a version folder whose modification time says when a process last used it
 LAST_USED = "last-used"
+#: file in a version folder holding the hash its kernels are stamped with (the sources they are compiled from)
+KERNEL_STAMP = "kernel-sources"
 PRUNE_AFTER_DAYS = 30.0
 #: files numba and this module write into a version folder (anything else there is left alone by `clear`)
-_OURS = re.compile(r"(\.nbi|\.nbc|\.tmp\.[0-9a-f]+)$|^" + LAST_USED + "$|^tmp")
+_OURS = re.compile(r"(\.nbi|\.nbc|\.tmp\.[0-9a-f]+)$|^(" + LAST_USED + "|" + KERNEL_STAMP + ")$|^tmp")
+#: the simulator's package: every source file in it is part of its code version
+_SIM_DIR = Path(__file__).resolve().parents[1]
+
+
+def code_version() -> str:
+    """The simulator's code version: the first 16 hex digits of the SHA-256 of every source file of `sim` (its path in
+    the package and its content), read now. The one name of the simulator's code: `ies --version` prints it, `ies
+    cache` and the kernel folder (``sim-VERSION``) carry it, and every study task's key holds it (`uq.problem.models`)."""
+    digest = hashlib.sha256()
+    for path in sorted(_SIM_DIR.rglob("*.py")):
+        digest.update(path.relative_to(_SIM_DIR).as_posix().encode() + b"\0")
+        digest.update(path.read_bytes())
+    return digest.hexdigest()[:16]
 
 
 def cache_root() -> tuple[Path, str]:
@@ -121,9 +142,11 @@ _said_fallback = False
 
 
 @functools.lru_cache(maxsize=None)
-def version_folder(group: str, code_hash: str) -> Path | None:
-    """The folder of `group`'s kernels compiled from sources with SHA-256 `code_hash`, made if needed (and marked
-    as used); None where neither the cache root nor the temporary fallback can be written."""
+def version_folder(group: str, code_hash: str, stamp: str | None = None) -> Path | None:
+    """The folder of `group`'s kernels for the code with hash `code_hash` (hex; its first 16 digits name it), made if
+    needed (and marked as used); None where neither the cache root nor the temporary fallback can be written.
+    stamp: the hash of the sources the kernels are compiled from, when it is not `code_hash` (the simulator's kernel
+    files): a new folder gets the machine code of the latest folder of the group with the same stamp (`_seed`)."""
     global _said_fallback
     name = folder_name(group, code_hash)
     root, _ = cache_root()
@@ -136,6 +159,8 @@ def version_folder(group: str, code_hash: str) -> Path | None:
                 sys.stderr.write(f"ies: the kernel cache folder {root} cannot be written; using {candidate} (set "
                                  f"{SETTING} to a writable folder)\n")
             _touch(folder / LAST_USED)
+            if stamp is not None and not (folder / KERNEL_STAMP).exists():
+                _seed(folder, group, stamp)
             if new:
                 _prune(candidate, group, name)
             return folder
@@ -144,6 +169,40 @@ def version_folder(group: str, code_hash: str) -> Path | None:
         sys.stderr.write(f"ies: no kernel cache folder can be written ({root}, {_fallback_root()}): the kernels are "
                          f"compiled in every process (set {SETTING} to a writable folder)\n")
     return None
+
+
+def _seed(folder: Path, group: str, stamp: str) -> None:
+    """Give the new version folder `folder` the machine code of the most recently used folder of `group` beside it
+    whose kernels carry `stamp` (hard links, copies across file systems), then mark it with the stamp; numba checks
+    the stamp of every index it loads, so a wrong file is never used, only compiled again."""
+    others = [p for p in folder.parent.glob(f"{group}-*") if p != folder and _VERSION_FOLDER.match(p.name)]
+    for other in sorted(others, key=_last_used, reverse=True):
+        try:
+            if _stamp_of(other) != stamp[:16]:
+                continue
+            for path in other.iterdir():
+                if path.suffix in (".nbi", ".nbc") and not (folder / path.name).exists():
+                    try:
+                        os.link(path, folder / path.name)
+                    except OSError:
+                        shutil.copy2(path, folder / path.name)
+        except OSError:
+            continue  # pruned or cleared meanwhile: compiled as if new
+        break
+    try:
+        (folder / KERNEL_STAMP).write_text(stamp + "\n")
+    except OSError:
+        pass
+
+
+def _stamp_of(folder: Path) -> str:
+    """The first 16 digits of the stamp a version folder's kernels carry: its KERNEL_STAMP file, else the hash in its
+    name (a folder named by its kernels' sources, as every folder was before the simulator's were named by its code
+    version)."""
+    try:
+        return (folder / KERNEL_STAMP).read_text().strip()[:16]
+    except FileNotFoundError:
+        return folder.name.rsplit("-", 1)[-1]
 
 
 @functools.lru_cache(maxsize=None)
@@ -177,12 +236,13 @@ def _cache_class(folder: str, stamp: str) -> type:
     return KernelCache
 
 
-def cache_in_folder(dispatcher, group: str, code_hash: str):
+def cache_in_folder(dispatcher, group: str, code_hash: str, stamp: str | None = None):
     """Give a numba dispatcher (compiled without ``cache=True``) its on-disk cache in `group`'s version folder for
-    `code_hash`; without a writable folder it stays uncached. Returns the dispatcher."""
-    folder = version_folder(group, code_hash)
+    `code_hash`, stamped with `stamp` (the hash of the kernels' sources; default `code_hash`); without a writable
+    folder it stays uncached. Returns the dispatcher."""
+    folder = version_folder(group, code_hash, stamp)
     if folder is not None:
-        dispatcher._cache = _cache_class(str(folder), code_hash)(dispatcher.py_func)
+        dispatcher._cache = _cache_class(str(folder), stamp or code_hash)(dispatcher.py_func)
     return dispatcher
 
 
@@ -233,6 +293,20 @@ def version_folders(root: Path | None = None) -> list[VersionFolder]:
         found.append(VersionFolder(folder, match["group"], sum(path.stat().st_size for path in files), len(files),
                                    _last_used(folder)))
     return sorted(found, key=lambda entry: -entry.last_used)
+
+
+def disk_size(entries: Iterable[VersionFolder]) -> int:
+    """Bytes the version folders `entries` take on disk: a file shared by several (a hard link of `_seed`) once."""
+    seen: dict[tuple[int, int], int] = {}
+    for entry in entries:
+        for path in entry.path.iterdir():
+            try:
+                stat = path.stat()
+            except OSError:
+                continue
+            if path.is_file():
+                seen[(stat.st_dev, stat.st_ino)] = stat.st_size
+    return sum(seen.values())
 
 
 def _remove_version_folder(folder: Path) -> int:

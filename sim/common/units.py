@@ -2,17 +2,20 @@
 
 The uncertain contact parameters of the seed paper (Table 2) are easy to type in the wrong unit: the
 clearance g* = 0.58 mm and the Hertzian spring constant k_H* = 282e3 N/mm^1.5 (Eq. 8) are quoted in mm, while
-the code works in SI units (m, N/m^1.5). `parse_quantity` reads ``0.58e-3``, ``"0.58mm"``, ``"580 um"`` or
-``"282e3 N/mm^1.5"`` and returns SI; `implausible` names a magnitude outside the physically plausible range
-and the value that was probably meant (e.g. ``--g 0.58`` is 0.58 m, probably 0.58 mm). The rows of
+the code works in SI units (m, N/m^1.5). `parse_quantity` reads ``0.58e-3``, ``"0.58mm"``, ``"580 um"``,
+``"282e3 N/mm^1.5"`` or a damping ratio ``"0.085%"`` and returns SI; `implausible` names a magnitude outside the
+physically plausible range and the reading that would make it plausible (``--g 0.58`` is 0.58 m, probably 0.58 mm;
+``--D 0.085`` is 8.5 %, probably 0.085 %). Such a value is refused, not computed with (`sim.model.parameters`,
+`--allow-implausible`): a unit slip computes a different experiment without a word. The rows of
 `sim.model.parameters.PARAMETERS` name their quantity here: the command line, the study files (`uq.problem.space`) and
-`ies design` (`uq.design.problem`) read g, k_H, k_t and R through this module.
+`ies design` (`uq.design.problem`) read D, g, k_H, k_t and R through this module.
 """
 from __future__ import annotations
 
 import math
 import re
 from dataclasses import dataclass
+from decimal import Decimal
 
 from sim.common.errors import SimulationInputError
 
@@ -28,7 +31,7 @@ class Quantity:
     example: str
 
     def format(self, value: float) -> str:
-        """`value` (SI) in the accepted unit that gives the shortest number, e.g. 0.58 mm."""
+        """`value` (SI) in the accepted unit that gives the shortest number, e.g. 0.58 mm (a ratio: in %)."""
         return min((f"{value / factor:.4g} {unit}" for unit, factor in self.units.items()), key=len)
 
 
@@ -45,6 +48,10 @@ MASS = Quantity("sphere mass m_a", "kg", {"kg": 1.0, "g": 1e-3}, (1e-4, 10.0), "
 K_H = Quantity("Hertzian spring constant k_H", "N/m^1.5", {"N/m^1.5": 1.0, "N/mm^1.5": 1e3**1.5}, (1e6, 1e14), "282e3N/mm^1.5")
 #: the tangential stiffness k_t of the floor contact (Appendix C: 22 kN/mm = 2.2e7 N/m); plausible 1e4-1e10 N/m
 K_T = Quantity("tangential stiffness k_t", "N/m", {"N/m": 1.0, "N/mm": 1e3, "kN/mm": 1e6}, (1e4, 1e10), "22kN/mm")
+#: a modal damping ratio (Table 2: D_1 = 0.085 %), a plain ratio or in %; plausible 0.001-5 %: a lightly damped
+#: structure's resonant mode, whose vibration an IES is built to mitigate (above 5 % there is little to mitigate,
+#: and 0.085 typed for 0.085 % is the slip this catches)
+DAMPING = Quantity("damping ratio", "", {"%": 1e-2}, (1e-5, 0.05), "0.085%")
 
 _NUMBER = re.compile(r"^\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(.*?)\s*$")
 
@@ -72,20 +79,31 @@ def parse_quantity(text: str | float, quantity: Quantity) -> float:
     factors = {_unit_key(u): f for u, f in quantity.units.items()}
     if unit not in factors:
         raise SimulationInputError(f"{quantity.name}: unknown unit {match.group(2)!r} in {text!r}; use one of {units}")
-    return number * factors[unit]
+    # in decimal, then rounded once: "0.085%" is the same float as 0.00085, "0.58mm" as 0.58e-3
+    return float(Decimal(match.group(1)) * Decimal(repr(factors[unit])))
 
 
-def implausible(value: float, quantity: Quantity) -> str | None:
-    """None when `value` (SI) lies in the quantity's plausible range; otherwise one sentence saying so and, when
-    the number read in another accepted unit lies in range (0.58 as mm), the value that was probably meant."""
+def implausible(value: float, quantity: Quantity, typed: str | None = None) -> str | None:
+    """None when `value` (SI) lies in the quantity's plausible range; otherwise one sentence saying so and, when the
+    number as typed read in another accepted unit lies in range (0.58 as mm, 0.085 as %), the reading probably meant,
+    e.g. "0.58 m is implausible for a clearance g (above 10 mm); did you mean 0.58mm?". typed: the text the value was
+    read from ("300e3", "0.6m", "8.5%"; None: a bare number, the SI value): its number is kept, its own unit is no
+    other reading (8.5% is no slip for 0.085%)."""
     lo, hi = quantity.plausible
     if not math.isfinite(value) or value <= 0 or lo <= value <= hi:
         return None
     side = f"above {quantity.format(hi)}" if value > hi else f"below {quantity.format(lo)}"
-    message = f"{quantity.name} = {value:.4g} {quantity.si_unit} is implausible ({side})"
+    shown = quantity.format(value) if not quantity.si_unit else f"{value:.4g} {quantity.si_unit}"
+    message = f"{shown} is implausible for a {quantity.name} ({side})"
+    match = _NUMBER.match(typed) if typed is not None else None
+    number, text, own = (float(match.group(1)), match.group(1), _unit_key(match.group(2))) if match else \
+        (value, f"{value:g}", "")
+    readings = {unit: factor for unit, factor in quantity.units.items() if _unit_key(unit) != own}
+    if own:  # a number typed with a unit: read bare (SI) too
+        readings[""] = 1.0
     centre = math.sqrt(lo * hi)
-    meant = [(unit, value * factor) for unit, factor in quantity.units.items() if lo <= value * factor <= hi]
+    meant = [(unit, number * factor) for unit, factor in readings.items() if lo <= number * factor <= hi]
     if meant:
-        unit, si = min(meant, key=lambda m: abs(math.log(m[1] / centre)))
-        message += f"; did you mean {value:g} {unit} = {si:.4g} {quantity.si_unit}? Give the unit: {value:g}{unit}"
+        unit, _ = min(meant, key=lambda m: abs(math.log(m[1] / centre)))
+        message += f"; did you mean {text}{unit}?"
     return message

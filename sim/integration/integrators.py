@@ -15,7 +15,9 @@ version of their sources). The first run of a version of the code on a machine c
 minute (each form of the kernels in a process of its own where there are cores: `compile_in_children`); `warm_up`
 does it before a command's progress bar starts (so that the bar's rate and ETA measure simulation only) and says so
 while it happens, with an estimate of how long: a small test compilation (`compile_probe_s`, about a second)
-measures this machine's speed and present load, and the reference times of COMPILE_S_QUIET scale with it.
+measures this machine's speed, the load average how many other processes share its cores with the compiling ones
+(`compile_estimate_s`), and the reference times of COMPILE_S_QUIET scale with both; the line states the quiet
+machine's figure beside it.
 """
 from __future__ import annotations
 
@@ -44,7 +46,9 @@ class Integrator:
     """One integrator: name (the --integrator value), module (its kernels, with ``run_step``), summary (one line of the
     help); friction: it takes dry friction (Appendix C); dt_scale: it takes a step scale; compile_s_quiet: how long
     compiling its kernels for one law takes with a cold cache on a quiet 2-core machine, s (what `warm_up`'s estimate
-    scales); laws: the contact laws it runs (None: all)."""
+    scales); typical_cost: seconds one simulated second of the rig's stepped sine takes on one quiet core (from its
+    SMR to its APR levels; the cost model measures it where it matters, `sim.stepped_sine.cost`, this sizes a run
+    count refused before anything is measured); laws: the contact laws it runs (None: all)."""
 
     name: str
     module: str
@@ -53,6 +57,7 @@ class Integrator:
     dt_scale: bool = False
     compile_s_quiet: float = 80.0
     laws: tuple[str, ...] | None = None
+    typical_cost: float = 0.02
 
     def run_step(self, *, dt_scale: float | None = None) -> RunStep:
         """Its `run_step`, with ``dt_scale`` bound if given (one line if it takes none)."""
@@ -89,8 +94,9 @@ class Integrator:
 #: "ode3" is the paper's reference; "exact" is the fast free-flight integrator (the default).
 INTEGRATORS: dict[str, Integrator] = {i.name: i for i in (
     Integrator("ode3", "sim.integration.ode3", "the paper's fixed step", friction=True, dt_scale=True,
-               compile_s_quiet=25.0),
-    Integrator("exact", "sim.integration.exact", "closed-form free flight, located contacts", compile_s_quiet=80.0),
+               compile_s_quiet=25.0, typical_cost=0.025),
+    Integrator("exact", "sim.integration.exact", "closed-form free flight, located contacts", compile_s_quiet=80.0,
+               typical_cost=0.006),
 )}
 DEFAULT_INTEGRATOR = "exact"
 
@@ -163,20 +169,36 @@ def compile_probe_s() -> float:
     return time.perf_counter() - started
 
 
-def compile_estimate_s(laws: dict[str, list[str]], *, probe_s: float | None = None, cores: int | None = None) -> float:
+def compile_estimate_s(laws: dict[str, list[str]], *, probe_s: float | None = None, cores: int | None = None,
+                       load: float | None = None) -> float:
     """Estimated seconds to compile the kernels of the integrators `laws` names, each for its list of contact laws,
-    from COMPILE_S_QUIET scaled by this machine's speed against the quiet reference (`compile_probe_s` /
-    PROBE_S_QUIET). With more than one core every (integrator, form) compiles in a process of its own
-    (`compile_in_children`), each taking FORM_SHARE of its integrator's time, in parallel while there are cores."""
-    scale = (compile_probe_s() if probe_s is None else probe_s) / PROBE_S_QUIET
+    from COMPILE_S_QUIET scaled by this machine's speed against the quiet reference. With more than one core every
+    (integrator, form) compiles in a process of its own (`compile_in_children`), each taking FORM_SHARE of its
+    integrator's time, all at once. The machine's other work (`load`, the 1-minute load average; None: now) shares
+    the cores: k processes of ours get cores / (load + k) of a core each, at most one. The test compilation that
+    measures the speed (`compile_probe_s`, `probe_s`) ran as one such process, so its time is the quiet machine's
+    speed times that share's slowdown, which is taken out before the children's own share is put in."""
+    cores = cores or os.cpu_count() or 1
+    others = _load() if load is None else max(0.0, load)
+    share = lambda k: min(1.0, cores / (others + k))  # noqa: E731
+    probe = compile_probe_s() if probe_s is None else probe_s
+    speed = probe / PROBE_S_QUIET * share(1)  # the machine's own speed against the quiet reference
     # an integrator registered after this module was imported (a plug-in) counts as the slowest
     each = [COMPILE_S_QUIET.get(name, max(COMPILE_S_QUIET.values())) * (1.0 + FURTHER_LAW_SHARE * (len(names) - 1))
             for name, names in laws.items()]
-    cores = cores or os.cpu_count() or 1
     if cores == 1:
-        return scale * sum(each)
-    jobs = [share * FORM_SHARE for share in each for _ in FORMS]
-    return scale * max(max(jobs), sum(jobs) / min(cores, len(jobs)))
+        return speed * sum(each) / share(1)
+    jobs = [part * FORM_SHARE for part in each for _ in FORMS]
+    k = len(jobs)
+    return speed * max(max(jobs) / share(1), sum(jobs) / (k * share(k)))
+
+
+def _load() -> float:
+    """The 1-minute load average (0 where the system does not say)."""
+    try:
+        return float(os.getloadavg()[0])
+    except (AttributeError, OSError):
+        return 0.0
 
 
 def cached(name: str) -> bool:
@@ -213,9 +235,10 @@ def _run_tiny_system(run_step: RunStep, *, law: str = "hertz", forms: Iterable[s
             run_step(y, 3, 2.0 * np.pi * 100.0, 1e-5, sys, None, ledger=Ledger())
 
 
-def _notice(what: str, estimate_s: float) -> str:
+def _notice(what: str, estimate_s: float, quiet_s: float, load: float, cores: int) -> str:
     return (f"compiling {what} (once per version of the code on this machine; about {_duration(estimate_s)} here, "
-            "estimated from a test compilation) ...\n")
+            f"estimated from a test compilation at load {load:.1f} on {cores} core(s); {_duration(quiet_s)} on a quiet "
+            "machine) ...\n")
 
 
 def _duration(seconds: float) -> str:
@@ -227,17 +250,21 @@ def _announced(what: str, laws: dict[str, list[str]], cold: bool, stream: TextIO
     """Say that `what` is being compiled and about how long it takes (`compile_estimate_s`): at once when the cache
     lacks the kernels, else once NOTICE_AFTER_S have passed; when done, how long it took. Silent when it is quick (the
     kernels came from the cache)."""
-    def say_so(estimate_s: float) -> None:
-        stream.write(_notice(what, estimate_s))
+    load, cores = _load(), os.cpu_count() or 1
+
+    def say_so(estimate_s: float, quiet_s: float) -> None:
+        stream.write(_notice(what, estimate_s, quiet_s, load, cores))
         stream.flush()
 
     if cold:  # compiled in children where they can hand their kernels over (`warm_up_all`), else here
-        say_so(compile_estimate_s(laws, cores=None if _shared_cache() else 1))
+        used = None if _shared_cache() else 1
+        say_so(compile_estimate_s(laws, cores=used, load=load),
+               compile_estimate_s(laws, probe_s=PROBE_S_QUIET, cores=used, load=0.0))
     # unexpected (e.g. a law compiled for the first time): no test compilation while numba holds its lock; the quiet
-    # reference scaled by the load
-    load = os.getloadavg()[0] / (os.cpu_count() or 1) if hasattr(os, "getloadavg") else 1.0
-    expected = compile_estimate_s(laws, probe_s=PROBE_S_QUIET * max(1.0, load), cores=1)  # here, in this process
-    notice = threading.Timer(NOTICE_AFTER_S, say_so, args=(expected,))
+    # machine's speed, in this process, at the present load
+    quiet = compile_estimate_s(laws, probe_s=PROBE_S_QUIET, cores=1, load=0.0)
+    expected = compile_estimate_s(laws, probe_s=PROBE_S_QUIET / min(1.0, cores / (load + 1.0)), cores=1, load=load)
+    notice = threading.Timer(NOTICE_AFTER_S, say_so, args=(expected, quiet))
     started = time.perf_counter()
     if not cold:
         notice.start()

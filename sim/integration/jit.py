@@ -6,10 +6,12 @@ other files: the period loop of `sim.integration.exact` embeds `sim.integration.
 of a callee file numba would still load the caller's machine code with the old callee compiled in.
 
 `kernel` is ``numba.njit`` with its cache in the workbench's kernel cache (`sim.common.kernel_cache`: a per-user
-folder, never the installed package) under the group ``sim`` and a fingerprint of the sources of all
-KERNEL_MODULES and FINGERPRINT_FILES (SHA-256 of their contents): any edit of any kernel file gives every kernel
-that could embed it a new folder, and the same sources find their machine code again wherever they are installed
-(a reinstall compiles nothing).
+folder, never the installed package) under the group ``sim``, in the folder of the simulator's code version
+(`sim.common.kernel_cache.code_version`, the hash `ies --version` prints), its machine code stamped with a
+fingerprint of the sources of all KERNEL_MODULES and FINGERPRINT_FILES (SHA-256 of their contents): any edit of any
+kernel file compiles every kernel that could embed it afresh, an edit elsewhere in the simulator finds the machine
+code of the same kernel sources again (the new folder starts from it), and so do the same sources wherever they are
+installed (a reinstall compiles nothing).
 
 Why this design and not kernels that never call another file's kernels: the state layout, the free-flight
 transitions and the closing functions are written once (`sim.integration.flight`) and shared by the exact integrator,
@@ -45,7 +47,7 @@ from typing import Callable
 
 import numba
 
-from sim.common.kernel_cache import cache_in_folder, sources_hash, version_folder
+from sim.common.kernel_cache import cache_in_folder, code_version, sources_hash, version_folder
 
 #: Modules of `sim` (file stems) whose numba kernels are compiled with `kernel`; they may embed each other.
 KERNEL_MODULES = ("jit", "flight", "dopri5", "collocation", "exact", "ode3")
@@ -67,9 +69,16 @@ def fingerprint() -> str:
     return sources_hash([*(_SOURCE_DIR / f"{stem}.py" for stem in KERNEL_MODULES), *FINGERPRINT_FILES])
 
 
+@functools.lru_cache(maxsize=None)
+def simulator_version() -> str:
+    """The simulator's code version when its kernels were first decorated in this process (the folder they live in)."""
+    return code_version()
+
+
 def cache_folder() -> Path | None:
-    """The folder of these sources' kernels in the kernel cache (None where no folder can be written)."""
-    return version_folder(CACHE_GROUP, fingerprint())
+    """The folder of the simulator's kernels in the kernel cache: its code version's, the machine code stamped with the
+    kernels' fingerprint (None where no folder can be written)."""
+    return version_folder(CACHE_GROUP, simulator_version(), fingerprint())
 
 
 def nrt_option_supported() -> bool:
@@ -101,6 +110,6 @@ def kernel(function: Callable | None = None, *, refcounts: bool | None = None, *
             sys.stderr.write(NRT_FALLBACK_NOTICE.format(version=numba.__version__))
 
     def decorate(py_function: Callable) -> Callable:
-        return cache_in_folder(numba.njit(**options)(py_function), CACHE_GROUP, fingerprint())
+        return cache_in_folder(numba.njit(**options)(py_function), CACHE_GROUP, simulator_version(), fingerprint())
 
     return decorate if function is None else decorate(function)

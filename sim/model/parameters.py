@@ -21,12 +21,11 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 from dataclasses import dataclass, fields, replace
 from typing import Any, Callable, Mapping
 
 from sim.common.errors import SimulationInputError
-from sim.common.units import CLEARANCE, K_H, K_T, Quantity, implausible, parse_quantity
+from sim.common.units import CLEARANCE, DAMPING, K_H, K_T, Quantity, implausible, parse_quantity
 
 # ---- the sphere and its cavity (Table 1, Sects. 2 and 4.1) ------------------------------------------------------
 SPHERE_MASS = 0.0177  # kg, Table 1
@@ -201,7 +200,8 @@ class CliOption:
 
     flag: the option; aliases: other names users already type for it (`--clearance` for `--g`), said in the help;
     parse: a value type of its own (None: the row's, `UncertainParameter.option_value`: a number, with a unit when
-    the row has a `quantity`, checked against the row's bounds, warned about when implausible)."""
+    the row has a `quantity`, checked against the row's bounds; an implausible magnitude is refused by the command,
+    `check_plausible`, unless --allow-implausible)."""
 
     flag: str
     metavar: str
@@ -305,19 +305,15 @@ class UncertainParameter:
     def implausible(self, value: float) -> str | None:
         """One sentence when `value` lies outside the quantity's plausible range (`sim.common.units.implausible`),
         else None (also for a row without a quantity)."""
-        return None if self.quantity is None else implausible(float(value), self.quantity)
+        return None if self.quantity is None else implausible(float(value), self.quantity, getattr(value, "text", None))
 
-    def option_value(self, text: str) -> float:
-        """argparse type of the row's option: `parse`, `check` (one line ``argument --X: ...`` otherwise), and a
-        warning line on stderr for an implausible magnitude."""
+    def option_value(self, text: str) -> "Typed":
+        """argparse type of the row's option: `parse` and `check` (one line ``argument --X: ...`` otherwise); the
+        value keeps the text typed, for the line of `check_plausible`."""
         try:
-            value = self.check(self.parse(text))
+            return Typed(self.check(self.parse(text)), text)
         except SimulationInputError as exc:
             raise argparse.ArgumentTypeError(str(exc)) from None
-        warning = self.implausible(value)
-        if warning:
-            sys.stderr.write(f"warning: {warning}\n")
-        return value
 
     def feed(self, settings: SystemSettings, value: float) -> SystemSettings:
         """The settings with this row's value fed in (`Feed.apply`)."""
@@ -331,6 +327,43 @@ class UncertainParameter:
         return dict(settings.inputs).get(self.name)
 
 
+class Typed(float):
+    """A number read from the command line (SI) that keeps the text it was read from (`text`), for messages."""
+
+    text: str
+
+    def __new__(cls, value: float, text: str) -> "Typed":
+        number = super().__new__(cls, value)
+        number.text = str(text)
+        return number
+
+
+#: the option that runs a value whose magnitude is implausible (`check_plausible`)
+ALLOW_IMPLAUSIBLE = "--allow-implausible"
+
+
+def check_plausible(values: Mapping[str, float | None], *, allow: bool = False,
+                    where: Callable[[UncertainParameter, float], str] | None = None) -> None:
+    """Refuse (SimulationInputError, one line) the first value of a row of `PARAMETERS` whose magnitude is implausible
+    for its quantity (`UncertainParameter.implausible`: a unit slip, ``--g 0.6`` for 0.6 mm, ``--D 0.085`` for
+    0.085 %), naming the reading that would make it plausible, unless `allow` (--allow-implausible). `where(row,
+    value)` names the value in the line (default: the row's option and the text typed, "--g 0.6")."""
+    if allow:
+        return
+    for name, value in values.items():
+        row = PARAMETERS.get(name)
+        if row is None or value is None or (why := row.implausible(value)) is None:
+            continue
+        if where is not None:
+            place = where(row, value)
+        else:
+            place = f"{row.option.flag if row.option else row.name} {getattr(value, 'text', f'{value:g}')}"
+        allow = f"pass {ALLOW_IMPLAUSIBLE} to compute with it as given"
+        if why.endswith("?"):  # a reading that is plausible: the number typed without its unit
+            raise SimulationInputError(f"{place}: {why} Give the unit, or {allow}")
+        raise SimulationInputError(f"{place}: {why}; {allow}")
+
+
 def _table2(name: str, unit: str, label: str, nominal: float, spread: Spread, feeds: Feed, **kwargs: Any) -> UncertainParameter:
     """A row of Table 2: its interval is its spread around the nominal value (bit for bit the paper's numbers)."""
     return UncertainParameter(name, unit, label, nominal, spread.ends(nominal), feeds, name, table2=True, spread=spread,
@@ -340,8 +373,9 @@ def _table2(name: str, unit: str, label: str, nominal: float, spread: Spread, fe
 #: every parameter of the simulator, in the order of Table 2 and then the optional ones
 PARAMETERS: dict[str, UncertainParameter] = {p.name: p for p in (
     _table2("D", "-", "modal damping ratio D_1", D1_NOMINAL, Spread("absolute", *D1_INTERVAL), Feed("D1"),
-            upper_limit=1.0, hint="a damping ratio, e.g. 0.00085", json_key="D1",
-            option=CliOption("--D", "D1", f"modal damping ratio of mode 1 (-), default the model's ({D1_NOMINAL:g})")),
+            upper_limit=1.0, hint="a damping ratio, e.g. 0.00085 or 0.085%", json_key="D1", quantity=DAMPING,
+            option=CliOption("--D", "D1", f"modal damping ratio of mode 1 (-), or in %%: 0.085%% (default the model's, "
+                                          f"{D1_NOMINAL:g}); above 5 %% it needs {ALLOW_IMPLAUSIBLE}")),
     _table2("g", "m", "clearance g", CLEARANCE_NOMINAL, Spread("offset", 0.0, CLEARANCE_WIDENING), Feed("clearance"),
             quantity=CLEARANCE, what="clearance g",
             option=CliOption("--g", "G", "clearance g in m, or with a unit: 0.58mm, 580um (default 0.58 mm)",

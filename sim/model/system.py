@@ -232,8 +232,28 @@ def a_noabs_star(model: ModalModel, a_base: float, nominal: Nominal | None = Non
 def a_base_star(model: ModalModel, nominal: Nominal | None = None) -> float:
     """Base amplitude reaching the clearance at the contact (Sect. 5.3): 2 D* g* / (phi_c phi^T M b), in m; D* the
     host's nominal damping and g* the paper's (`Nominal.of`) unless `nominal` is given."""
+    check_resonant_mode(model)
     nominal = Nominal.of(model) if nominal is None else nominal
     return 2.0 * nominal.D1 * nominal.clearance / abs(model.phi_contact * model.participation[0])
+
+
+def check_resonant_mode(model: ModalModel) -> None:
+    """One line (SimulationInputError) when `model` cannot host an IES for its mode 1, the resonance it mitigates
+    (Sect. 5): its cavity walls do not move in that mode (phi_c = 0: the IES sits at a node, the sphere is never struck
+    by the mode and cannot scatter its energy), or the base does not excite it (phi^T M b = 0: there is no resonance
+    to mitigate); a_base* would be infinite either way."""
+    scale = max(float(np.max(np.abs(model.phi_wall_left))), float(np.max(np.abs(model.phi_wall_right))),
+                float(np.max(np.abs(model.phi_tip))), 1e-300)
+    if abs(model.phi_contact) <= 1e-9 * scale:
+        raise SimulationInputError(
+            f"the cavity walls do not move in mode 1 ({model.frequencies_hz[0]:.4g} Hz: phi_wall_left "
+            f"{model.phi_wall_left[0]:g}, phi_wall_right {model.phi_wall_right[0]:g}): the IES sits at a node of the "
+            "resonance it is to mitigate, its sphere is never struck by it and scatters nothing; give the wall values "
+            "of a cavity where mode 1 moves (and check the order and signs of the modes)")
+    if model.participation[0] == 0.0:
+        raise SimulationInputError(
+            f"the base does not excite mode 1 ({model.frequencies_hz[0]:.4g} Hz: participation 0): there is no "
+            "resonance for the IES to mitigate; check the participation factors phi^T M b of the modes")
 
 
 def check_open_unit(value: float, name: str) -> float:

@@ -42,16 +42,19 @@ from sim.common.figure_style import (  # noqa: F401 (re-exported for the figures
 )
 from sim.plots.redraw import PlotOptions, register, selected
 
-#: the shading of a regime on the level plots (Sect. 5.1, `sim.stepped_sine.measures.classify_regime`); SMR levels stay white
+#: the shading of a regime on the level plots (Sect. 5.1, `sim.stepped_sine.measures.classify_regime`); SMR levels stay
+#: white; "mixed": a band's points in both regimes at a level (`uq.outputs.figures`)
 REGIME_SHADING = {"APR": {"facecolor": "0.9", "label": "APR levels (almost periodic response); white: SMR"},
+                  "mixed": {"facecolor": "0.965", "label": "mixed levels: APR and SMR points"},
                   "linear": {"facecolor": "none", "edgecolor": "0.6", "hatch": "..",
                              "label": "linear levels (no impacts)"}}
 
 
-def shade_regimes(ax: Any, levels: Sequence[float], regimes: Sequence[str]) -> dict[str, list[tuple[float, float]]]:
-    """Shade the excitation levels of each regime (REGIME_SHADING) behind the data of a level plot: a level's
-    span reaches half way to its neighbours (half the nearest spacing beyond the first and last level). Returns the
-    spans (from, to) of each regime, shaded or not."""
+def shade_regimes(ax: Any, levels: Sequence[float], regimes: Sequence[str],
+                  labels: Mapping[str, str] | None = None) -> dict[str, list[tuple[float, float]]]:
+    """Shade the excitation levels of each regime (REGIME_SHADING; `labels` replaces its legend entries, e.g. to say
+    whose regime it is) behind the data of a level plot: a level's span reaches half way to its neighbours (half the
+    nearest spacing beyond the first and last level). Returns the spans (from, to) of each regime, shaded or not."""
     import numpy as np
 
     spans: dict[str, list[tuple[float, float]]] = {}
@@ -72,7 +75,8 @@ def shade_regimes(ax: Any, levels: Sequence[float], regimes: Sequence[str]) -> d
         style = REGIME_SHADING.get(kinds[i])
         if style is not None:
             style = dict(style)
-            label = style.pop("label")
+            label = (labels or {}).get(kinds[i], style.pop("label"))
+            style.pop("label", None)
             ax.axvspan(edges[i], edges[j + 1], lw=0, zorder=0, label=None if kinds[i] in labelled else label,
                        gid=f"regime:{kinds[i]}", **style)
             labelled.add(kinds[i])
@@ -103,16 +107,18 @@ def secondary_mm(ax: Any, a_noabs: float, label: str = "tip amplitude (mm)") -> 
     return axis
 
 
-def draw_sweep(ax: Any, data: Mapping[str, Any], title: str) -> None:
-    """Fig. 5 on `ax`: mean (solid) and max (dashed) amplitude a/a_noabs* vs eta, each with the range of its
-    repetition samples as a band (the spread of the paper's figure); with the data's a_noabs (m, a_noabs* at
-    this level, Sect. 5), a right-hand axis gives the tip amplitude in mm."""
+def draw_sweep(ax: Any, data: Mapping[str, Any], title: str, *, right_mm: bool = True) -> None:
+    """Fig. 5 on `ax`: mean (solid, circles) and max (dashed, squares) amplitude a/a_noabs* at each frequency point of
+    the stepped sine (a marker each: between two points nothing is known, a jump is not a slope), each with the range
+    of its repetition samples as a translucent band (the spread of the paper's figure; neither band hides the other
+    where they overlap); with `right_mm` and the data's a_noabs (m, a_noabs* at this level, Sect. 5), a right-hand
+    axis gives the tip amplitude in mm."""
     eta = data["eta"]
     ax.fill_between(eta, data["max_lo"], data["max_hi"], color="C3", alpha=0.2, lw=0, label="max: range of the runs")
-    ax.plot(eta, data["max"], "--", color="C3", label="max")
-    ax.fill_between(eta, data["mean_lo"], data["mean_hi"], color="C0", alpha=0.3, lw=0, hatch="////",
+    ax.fill_between(eta, data["mean_lo"], data["mean_hi"], color="C0", alpha=0.25, lw=0,
                     label="mean: range of the runs")
-    ax.plot(eta, data["mean"], "-", color="C0", label="mean")
+    ax.plot(eta, data["max"], "s--", color="C3", ms=2.5, lw=1.0, label="max")
+    ax.plot(eta, data["mean"], "o-", color="C0", ms=2.5, lw=1.0, label="mean")
     if data.get("dynamics"):  # ies sweep --lyapunov: periodic / quasi-periodic / chaotic on the mean
         from sim.plots.dynamics import draw_dynamics
 
@@ -122,7 +128,7 @@ def draw_sweep(ax: Any, data: Mapping[str, Any], title: str) -> None:
     ax.set_title(title, fontsize=9)
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
-    if data.get("a_noabs"):
+    if right_mm and data.get("a_noabs"):
         secondary_mm(ax, data["a_noabs"])
 
 
@@ -135,7 +141,9 @@ def plot_sweep(data: Mapping[str, Any], path: str | os.PathLike, title: str) -> 
 
 def plot_sweeps(panels: Sequence[tuple[Mapping[str, Any], str]], path: str | os.PathLike, title: str) -> None:
     """Fig. 5: one panel per (frequency response, panel title), two columns on one y scale (the panels are
-    compared), one legend below them, written to `path`."""
+    compared), one legend below them, written to `path`. The tip amplitude in mm is said once, as Eq. B.1's factor
+    (`tip_note`), not as a right-hand scale per panel: a_noabs* grows with the level, so one left scale would carry a
+    different mm scale in every panel."""
     from sim.common.files import pyplot
 
     plt = pyplot()
@@ -145,7 +153,7 @@ def plot_sweeps(panels: Sequence[tuple[Mapping[str, Any], str]], path: str | os.
                              layout="constrained")
     try:
         for ax, (data, panel_title) in zip(axes.flat, panels):
-            draw_sweep(ax, data, panel_title)
+            draw_sweep(ax, data, panel_title, right_mm=False)
         for ax in axes.flat[len(panels):]:
             ax.set_visible(False)
         # one y range for all panels, from 0 to the highest band edge of any of them
@@ -153,7 +161,12 @@ def plot_sweeps(panels: Sequence[tuple[Mapping[str, Any], str]], path: str | os.
         for ax in axes[:, 1:].flat:
             ax.set_ylabel("")  # the shared scale is labelled once, on the left
         handles, labels = axes.flat[0].get_legend_handles_labels()
-        fig.legend(handles, labels, loc="outside lower center", ncols=4, fontsize=LEGEND_PT, frameon=False)
+        first = panels[0][0]
+        level = first.get("level")
+        level = level[0] if isinstance(level, (list, tuple)) and level else level  # a sweeps.csv column or a number
+        factor = 1e3 * first["a_noabs"] / level if first.get("a_noabs") and level else None
+        fig.legend(handles, labels, loc="outside lower center", ncols=4, fontsize=LEGEND_PT, frameon=False,
+                   title=tip_note(factor), title_fontsize=LEGEND_PT)
         fig.suptitle(title, fontsize=10)
         save_figure(fig, path)
     finally:
@@ -165,42 +178,42 @@ def _reduction(value: float) -> str:
     return f"{1 / value:.0f}-fold" if value > 0 else "-"
 
 
+#: what the legend of a level plot says about the mean and max drawn apart at each level
+SIDE_BY_SIDE = "max (left) and mean (right) drawn side by side at each level"
+
+
 def draw_overview(ax: Any, data: Mapping[str, Any], title: str, *, paper_optimum: bool = False) -> None:
     """Fig. 6 on `ax`: the resonant mean (solid) and max (dashed) level vs the excitation level, each with the
-    range of its repetition samples at the resonant eta as error bars, the regime of each level (APR, SMR,
-    linear: `sim.stepped_sine.measures.classify_regime` through the aggregation) shaded behind the data, this model's optimum
-    (the lowest resonant mean) and, with `paper_optimum`, the paper's landmarks: the optimum (a_base/a_base* ~ 6.7
-    with its mean and max levels, Sect. 5.3) and the almost periodic level at 7.4 (Appendix B)."""
+    range of its repetition samples at the resonant eta as error bars, drawn side by side at each level (SIDE_BY_SIDE:
+    the bars of an SMR level overlap), the regime of each level (APR, SMR, linear:
+    `sim.stepped_sine.measures.classify_regime` through the aggregation) shaded behind the data, this model's optimum
+    (the lowest resonant mean) ringed on its two points and, with `paper_optimum`, the paper's landmarks: its optimum
+    (a_base/a_base* ~ 6.7, its mean and max levels as stars, Sect. 5.3) and the almost periodic level at 7.4
+    (Appendix B)."""
     import numpy as np
 
     levels = np.asarray(data["levels"], dtype=float)
     shade_regimes(ax, levels, data["regime"])
     tops = []
     step = float(np.min(np.diff(np.unique(levels)))) if np.unique(levels).size > 1 else 1.0
+    at = {}
     for side, (name, style, color) in zip((-1, 1), (("max", "s--", "C3"), ("mean", "o-", "C0"))):
         value = np.asarray(data[f"resonant_{name}"], dtype=float)
         spread = [value - np.asarray(data[f"resonant_{name}_lo"], dtype=float),
                   np.asarray(data[f"resonant_{name}_hi"], dtype=float) - value]
-        # max and mean a little apart (an eighth of the closest levels' spacing): the bars of an SMR level overlap
-        ax.errorbar(levels + side * step / 8, value, yerr=spread, fmt=style, color=color, ms=4, capsize=2, lw=1.2,
+        at[name] = (levels + side * step / 8, value)
+        ax.errorbar(at[name][0], value, yerr=spread, fmt=style, color=color, ms=4, capsize=2, lw=1.2,
                     label=f"resonant {name} (bars: range of the runs)")
         tops.append(np.fmax(value, np.asarray(data[f"resonant_{name}_hi"], dtype=float)))
-    top_of_data = np.nanmax(tops, axis=0)
-    y_top = 1.3 * max([float(np.nanmax(top_of_data)),
+    y_top = 1.3 * max([float(np.nanmax(np.nanmax(tops, axis=0))),
                        *((PAPER_APR_LEVEL[1], 1 / PAPER_REDUCTION_MAX) if paper_optimum else ())])
-
-    def marker_line(x: float, **style: Any) -> None:
-        """A vertical line at level x from above the data there (never through its error bars) to the top."""
-        near = np.abs(levels - x) < 0.5 * step
-        start = 1.08 * float(np.nanmax(top_of_data[near])) if near.any() else 0.0
-        ax.plot([x, x], [start, y_top], **style)
-
     best = int(np.argmin(data["resonant_mean"]))
-    marker_line(levels[best], color="C2", lw=1.2, ls=":",
-                label=f"optimum of this model at {levels[best]:g}: mean reduced "
-                      f"{_reduction(data['resonant_mean'][best])}, max {_reduction(data['resonant_max'][best])}")
+    ax.plot([at["max"][0][best], at["mean"][0][best]], [at["max"][1][best], at["mean"][1][best]], "o", ms=12,
+            mfc="none", mec="C2", mew=1.5, ls="none", zorder=5,
+            label=f"optimum of this model at {levels[best]:g} (rings): mean reduced "
+                  f"{_reduction(data['resonant_mean'][best])}, max {_reduction(data['resonant_max'][best])}")
     if paper_optimum:
-        draw_paper_landmarks(ax, marker_line)
+        draw_paper_landmarks(ax)
     ax.set_ylim(0, y_top)
     ax.set_xlabel(LEVEL_LABEL)
     ax.set_ylabel(f"resonant level {RESPONSE_LABEL}")
@@ -209,17 +222,18 @@ def draw_overview(ax: Any, data: Mapping[str, Any], title: str, *, paper_optimum
 
 
 def draw_paper_landmarks(ax: Any, vertical_line: Any = None) -> None:
-    """The paper's Fig. 6 landmarks on `ax`: its optimum (a_base/a_base* ~ 6.7, a vertical line, with its mean and
-    max levels as stars, Sect. 5.3) and its almost periodic level at 7.4 (a grey box, Appendix B). vertical_line(x,
-    **style): how to draw the optimum's line (default: across the axes)."""
+    """The paper's Fig. 6 landmarks on `ax`: its optimum (a_base/a_base* ~ 6.7, its mean and max levels as stars,
+    Sect. 5.3) and its almost periodic level at 7.4 (a grey box, Appendix B). vertical_line(x, **style): a line also
+    marking the optimum's level where a plot wants one (`plot_series`; default none: the stars mark it)."""
     from matplotlib.patches import Rectangle
 
-    (vertical_line or ax.axvline)(PAPER_OPTIMUM_LEVEL, color="k", lw=1, ls="-.", alpha=0.6,
-                                  label=f"paper's optimum at {PAPER_OPTIMUM_LEVEL:g} (stars): mean reduced "
-                                        f"{PAPER_REDUCTION_MEAN:g}-fold, max {PAPER_REDUCTION_MAX:g}-fold")
-    ax.plot([PAPER_OPTIMUM_LEVEL] * 2, [1 / PAPER_REDUCTION_MEAN, 1 / PAPER_REDUCTION_MAX], "k*", ms=8)
+    if vertical_line is not None:
+        vertical_line(PAPER_OPTIMUM_LEVEL, color="k", lw=1, ls="-.", alpha=0.6)
+    ax.plot([PAPER_OPTIMUM_LEVEL] * 2, [1 / PAPER_REDUCTION_MEAN, 1 / PAPER_REDUCTION_MAX], "k*", ms=8, ls="none",
+            label=f"paper's optimum at {PAPER_OPTIMUM_LEVEL:g} (stars, its mean and max): mean reduced "
+                  f"{PAPER_REDUCTION_MEAN:g}-fold, max {PAPER_REDUCTION_MAX:g}-fold")
     ax.add_patch(Rectangle((7.2, PAPER_APR_LEVEL[0]), 0.4, PAPER_APR_LEVEL[1] - PAPER_APR_LEVEL[0],
-                           facecolor="0.6", alpha=0.5, hatch="////",
+                           facecolor="0.55", edgecolor="0.3", alpha=0.6, lw=0.8,
                            label=f"paper's almost periodic level at 7.4 ({PAPER_APR_LEVEL[0]:g}-"
                                  f"{PAPER_APR_LEVEL[1]:g}, App. B)"))
 
@@ -233,7 +247,7 @@ def plot_overview(data: Mapping[str, Any], path: str | os.PathLike, title: str, 
         mm_per_level = 1e3 * sweeps[0]["a_noabs"] / sweeps[0]["level"]  # a_noabs* grows with a_base (Sect. 5)
     with plot_to(path, figsize=(9.5, 4.4)) as (fig, ax):
         draw_overview(ax, data, title, paper_optimum=paper_optimum)
-        legend_beside(ax, title=tip_note(mm_per_level))
+        legend_beside(ax, title="\n".join(t for t in (SIDE_BY_SIDE, tip_note(mm_per_level)) if t))
 
 
 def plot_series(series: Sequence[tuple[str, Mapping[str, Any]]], path: str | os.PathLike, title: str,
@@ -274,7 +288,7 @@ def plot_series(series: Sequence[tuple[str, Mapping[str, Any]]], path: str | os.
         if paper_line is not None:
             above_the_data(paper_line[0], color="k", lw=1, ls="-.", alpha=0.6, label=paper_line[1])
         if paper_landmarks:
-            draw_paper_landmarks(ax, above_the_data)
+            draw_paper_landmarks(ax)
         ax.set_ylim(0, y_top)
         ax.set_xlabel(LEVEL_LABEL)
         ax.set_ylabel(f"resonant mean {RESPONSE_LABEL}")

@@ -553,21 +553,18 @@ def sweep(model: ModalModel, impactor: Impactor | None, level: float, protocol: 
     """`reps` runs (rep = 0 .. reps-1) of `run_sweep`, aggregated (Sects. 5.1, 5.2); lyapunov: with each hold's
     largest Lyapunov exponent and dynamics.
 
-    progress: show a tqdm bar on stderr (None: only if stderr is a terminal and the sweep is long), or a
-    callable called after every point (the caller's own progress bar).
+    progress: report the progress on stderr (`sim.common.progress`: a bar on a terminal, plain lines in a log; None:
+    only if the sweep is long), or a callable called after every point (the caller's own report).
     """
-    import sys as _sys
-
-    from tqdm import tqdm
+    from sim.common.progress import progress as report
 
     if int(reps) != reps or reps < 1:
         raise SimulationInputError(f"reps must be a positive integer, got {reps!r}")
     total = int(reps) * len(protocol.legs) * int(protocol.n_eta)
     if progress is None:
-        progress = _sys.stderr.isatty() and total * (protocol.wait + protocol.hold) > 60.0
+        progress = total * (protocol.wait + protocol.hold) > 60.0
     started = time.perf_counter()
-    with tqdm(total=total, disable=callable(progress) or not progress, unit="pt", desc=f"sweep {level:g}",
-              leave=False) as bar:
+    with report(total, f"sweep {level:g}", "pt", enabled=not callable(progress) and bool(progress), leave=False) as bar:
         runs = [run_sweep(model, impactor, level, protocol, seed=seed, rep=rep, nominal=nominal,
                           progress=progress if callable(progress) else bar.update, lyapunov=lyapunov)
                 for rep in range(int(reps))]

@@ -45,7 +45,11 @@ def compare_command(args: argparse.Namespace) -> int:
             raise SimulationInputError(f"{folder} is given twice (also as {seen[folder.resolve()]}); give each study's "
                                        "folder once")
         seen[folder.resolve()] = folder
+    from uq.outputs.netcdf import check_readable
+
     studies = [read_response_folder(folder) for folder in args.folders]
+    for folder in args.folders:
+        check_readable(folder)  # a damaged results.nc is named: the tables beside it came from the same run
     rows = [compare_row(study) for study in studies]
     context = style(args.style)
     if args.out.exists() and not args.out.is_dir():

@@ -89,10 +89,15 @@ def design_command(args: argparse.Namespace) -> int:
     from uq.design.results import design_table
     from uq.design.search import run_design
 
+    from uq.engine.runner import release_output
+
     problem, out, cluster = design_problem(args)
-    with engine(args, cluster) as client:
-        result = run_design(problem, out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
-                            progress=not args.quiet, figures=not args.no_figures, client=client)
+    try:
+        with engine(args, cluster) as client:
+            result = run_design(problem, out, jobs=args.jobs, scheduler=args.scheduler, resume=args.resume,
+                                progress=not args.quiet, figures=not args.no_figures, client=client)
+    finally:
+        release_output(out)  # the folder's lock, taken when the design's runs began (uq.engine.runner.prepare_output)
     print(design_table(result))
     print_files(result.folder, result.files)
     if result.refusal is not None:

@@ -31,7 +31,10 @@ def plot_command(args: argparse.Namespace) -> int:
     from sim.common.files import report_written
     from sim.plots.redraw import PlotOptions, kind_of, redraw, style
 
+    from uq.outputs.netcdf import check_readable
+
     kind_of(args.folder)  # what it is and whether the style exists, before any folder is made
+    check_readable(args.folder)  # a damaged results.nc is named, not drawn around
     style(args.style)
     if args.out is not None:
         if args.out.exists() and not args.out.is_dir():

@@ -3,10 +3,11 @@ as k_H's upper bound (Sect. 4.1)."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 from sim.common.options import positive_int
 from uq.commands.study import JOBS_HELP, engine
@@ -46,6 +47,9 @@ def add_reproduce_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--integrator", metavar="NAME",
                         help="override the study files' integrator (ode3 = the paper's scheme, exact = free flight)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--allow-large", action="store_true",
+                        help="run when the cost estimate of the figures (measured here before the first run) exceeds "
+                             "an hour (refused by default; the paper's protocol takes longer than --quick)")
 
 
 def study_file(figure: str, quick: bool) -> Path:
@@ -92,14 +96,72 @@ def reproduce_command(args: argparse.Namespace, *, calibrate: Calibrate) -> int:
     calibration = None
     if args.calibration is not None:  # a bad file fails here too
         calibration = {"k_H": calibrated_k_H(args.calibration), "source": str(args.calibration)}
-    with engine(args, None) as batch, dask_client(args.scheduler, batch) as client:
+    with engine(args, None) as batch, dask_client(args.scheduler, batch) as client, _made(args.out):
         # connected (or the batch cluster started) once, first: a bad address leaves nothing behind
         check_writable(args.out)
+        from sim.common.folder_lock import locked
         from sim.integration.integrators import warm_up_all
 
-        # every kernel any study's workers will call, compiled here once, before the first bar
-        warm_up_all(pair for model in models if hasattr(model, "kernel_variants") for pair in model.kernel_variants())
-        return _reproduce(args, figures, studies, client, calibrate, calibration)
+        with locked(args.out):  # one reproduction per --out: its calibration, summary and index beside the figures
+            # every kernel any study's workers will call, compiled here once, before the first bar
+            warm_up_all(pair for model in models if hasattr(model, "kernel_variants") for pair in model.kernel_variants())
+            check_cost(args, figures, studies, calibration, client)
+            return _reproduce(args, figures, studies, client, calibrate, calibration)
+
+
+@contextlib.contextmanager
+def _made(folder: Path) -> Iterator[None]:
+    """Remove `folder` again when it is made here and the command ends before anything is written into it (refused
+    by the cost estimate, say)."""
+    made = not folder.exists()
+    try:
+        yield
+    except BaseException:
+        if made and folder.is_dir() and not any(folder.iterdir()):
+            folder.rmdir()
+        raise
+
+
+def check_cost(args: argparse.Namespace, figures: tuple[str, ...], studies: list, calibration: dict | None,
+               client: Any) -> None:
+    """The cost of every figure's runs together, estimated before the first (`sim.stepped_sine.cost`: a probe of each
+    study's protocol here): one line, refused above an hour unless --allow-large. With --resume only the runs not
+    stored count (an interval study's k_H bound from the calibration given or kept in OUT/calibration.json)."""
+    from collections import Counter
+
+    from sim.stepped_sine.cost import check_estimate, estimate
+    from uq.engine.runner import pending_tasks, workers_for
+    from uq.problem.space import calibrated_k_H
+    from uq.problem.study import with_calibration
+    from uq.problem.tasks import Task
+
+    kept = args.out / "calibration.json"
+    if calibration is None and args.resume and kept.is_file() and not args.no_calibration:
+        calibration = {"k_H": calibrated_k_H(kept)}
+    runs_at: Counter = Counter()
+    per_run: dict = {}
+    for figure, study in zip(figures, studies):
+        if calibration is not None and study.kind == "interval" and "k_H" in [p.name for p in study.space.varied]:
+            study = with_calibration(study, calibrated_k_H(calibration))
+        model = study.make_model()
+        if not hasattr(model, "seconds_per_run") or study.method.substudies(study):
+            continue  # the series (Figs. 11, C.1, not in `all`) say their own estimate as each part starts
+        model = model.with_rig()
+        tasks = [Task.make(p, level, rep) for p in study.method.plan(study).points for level in study.levels
+                 for rep in range(study.repetitions)]
+        if args.resume:
+            tasks = pending_tasks(model, tasks, study.seed, args.out / figure)
+        levels = Counter(task.level for task in tasks)
+        seconds = model.seconds_per_run(list(levels), len(tasks)) if tasks else None
+        if seconds is None:
+            continue
+        runs_at.update({(figure, level): n for level, n in levels.items()})
+        per_run.update({(figure, level): seconds[level] for level in levels})
+    if runs_at:
+        serial = estimate(runs_at, per_run).serial_s
+        check_estimate(estimate(runs_at, per_run, workers=workers_for(args.jobs, serial, client)),
+                       "run --quick (minutes), one figure at a time, or on a cluster (--cluster)",
+                       allow_large=args.allow_large)
 
 
 def _reproduce(args: argparse.Namespace, figures: tuple[str, ...], studies: list, client: Any,
@@ -144,7 +206,8 @@ def _reproduce_figure(args: argparse.Namespace, figure: str, study: Any, client:
         calibrated = True
     folder = out / figure
     print(f"{figure}: {study.source} -> {folder}/")
-    result = run_study(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet)
+    result = run_study(study, out=folder, jobs=args.jobs, client=client, resume=args.resume, progress=not args.quiet,
+                       allow_large=args.allow_large, paper_figure=figure)
     paths = study.method.figures(result.folder)
     if row.traced:
         from uq.methods.response import series_traces

@@ -55,6 +55,9 @@ def add_study_arguments(kind: str) -> Callable[[argparse.ArgumentParser], None]:
             parser.add_argument("--method", choices=[m.name for m in methods],
                                 help="; ".join(f"{m.name}: {m.help}" for m in methods) + f" (default: [{kind}] method, "
                                      f"else {methods[0].name})")
+        parser.add_argument("--allow-implausible", action="store_true",
+                            help="compute with values of implausible magnitude in the study file (a clearance of "
+                                 "0.612 m, a damping ratio of 9 %%), refused by default as unit slips")
         add_run_arguments(parser)
 
     return add
@@ -68,7 +71,7 @@ def study_command(kind: str) -> Callable[[argparse.Namespace], int]:
         from uq.methods import METHODS, kinds
         from uq.problem.study import with_settings
 
-        study = _load_study(args.study, kind)
+        study = _load_study(args.study, kind, allow_implausible=args.allow_implausible)
         given = {s.key: getattr(args, s.key, None) for m in kinds()[kind] for s in m.settings if s.option}
         given["method"] = getattr(args, "method", None)
         study = with_settings(study, METHODS, given)
@@ -96,11 +99,11 @@ def engine(args: argparse.Namespace, table: Any) -> Iterator[Any]:
         yield client
 
 
-def _load_study(path: Path, kind: str) -> Any:
+def _load_study(path: Path, kind: str, *, allow_implausible: bool = False) -> Any:
     """The study file, refused (one line) when it is of another kind."""
     from uq.methods import load_study
 
-    study = load_study(path)
+    study = load_study(path, allow_implausible=allow_implausible)
     if study.kind != kind:
         raise StudyError(f"{path} is a '{study.kind}' study; run it with `ies {study.kind}`")
     return study

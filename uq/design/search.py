@@ -90,6 +90,20 @@ def first_runs(problem: DesignProblem) -> tuple[int, int]:
     return designs * per_design, spheres * references
 
 
+def check_first_runs_cost(problem: DesignProblem, model: Any, out: Any, runs: int, *, jobs: int | None,
+                          client: Any, quiet: bool) -> None:
+    """The cost model's estimate (`uq.engine.runner.check_cost`) of the first `runs` runs (those not yet stored in
+    `out`), spread over the operating and margin levels, before the first: one line, refused above an hour unless
+    --allow-large."""
+    from uq.engine.runner import ResultStore, check_cost
+    from uq.problem.tasks import Task
+
+    levels = levels_of(model.rig, [*problem.excitation, problem.margin_level()])
+    each = math.ceil(max(0, runs - ResultStore(out).count()) / len(levels))
+    check_cost(model, [Task.make({}, level, rep) for level in levels for rep in range(each)], jobs=jobs, client=client,
+               allow_large=problem.allow_large, quiet=quiet)
+
+
 def check_size(problem: DesignProblem) -> None:
     """Refuse, before any work, a design whose first batch and references exceed a study's run limit
     (`uq.problem.tasks.MAX_RUNS`) unless `allow_large`, with the estimate in the line."""
@@ -412,6 +426,9 @@ def run_design(problem: DesignProblem, out: Any, *, jobs: int | None = 1, schedu
     screened = screen_designs(problem, mode)
     with dask_client(scheduler, client) as connected:
         model = model.with_rig()
+        model.warm_up()
+        check_first_runs_cost(problem, model, Path(out), verify_runs + reference_runs, jobs=jobs, client=connected,
+                              quiet=not progress)
         folder = prepare_output(Path(out), resume=resume, study=("design", design_key(problem, model)))
         model.warm_up()
         store = ResultStore(folder)

@@ -19,7 +19,9 @@ import numpy as np
 
 from sim.common.files import dumps, write_csv, write_text
 from sim.common.outputs import header
-from uq.engine.runner import ResultStore, dask_client, describe_model, prepare_output, run_tasks
+from sim.common.folder_lock import locked
+from uq.engine.runner import (ResultStore, check_cost, check_writable, dask_client, describe_model, pending_tasks,
+                              prepare_output, release_output, run_tasks)
 from uq.outputs.tables import RUNS_CSV, parameter_columns, runs_rows
 from uq.problem.method import Analysis, Plan, Runs
 from uq.problem.study import Study
@@ -78,11 +80,13 @@ def study_key(study: Study, model: Any) -> str:
 
 
 def run_study(study: Study, *, out: Path | None = None, jobs: int | None = 1, scheduler: str | None = None,
-              resume: bool = False, progress: bool = True, client: Any = None,
-              allow_large: bool = False) -> StudyResult:
+              resume: bool = False, progress: bool = True, client: Any = None, allow_large: bool = False,
+              paper_figure: str | None = None) -> StudyResult:
     """Run a study with its method: every (point, level, repetition) of its plan through the task store (cached,
     resumable; serially, on local workers or on Dask), then its analysis, and write its files into `out` (default:
-    the study's [study] output). A study of sub-studies (`Method.substudies`) runs each into a sub-folder."""
+    the study's [study] output). A study of sub-studies (`Method.substudies`) runs each into a sub-folder.
+    paper_figure: the paper's figure the study reproduces (`ies reproduce`), kept in study.json: its figures carry
+    the paper's names (`uq.outputs.paper_figures`)."""
     method = study.method
     parts = method.substudies(study)
     if parts:
@@ -91,16 +95,35 @@ def run_study(study: Study, *, out: Path | None = None, jobs: int | None = 1, sc
     model = study.make_model()
     model.check()
     plan = method.plan(study)
-    check_run_total(len(plan.points), len(study.levels), study.repetitions, allow_large=allow_large)
+    typical = getattr(model, "typical_seconds_per_run", None)
+    check_run_total(len(plan.points), len(study.levels), study.repetitions, allow_large=allow_large,
+                    per_run_s=typical() if typical is not None else None)
+    folder = Path(out or study.output)
+    try:
+        return _run(study, model, plan, folder, jobs=jobs, scheduler=scheduler, resume=resume, progress=progress,
+                    client=client, allow_large=allow_large, paper_figure=paper_figure)
+    finally:
+        release_output(folder)  # the lock prepare_output took, once the last file is written
+
+
+def _run(study: Study, model: Any, plan: Plan, folder: Path, *, jobs: int | None, scheduler: str | None, resume: bool,
+         progress: bool, client: Any, allow_large: bool, paper_figure: str | None) -> StudyResult:
+    """`run_study` of one study from its output folder on: the kernels, the cost estimate (refused above an hour
+    unless `allow_large`), the tasks, the analysis and the files."""
+    method = study.method
+    tasks = _tasks(plan.points, study)
     with dask_client(scheduler, client) as client:
         if hasattr(model, "with_rig"):
             model = model.with_rig()
-        folder = prepare_output(out or study.output, resume=resume, study=(study.name, study_key(study, model)))
         if hasattr(model, "warm_up"):
-            model.warm_up()  # compile the kernels before the progress bar (workers load them from the cache)
+            model.warm_up()  # compile the kernels before the estimate and the progress bar (workers load them)
+        todo = pending_tasks(model, tasks, study.seed, folder) if resume else tasks
+        work = check_cost(model, todo, jobs=jobs, client=client, allow_large=allow_large,
+                          quiet=not progress)  # before the first run
+        folder = prepare_output(folder, resume=resume, study=(study.name, study_key(study, model)))
         started = time.perf_counter()
-        records, ran = run_tasks(model, _tasks(plan.points, study), study.seed, ResultStore(folder), jobs=jobs,
-                                 progress=progress, client=client)
+        records, ran = run_tasks(model, tasks, study.seed, ResultStore(folder), jobs=jobs, progress=progress,
+                                 client=client, expected_s=work.per_run_s if work is not None else None)
         elapsed = time.perf_counter() - started
     result = StudyResult(folder)
     failed = sum(1 for rec in records.values() if rec["error"])
@@ -121,7 +144,8 @@ def run_study(study: Study, *, out: Path | None = None, jobs: int | None = 1, sc
     result.files.append(_netcdf(study, model, folder, plan, records, stats, regimes, analysis))
     result.summary = {"tasks": len(records), "ran": ran, "reused": len(records) - ran, "failed_runs": failed,
                       "wall_time_s": elapsed, "points": len(plan.points), **analysis.summary}
-    result.files.append(_metadata(study, model, result, {"summary": result.summary, **analysis.metadata}))
+    result.files.append(_metadata(study, model, result, {"summary": result.summary, **analysis.metadata,
+                                                          **({"paper_figure": paper_figure} if paper_figure else {})}))
     return result
 
 
@@ -167,11 +191,20 @@ def _run_parts(study: Study, parts: list[tuple[str, Study]], *, out: Path | None
     """A study of sub-studies (a response series, Fig. 11): each in its own folder OUT/NAME=VALUE (resumable like any
     study), OUT/results.nc with their datasets along the dimension NAME (the values its coordinate) and
     OUT/study.json naming them."""
+    folder = Path(out) if out is not None else study.output
+    check_writable(folder)
+    with locked(folder):  # the series' own files (results.nc, study.json) beside its parts' folders
+        return _series(study, parts, folder, jobs=jobs, scheduler=scheduler, resume=resume, progress=progress,
+                       client=client, allow_large=allow_large)
+
+
+def _series(study: Study, parts: list[tuple[str, Study]], folder: Path, *, jobs: int | None, scheduler: str | None,
+            resume: bool, progress: bool, client: Any, allow_large: bool) -> StudyResult:
+    """`_run_parts` in its locked folder."""
     import xarray as xr
 
     from uq.outputs.netcdf import finish, open_results
 
-    folder = Path(out) if out is not None else study.output
     result = StudyResult(folder)
     totals = {"tasks": 0, "ran": 0, "reused": 0, "failed_runs": 0, "wall_time_s": 0.0, "points": 0}
     names = []

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import io
 import json
 import logging
 import math
@@ -27,6 +28,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Mapping, Sequence
 
 from sim.common.files import write_text
+from sim.common.folder_lock import lock_folder, unlock_folder
 from uq.errors import StudyError
 from uq.problem.tasks import Task
 
@@ -75,6 +77,22 @@ class ResultStore:
     def load(self, key: str) -> dict:
         return json.loads(self._path(key).read_text())
 
+    def read(self, key: str) -> dict | None:
+        """The stored record of `key`; None when there is none, or when its file is damaged (cut short, not a task's
+        JSON, another task's record: a disk that filled up, a copy cut off), which is then removed so that the task
+        runs again (`run_tasks` says so)."""
+        path = self._path(key)
+        try:
+            record = json.loads(path.read_bytes())
+        except FileNotFoundError:
+            return None
+        except (OSError, ValueError):  # json.JSONDecodeError and UnicodeDecodeError are ValueErrors
+            record = None
+        if isinstance(record, dict) and record.get("key") == key and {"outputs", "error"} <= set(record):
+            return record
+        path.unlink(missing_ok=True)
+        return None
+
 
 def check_writable(folder: str | Path) -> Path:
     """Create `folder` (and parents) and prove a file can be written in it, else a one-line StudyError."""
@@ -95,27 +113,39 @@ STUDY_MARK = "STUDY.txt"
 
 
 def prepare_output(folder: str | Path, *, resume: bool, study: tuple[str, str] | None = None) -> Path:
-    """Create the output folder and check it can be written; refuse to overwrite finished results, and refuse
-    `resume` into a folder that holds the tasks of another study. `study`: (name, key) of the study to run
-    (`uq.engine.execution.study_key`), kept in OUT/tasks/STUDY.txt."""
+    """Create the output folder, check it can be written and take its lock (`sim.common.folder_lock`: a second run
+    into a folder in use is refused with one line naming the other run; `release_output` gives it back when the
+    run's last file is written); refuse to overwrite finished results, and refuse `resume` into a folder that holds
+    the tasks of another study. `study`: (name, key) of the study to run (`uq.engine.execution.study_key`), kept in
+    OUT/tasks/STUDY.txt."""
     folder = Path(folder)
     store = ResultStore(folder)
-    if not resume and store.count():
-        raise StudyError(f"output folder {folder} already holds task results; pass --resume to continue that study "
-                         "or choose another --out")
-    mark = store.folder / STUDY_MARK
-    if resume and study is not None and mark.is_file():
-        name, key = (mark.read_text().splitlines() + ["", ""])[:2]
-        if key != study[1] and store.count():
-            raise StudyError(f"output folder {folder} holds the tasks of another study ('{name}', key {key[:12]}), not "
-                             f"of '{study[0]}' (key {study[1][:12]}); --resume continues only the same study: choose "
-                             "another --out")
     check_writable(store.folder)
-    if study is not None:
-        write_text(mark, f"{study[0]}\n{study[1]}\n")
-    for stale in store.folder.glob(".*.json"):  # a temporary file of a write cut off by SIGKILL
-        stale.unlink(missing_ok=True)
+    lock_folder(folder)  # before the folder's tasks are looked at: another run may be adding to them
+    try:
+        if not resume and store.count():
+            raise StudyError(f"output folder {folder} already holds task results; pass --resume to continue that study "
+                             "or choose another --out")
+        mark = store.folder / STUDY_MARK
+        if resume and study is not None and mark.is_file():
+            name, key = (mark.read_text().splitlines() + ["", ""])[:2]
+            if key != study[1] and store.count():
+                raise StudyError(f"output folder {folder} holds the tasks of another study ('{name}', key {key[:12]}), "
+                                 f"not of '{study[0]}' (key {study[1][:12]}); --resume continues only the same study: "
+                                 "choose another --out")
+        if study is not None:
+            write_text(mark, f"{study[0]}\n{study[1]}\n")
+        for stale in store.folder.glob(".*.json"):  # a temporary file of a write cut off by SIGKILL
+            stale.unlink(missing_ok=True)
+    except BaseException:
+        unlock_folder(folder)
+        raise
     return folder
+
+
+def release_output(folder: str | Path) -> None:
+    """Give back the lock `prepare_output` took on `folder` (nothing if this process holds none)."""
+    unlock_folder(folder)
 
 
 def evaluate(model: Callable, task: Task, seed: int) -> dict:
@@ -206,47 +236,110 @@ def choose_jobs(jobs: int | None, work_s: float, cores: int | None = None, strea
     return cores if work_s > PARALLEL_OVERHEAD_S * cores / (cores - 1) else 1
 
 
+#: what a study's cost estimate or refusal suggests (`check_cost`)
+LESS_WORK = "ask for fewer levels, repetitions or points, a shorter wait or hold, or run it on a cluster (--cluster)"
+
+
+def pending_tasks(model: Any, tasks: Sequence[Task], seed: int, folder: str | Path) -> list[Task]:
+    """The tasks of `tasks` (each once) whose result is not stored in `folder`'s task store (`ResultStore`)."""
+    keyer = _keyer(model, seed, model.version())
+    store = ResultStore(folder)
+    return list({keyer(task): task for task in tasks if not store.has(keyer(task))}.values())
+
+
+def workers_for(jobs: int | None, serial_s: float, client: Any = None) -> int:
+    """The processes that will share work of `serial_s` seconds: the Dask cluster's threads, --jobs, or
+    `choose_jobs`'s choice."""
+    if client is not None:
+        try:
+            return max(1, sum(client.nthreads().values()))
+        except Exception:  # noqa: BLE001 - a cluster that cannot say (yet): counted as one
+            return 1
+    if jobs is not None:
+        return jobs
+    return choose_jobs(None, serial_s, stream=io.StringIO())
+
+
+def check_cost(model: Any, tasks: Sequence[Task], *, jobs: int | None = None, client: Any = None,
+               allow_large: bool = False, quiet: bool = False) -> Any:
+    """The cost estimate of `tasks` before the first runs (`sim.stepped_sine.cost`: runs x the seconds of one run,
+    measured here by a probe of the model's protocol at their levels, on the workers that will run them): said in one
+    line when long (with `quiet` only above half an hour), refused (one line naming the estimate and --allow-large)
+    above an hour. None for a model that
+    cannot be probed (no `seconds_per_run`: the first run is timed instead) or work too small to be worth it."""
+    from collections import Counter
+
+    from sim.stepped_sine.cost import check_estimate, estimate
+
+    if not tasks or not hasattr(model, "seconds_per_run"):
+        return None
+    runs_at = Counter(task.level for task in tasks)
+    per_run = model.seconds_per_run(list(runs_at), len(tasks))
+    if per_run is None:
+        return None
+    serial = estimate(runs_at, per_run).serial_s
+    work = estimate(runs_at, per_run, workers=workers_for(jobs, serial, client))
+    check_estimate(work, LESS_WORK, allow_large=allow_large, quiet=quiet)
+    return work
+
+
 def run_tasks(model: Callable, tasks: Sequence[Task], seed: int, store: ResultStore, *, jobs: int | None = 1,
-              scheduler: str | None = None, progress: bool = True, client: Any = None) -> tuple[dict[Task, dict], int]:
-    """Run every task whose result is not in `store`; return all results by task and how many ran now.
+              scheduler: str | None = None, progress: bool = True, client: Any = None,
+              expected_s: float | None = None) -> tuple[dict[Task, dict], int]:
+    """Run every task whose result is not in `store` (or whose stored file is damaged: removed and run again, said
+    in one warning line, `ResultStore.read`); return all results by task and how many ran now.
 
     jobs: local worker processes (joblib/loky; 1 = in this process; None: `choose_jobs` after timing the first task
-    in this process, which also gives the cost estimate of the rest, `sim.stepped_sine.cost.announce_runs`).
+    in this process). expected_s: the seconds of one run estimated before (`check_cost`); the first run's time says
+    what the rest will take where there was no estimate, or where it is far off (`sim.stepped_sine.cost.first_run_line`).
     scheduler: a Dask scheduler address (`client` may be passed instead, e.g. in tests): every task is submitted
     to the cluster, whatever its size. Each result is saved as it arrives, so an interruption (Ctrl-C, a killed
     process, a lost scheduler) loses only the tasks in flight; a lost scheduler is one StudyError line that names
     `--resume`.
     """
-    from tqdm import tqdm
+    from sim.common.progress import progress as report
 
     if jobs is not None and jobs < 1:
         raise StudyError(f"--jobs must be >= 1, got {jobs}")
     version = model.version()
     keyer = _keyer(model, seed, version)
     keys = {task: keyer(task) for task in tasks}
+    records: dict[str, dict] = {}
     unique: dict[str, Task] = {}
+    damaged = []
     for task, key in keys.items():
-        if key not in unique and not store.has(key):
+        if key in unique or key in records:
+            continue
+        present = store.has(key)
+        record = store.read(key) if present else None
+        if record is None:
             unique[key] = task
+            if present:
+                damaged.append(key)
+        else:
+            records[key] = record
+    if damaged:
+        sys.stderr.write(f"warning: {len(damaged)} stored task file(s) in {store.folder} were damaged (cut short or not "
+                         f"a task's record, e.g. {damaged[0]}.json) and were removed; they run again\n")
     pending = list(unique.items())
     total = len(set(keys.values()))
-    bar = tqdm(total=total, initial=total - len(pending), desc="tasks", unit="run",
-               disable=not progress, file=sys.stderr, dynamic_ncols=True)
+    bar = report(total, "tasks", "run", initial=total - len(pending), enabled=progress)
     try:
         if scheduler is not None and client is None:
             with dask_client(scheduler) as own:
-                _run_and_store(model, pending, seed, jobs, own, store, bar, total)
+                _run_and_store(model, pending, seed, jobs, own, store, bar, total, expected_s=expected_s)
         else:
-            _run_and_store(model, pending, seed, jobs, client, store, bar, total)
+            _run_and_store(model, pending, seed, jobs, client, store, bar, total, expected_s=expected_s)
     finally:
         bar.close()
-    return {task: store.load(key) for task, key in keys.items()}, len(pending)
+    records.update((key, store.load(key)) for key, _ in pending)
+    return {task: records[key] for task, key in keys.items()}, len(pending)
 
 
 def _run_and_store(model: Callable, pending: list[tuple[str, Task]], seed: int, jobs: int | None, client: Any,
-                   store: ResultStore, bar: Any, total: int) -> None:
+                   store: ResultStore, bar: Any, total: int, *, expected_s: float | None) -> None:
     """Save each result as it arrives; a lost Dask scheduler becomes one StudyError line."""
-    from sim.stepped_sine.cost import announce_runs
+    from sim.stepped_sine.cost import first_run_line
 
     done = total - len(pending)
     if client is None and pending:  # locally the first task runs here: its time sizes the rest
@@ -257,9 +350,10 @@ def _run_and_store(model: Callable, pending: list[tuple[str, Task]], seed: int, 
         bar.update(1)
         pending = pending[1:]
         per_run = time.perf_counter() - started
-        announce_runs(len(pending), per_run, "interrupt with Ctrl-C and rerun with --resume to go on; fewer levels, "
-                                             "repetitions or points make it shorter")
         jobs = choose_jobs(jobs, len(pending) * per_run) if pending else 1
+        line = first_run_line(len(pending), per_run, expected_s, jobs)
+        if line:
+            bar.write(f"{line}; interrupt with Ctrl-C and rerun with --resume to go on", file=sys.stderr)
     try:
         for key, task, result in _dispatch(model, pending, seed, jobs, client):
             store.save(key, task, result)

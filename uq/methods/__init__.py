@@ -40,9 +40,10 @@ def kinds() -> dict[str, list[Method]]:
     return kinds_of(METHODS)
 
 
-def load_study(path: str | Path) -> Study:
-    """Read and validate a study file (`uq.problem.study`) against the registered methods; one-line StudyError."""
-    return read_study(path, METHODS, ELSEWHERE)
+def load_study(path: str | Path, *, allow_implausible: bool = False) -> Study:
+    """Read and validate a study file (`uq.problem.study`) against the registered methods; one-line StudyError (a value
+    of implausible magnitude too, unless `allow_implausible`)."""
+    return read_study(path, METHODS, ELSEWHERE, allow_implausible=allow_implausible)
 
 
 def study_from(data: Mapping[str, Any], *, base_dir: Path = Path("."), source: str = "") -> Study:

@@ -33,7 +33,7 @@ from uq.errors import StudyError
 from uq.outputs.tables import PARAMETERS_COLUMN, parameter_columns
 from uq.problem.method import Analysis, Method, Plan, Runs, Table
 from uq.problem.space import ParameterSpace, resolve_value
-from uq.problem.study import Context, Setting, Study, check_number, numeric, warn_implausible
+from uq.problem.study import Context, Setting, Study, check_number, check_plausible, numeric
 
 
 @dataclass(frozen=True)
@@ -253,7 +253,7 @@ def _fix(value: Any, context: Context) -> dict[str, float]:
             fixed = space.extras[f"{pname}_best_estimate"]
         elif pname in PARAMETERS and PARAMETERS[pname].quantity is not None:  # k_H, g, k_t: also with a unit
             fixed = resolve_value(pname, raw, base_dir=context.base_dir)
-            warn_implausible(context.source, f"[interval] fix.{pname}", pname, fixed)
+            check_plausible(f"[interval] fix.{pname}", pname, fixed, raw, context.allow_implausible)
         else:
             fixed = check_number(f"[interval] fix.{pname}", raw, positive=space[pname].positive)
         out[pname] = float(fixed)

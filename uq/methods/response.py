@@ -148,15 +148,13 @@ def series_traces(study: Study, folder: Path, levels: Sequence[float], periods: 
     point of the resonant mean at each of `levels`, reached as the study's runs reach it (its grid up to that eta,
     the first run's random offset), into folder/trace-LEVEL: trace.csv, trace.json, Figs. 4/9a (trace.png) and
     the walls and the sphere (motion.png)."""
-    import csv
-
+    from sim.common.files import read_rows
     from sim.plots.figures import plot_motion, plot_trace
     from uq.outputs.figures import series_label
     from sim.analysis.trace import record_trace, write_trace
 
     sub, one = Response().substudies(study)[-1]
-    with open(folder / sub / "overview.csv", newline="") as fh:
-        resonant = {float(r["level"]): float(r["eta_resonant_mean"]) for r in csv.DictReader(fh)}
+    resonant = {float(r["level"]): float(r["eta_resonant_mean"]) for r in read_rows(folder / sub / "overview.csv")}
     model = one.make_model().with_rig()
     point = one.space.nominal()
     rig, impactor = model.simulated_system(point)

@@ -262,6 +262,8 @@ class PCE(SobolMethod):
                 numeric("max_misfit", MAX_MISFIT, "cross-validated error beyond the noise (share of the variance) above "
                         "which the response is flagged not smooth", identity=False))
     tables = (*SobolMethod.tables, Table(SURROGATE_CSV, dims={"level": "level"}, split="output"))
+    #: Saltelli's base sample n, which files of the release before the method registry gave any Sobol' study
+    superseded = {"n": "points"}
 
     def finish(self, values: dict[str, Any], context: Context) -> dict[str, Any]:
         values = super().finish(values, context)

@@ -18,7 +18,6 @@ formats of the plot options (PNG and PDF by default).
 """
 from __future__ import annotations
 
-import csv
 import json
 from collections import defaultdict
 from dataclasses import dataclass
@@ -39,7 +38,7 @@ from sim.plots.figures import (
     tip_mm_per_level,
     tip_note,
 )
-from sim.common.files import pyplot, save_figure
+from sim.common.files import pyplot, read_rows, save_figure
 from sim.plots.redraw import KINDS, PlotOptions, kind_of, register, selected
 from uq.outputs.results import nominal_regimes, study_kind
 
@@ -52,9 +51,9 @@ _DISCRETE_OUTPUTS = ("restitution", "restitution_wall")
 
 
 def _rows(path: Path, options: PlotOptions | None = None) -> list[dict]:
-    """A CSV file's rows; with `options`, only the rows of the chosen levels."""
-    with open(path, newline="") as fh:
-        rows = list(csv.DictReader(fh))
+    """A CSV file's rows (`sim.common.files.read_rows`: one line naming the file and the line where it is cut short);
+    with `options`, only the rows of the chosen levels."""
+    rows = read_rows(path)
     if options is not None and rows and "level" in rows[0]:
         rows = [r for r in rows if options.keeps(float(r["level"]))]
     return rows
@@ -128,24 +127,46 @@ def _errorbar(ax: Any, x: np.ndarray, y: np.ndarray, se: np.ndarray, fmt: str, *
                 elinewidth=0.8, **kwargs)
 
 
-def _band_with_noise(ax: Any, band: dict, color: str, alpha: float, label: str, *, hatch: str | None = None,
-                     discrete: bool = False, offset: float = 0.0, width: float = 0.0,
+#: what the fill of a band spans (its legend entry)
+BAND_SPAN = "lowest to highest point"
+#: how an unresolved band is drawn and said (`uq.outputs.results.unresolved`)
+UNRESOLVED = "not resolved (narrower than 2 SE of its edges): dotted"
+
+
+def _band_with_noise(ax: Any, band: dict, color: str, alpha: float, label: str, *, discrete: bool = False,
+                     offset: float = 0.0, width: float = 0.0,
                      curves: Sequence[tuple[np.ndarray, np.ndarray]] = ()) -> None:
-    """The band (shaded, or hatched and unfilled with `hatch` so that a band beneath stays visible) and the
-    standard errors of its edges (bars at both edges). discrete: one box per level (width in level units, shifted
-    by offset), no band drawn between levels. curves: (levels, values) of the curves drawn with their own error bars
-    at the same levels: where an edge is one of them (a corner or the nominal at a bound) its bar is theirs, not drawn
-    twice."""
+    """The band, filled from its lowest to its highest point where it is resolved (wider than the noise of its edges,
+    `uq.outputs.results.unresolved`) and only outlined (dotted) where it is not, and the standard errors of its edges
+    (bars at both edges). discrete: one box per level (width in level units, shifted by offset), no band drawn between
+    levels. curves: (levels, values) of the curves drawn with their own error bars at the same levels: where an edge is
+    one of them (a corner or the nominal at a bound) its bar is theirs, not drawn twice."""
+    from uq.outputs.results import unresolved
+
     x = band["level"] + offset
-    fill = {"facecolor": "none", "edgecolor": color, "hatch": hatch, "lw": 0.8} if hatch else \
-        {"color": color, "alpha": alpha, "lw": 0}
+    loose = np.array([unresolved(lo, hi, lo_se, hi_se) for lo, hi, lo_se, hi_se in
+                      zip(band["lower"], band["upper"], band["lower_se"], band["upper_se"])], dtype=bool)
+    outline = {"fill": False, "edgecolor": color, "ls": ":", "lw": 1.2}
     if discrete:
-        ax.bar(x, band["upper"] - band["lower"], width, bottom=band["lower"], label=label, **fill)
+        ax.bar(x[~loose], (band["upper"] - band["lower"])[~loose], width, bottom=band["lower"][~loose], color=color,
+               alpha=alpha, lw=0, label=label)
+        if loose.any():
+            ax.bar(x[loose], (band["upper"] - band["lower"])[loose], width, bottom=band["lower"][loose],
+                   label=f"{label.split(':')[0].split(' (')[0]} {UNRESOLVED}", **outline)
     else:
-        ax.fill_between(x, band["lower"], band["upper"], label=label, **fill)
+        # filled between resolved levels only (matplotlib fills between consecutive levels both kept); where a level
+        # is not resolved the band is its two edges, dotted
+        ax.fill_between(x, band["lower"], band["upper"], where=~loose, color=color, alpha=alpha, lw=0, label=label)
+        if loose.any():
+            near = _near_unresolved(loose)
+            for edge in ("lower", "upper"):
+                ax.plot(x, np.where(near, band[edge], np.nan), ":", color=color, lw=1.2,
+                        label=f"{label.split(':')[0].split(' (')[0]} {UNRESOLVED}" if edge == "lower" else None)
     at = x - 0.3 * width if discrete else x  # a box's edge errors off its centre, where the nominal point sits
     for edge in ("lower", "upper"):
-        own = np.ones(band["level"].size, dtype=bool)
+        own = ~loose  # an unresolved band's edge bars would lie on one another: its outline says it all
+        if not own.any():
+            continue
         for levels, values in curves:
             at_level = dict(zip(np.round(levels, 9), values))
             own &= ~np.array([np.isclose(at_level.get(round(lv, 9), np.nan), v, rtol=1e-12, atol=0.0)
@@ -154,11 +175,25 @@ def _band_with_noise(ax: Any, band: dict, color: str, alpha: float, label: str, 
                     ecolor=color, elinewidth=0.8, capsize=2, alpha=0.9)
 
 
+def _near_unresolved(loose: np.ndarray) -> np.ndarray:
+    """The levels an outline runs through: the unresolved ones and their neighbours (the dotted segments reach the
+    filled part)."""
+    near = loose.copy()
+    near[1:] |= loose[:-1]
+    near[:-1] |= loose[1:]
+    return near
+
+
 def _marks(ax: Any, band: dict, prefix: str = "", offset: float = 0.0) -> None:
-    """Where the nominal value lies outside the band (beyond or within the noise), where the monotonicity check
-    failed (band widened) and where it could not be made; each explained in the legend."""
+    """Where the nominal value lies outside the band (beyond or within the noise; not judged where the band is not
+    resolved: it is noise there), where the monotonicity check failed (band widened) and where it could not be made;
+    each explained in the legend."""
+    from uq.outputs.results import unresolved
+
     lv = band["level"] + offset
-    applies = band["nominal_outside"] >= 0
+    loose = np.array([unresolved(lo, hi, lo_se, hi_se) for lo, hi, lo_se, hi_se in
+                      zip(band["lower"], band["upper"], band["lower_se"], band["upper_se"])], dtype=bool)
+    applies = (band["nominal_outside"] >= 0) & ~loose
     beyond = applies & (band["nominal_outside"] == 1)
     outside = applies & ((band["nominal"] < band["lower"]) | (band["nominal"] > band["upper"]))
     within = outside & ~beyond
@@ -176,6 +211,21 @@ def _marks(ax: Any, band: dict, prefix: str = "", offset: float = 0.0) -> None:
     if untested.any():
         ax.plot(lv[untested], band["upper"][untested], ls="none", marker="$?$", color="0.3", ms=9,
                 label=f"{prefix}monotonicity not tested (no noise estimate)")
+
+
+def band_regimes(points: list[dict], design: str, output: str) -> dict[float, str]:
+    """{level: regime} of a band: APR or SMR (or linear) where every point of the design and the nominal point has it,
+    "mixed" where they differ (`sim.plots.figures.shade_regimes`): the nominal point's regime alone would call a
+    level APR where an edge of the band is strongly modulated."""
+    found: dict[float, set[str]] = {}
+    for r in points:
+        if r["output"] == output and r["design"] in (design, "nominal"):
+            found.setdefault(float(r["level"]), set()).add(r.get("regime", ""))
+    return {level: next(iter(kinds)) if len(kinds) == 1 else "mixed" for level, kinds in sorted(found.items())}
+
+
+#: whose regime a band figure shades
+BAND_REGIMES = {"APR": "APR: every point of the band (white: SMR)", "mixed": "mixed: APR and SMR points in the band"}
 
 
 def _tip_mm_per_level(meta: dict) -> float | None:
@@ -197,10 +247,6 @@ def _level_step(levels: np.ndarray) -> float:
     return float(np.min(np.diff(unique))) if unique.size > 1 else 1.0
 
 
-#: the y range a restitution's band figure shows at least (Eq. D.1: r in (0, 1]; the paper's r ~ 0.8 inside)
-_RESTITUTION_AXIS = {"restitution": (0.5, 1.0), "restitution_wall": (0.5, 1.0)}
-
-
 def residual_label(study: dict) -> str:
     """The residual band's legend entry with the values its parameters are fixed at ('residual: $k_H$ = 352x10^3
     N/mm^1.5 fixed (its best estimate)')."""
@@ -212,123 +258,191 @@ def residual_label(study: dict) -> str:
     return "residual: " + ", ".join(parts) if parts else "residual"
 
 
-def _unresolved_levels(band: dict, z: float = 2.0) -> list[float]:
-    """Levels whose band is narrower than z combined standard errors of its edges (the band is noise there)."""
-    width = band["upper"] - band["lower"]
-    noise = z * np.hypot(np.nan_to_num(band["lower_se"]), np.nan_to_num(band["upper_se"]))
-    return [float(lv) for lv, w, n in zip(band["level"], width, noise) if np.isfinite(w) and w < n]
+def joint_label(study: dict) -> str:
+    """The joint band's legend entry naming what varies in it ('joint: $D$ and $g$ varied together')."""
+    varied = [name for name, p in study.get("parameters", {}).items()
+              if not name.startswith("_") and isinstance(p, dict) and p.get("max", 0) > p.get("min", 0)]
+    names = [f"${name}$" if name in ("D", "g", "k_H") else name for name in varied]
+    together = names[0] if len(names) == 1 else ", ".join(names[:-1]) + f" and {names[-1]}"
+    return f"joint: {together} varied together" if names else "joint"
 
 
+#: the title over the panels of a joint-band figure of several outputs (Fig. D.3: r from the tip and from the wall)
+BOX_SUPTITLE = "Joint variation (cf. Fig. D.3)"
 #: the joint-band figure of a banded output: (file stem, title, a level of the paper to mark (value, label) or None)
 BoxFigure = tuple[str, str, "tuple[float, str] | None"]
 
 
 def interval_figures(folder: str | Path, options: PlotOptions | None = None, *, individual_stem: str,
-                     box_figure: Callable[[str], BoxFigure]) -> list[Path]:
-    """Draw Figs. 7 and 8 (as far as the study has the designs) and the nominal levels from folder/*.csv: the
-    individual variation under the stem `individual_stem`, the joint band of an output as `box_figure(output)` names it
-    (`uq.outputs.paper_figures.interval_figures` passes the figure table's names)."""
+                     box_figure: Callable[[str], BoxFigure], nominal_levels: bool = True) -> list[Path]:
+    """Draw Figs. 7 and 8 (as far as the study has the designs) and, with `nominal_levels`, the nominal point's levels
+    from folder/*.csv: the individual variation under the stem `individual_stem`, the joint band as `box_figure(output)`
+    names it (`uq.outputs.paper_figures.interval_figures` passes the names: the paper's for `ies reproduce`, what they
+    show for a study of one's own)."""
     folder = Path(folder)
     options = options or PlotOptions()
-    plt = pyplot()
     meta = _study(folder)
     points, bands = _rows(folder / "points.csv", options), _rows(folder / "bands.csv", options)
     selected(sorted({float(r["level"]) for r in _rows(folder / "bands.csv")}), options, folder)
     output = meta["outputs"][0]  # "mean" for the simulator: the paper's Figs. 7-8 show the mean only
     designs = list(dict.fromkeys(r["design"] for r in bands))
-    params = meta["study"]["parameters"]
-    nominal = _curve(points, "nominal", "nominal", output)
-    nominal_text = nominal_label(params)
-    regimes = nominal_regimes(points, output)
-    discrete = output in _DISCRETE_OUTPUTS or len(regimes) < 4
+    discrete = output in _DISCRETE_OUTPUTS or len(nominal_regimes(points, output)) < 4
     note = _NOISE_NOTE.format(n=meta["study"]["repetitions"])
     factor = _tip_mm_per_level(meta) if output in ("mean", "max") else None
     notes = "\n".join(text for text in (note, tip_note(factor)) if text)
+    view = _IntervalView(meta, points, bands, discrete, notes)
     paths: list[Path] = []
-
     individual = [d for d in designs if d.startswith("individual:")]
     if individual:
-        fig, axes = plt.subplots(1, len(individual), figsize=(4.4 * len(individual), 5.6), squeeze=False, sharey=True,
-                                 layout="constrained")
-        for ax, d in zip(axes[0], individual):
-            pname = d.split(":", 1)[1]
-            band = _band(bands, d, output)
-            if not discrete:
-                shade_regimes(ax, list(regimes), list(regimes.values()))
-            width = 0.3 * _level_step(band["level"])
-            corners = sorted({r["point"] for r in points if r["design"] == d and r["role"] == "corner"},
-                             key=_corner_value)
-            value = params.get(pname, {}).get("nominal")
-            # a corner at the nominal value is the nominal curve: drawn and listed once, as the nominal at that end
-            ends = [(label, marker, style, color, end) for (label, marker, style, color, end) in
-                    ((corners[0], "v", ":", "C0", "lower"), (corners[-1], "^", "-", "C3", "upper"))
-                    if value is None or not np.isclose(_corner_value(label), value, rtol=1e-6)]
-            at_end = [end for end in ("lower", "upper") if end not in {e[-1] for e in ends}]
-            curves = [_curve(points, d, label, output) for label, *_ in ends]
-            _band_with_noise(ax, band, "C0", 0.2, "band (± SE of its edges)", discrete=discrete, width=width,
-                             curves=[(c[0], c[1]) for c in [nominal, *curves]])
-            _errorbar(ax, *nominal, "--" if not discrete else "D", color="k", lw=1.4 if at_end else 1.0, ms=3, zorder=4,
-                      label=(parameter_text(pname, value, star=True) + " (nominal"
-                             + "".join(f", {end} end" for end in at_end) + ")") if pname in params else "nominal")
-            for (label, marker, style, color, _), curve in zip(ends, curves):
-                _errorbar(ax, *curve, marker + ("" if discrete else style), color=color, mfc="none", ms=6, zorder=3,
-                          label=parameter_text(pname, _corner_value(label)))
-            _marks(ax, band)
-            ax.set_title(parameter_title(pname, params.get(pname, {})), fontsize=9)
-            ax.set_xlabel(LEVEL_LABEL)
-            ax.grid(alpha=0.3)
-            legend_below(ax)
-        axes[0][0].set_ylabel(_YLABEL.get(output, output))
-        fig.suptitle(f"Individual variation (cf. Fig. 7); {nominal_text}", fontsize=10)
-        fig.supxlabel(notes, fontsize=LEGEND_PT)
-        paths += _save(fig, folder, individual_stem, options)
-        plt.close(fig)
-
+        paths += _individual_figure(view, individual, output, individual_stem, folder, options)
     box = [d for d in designs if d in ("joint", "residual")]
     if box:
-        fig, ax = plt.subplots(figsize=(9.5, 4.8), layout="constrained")
-        styles = {"joint": ("C0", 0.25, None, "all parameters (joint)"),
-                  "residual": ("C1", 0.0, "//", residual_label(meta["study"]))}
-        step = _level_step(np.array([float(r["level"]) for r in bands]))
-        if not discrete:
-            shade_regimes(ax, list(regimes), list(regimes.values()))
+        # Fig. D.3's r from the tip and from the wall: a panel each; Fig. 8 the resonant mean only
+        shown = [o for o in meta["outputs"] if o in _DISCRETE_OUTPUTS] if output in _DISCRETE_OUTPUTS else [output]
+        paths += _box_figure(view, box, shown, box_figure, folder, options)
+    if nominal_levels and {"mean", "max"} <= set(meta["outputs"]):
+        paths += _nominal_levels(folder, points, nominal_label(meta["study"]["parameters"]), notes, options)
+    return paths
+
+
+@dataclass(frozen=True)
+class _IntervalView:
+    """What the figures of an interval study are drawn from: study.json, points.csv and bands.csv at the chosen
+    levels, whether levels are drawn one by one (`discrete`) and the notes heading the legends."""
+
+    meta: dict
+    points: list[dict]
+    bands: list[dict]
+    discrete: bool
+    notes: str
+
+
+def _individual_figure(view: _IntervalView, individual: list[str], output: str, stem: str, folder: Path,
+                       options: PlotOptions) -> list[Path]:
+    """Fig. 7: a panel per parameter, its band (lowest to highest point), the nominal curve and its corners, the levels
+    shaded by the regimes of the band's points (`band_regimes`)."""
+    plt = pyplot()
+    params = view.meta["study"]["parameters"]
+    nominal = _curve(view.points, "nominal", "nominal", output)
+    fig, axes = plt.subplots(1, len(individual), figsize=(4.4 * len(individual), 5.6), squeeze=False, sharey=True,
+                             layout="constrained")
+    for ax, d in zip(axes[0], individual):
+        pname = d.split(":", 1)[1]
+        band = _band(view.bands, d, output)
+        if not view.discrete:
+            regimes = band_regimes(view.points, d, output)
+            shade_regimes(ax, list(regimes), list(regimes.values()), labels=BAND_REGIMES)
+        width = 0.3 * _level_step(band["level"])
+        corners = sorted({r["point"] for r in view.points if r["design"] == d and r["role"] == "corner"},
+                         key=_corner_value)
+        value = params.get(pname, {}).get("nominal")
+        # a corner at the nominal value is the nominal curve: drawn and listed once, as the nominal at that end
+        ends = [(label, marker, style, color, end) for (label, marker, style, color, end) in
+                ((corners[0], "v", ":", "C0", "lower"), (corners[-1], "^", "-", "C3", "upper"))
+                if value is None or not np.isclose(_corner_value(label), value, rtol=1e-6)]
+        at_end = [end for end in ("lower", "upper") if end not in {e[-1] for e in ends}]
+        curves = [_curve(view.points, d, label, output) for label, *_ in ends]
+        _band_with_noise(ax, band, "C0", 0.2, f"band: {BAND_SPAN} (bars: ± SE of its edges)", discrete=view.discrete,
+                         width=width, curves=[(c[0], c[1]) for c in [nominal, *curves]])
+        _errorbar(ax, *nominal, "--" if not view.discrete else "D", color="k", lw=1.4 if at_end else 1.0, ms=3,
+                  zorder=4, label=(parameter_text(pname, value, star=True) + " (nominal"
+                                   + "".join(f", {end} end" for end in at_end) + ")") if pname in params else "nominal")
+        for (label, marker, style, color, _), curve in zip(ends, curves):
+            _errorbar(ax, *curve, marker + ("" if view.discrete else style), color=color, mfc="none", ms=6, zorder=3,
+                      label=parameter_text(pname, _corner_value(label)))
+        _marks(ax, band)
+        ax.set_title(_capitalised(parameter_title(pname, params.get(pname, {}))), fontsize=9)
+        ax.set_xlabel(LEVEL_LABEL)
+        ax.grid(alpha=0.3)
+        legend_below(ax)
+    axes[0][0].set_ylabel(_YLABEL.get(output, output))
+    fig.suptitle(f"Individual variation (cf. Fig. 7); {nominal_label(params)}", fontsize=10)
+    fig.supxlabel(view.notes, fontsize=LEGEND_PT)
+    paths = _save(fig, folder, stem, options)
+    plt.close(fig)
+    return paths
+
+
+def _capitalised(text: str) -> str:
+    """`text` with a capital first letter (a title)."""
+    return text[:1].upper() + text[1:]
+
+
+def _box_figure(view: _IntervalView, box: list[str], outputs: list[str], box_figure: Callable[[str], BoxFigure],
+                folder: Path, options: PlotOptions) -> list[Path]:
+    """Fig. 8 (the joint band filled, the residual band in another colour over it, both see-through) or Fig. D.3 (r
+    from the tip and from the wall, a panel each, the bands level by level), with the nominal curve, the marks of
+    `_marks`, the levels shaded by the regimes of the joint band's points and the paper's reference level."""
+    plt = pyplot()
+    study = view.meta["study"]
+    labels = {"joint": joint_label(study), "residual": residual_label(study)}
+    colors = {"joint": ("C0", 0.22), "residual": ("C1", 0.3)}
+    step = _level_step(np.array([float(r["level"]) for r in view.bands]))
+    stem, _, _ = box_figure(outputs[0])
+    fig, axes = plt.subplots(1, len(outputs), figsize=(9.5 if len(outputs) == 1 else 6.2 * len(outputs), 4.8),
+                             squeeze=False, sharey=True, layout="constrained")
+    for ax, output in zip(axes[0], outputs):
+        _, title, reference = box_figure(output)  # Fig. 8 for the resonant level, Fig. D.3 for r (a panel each)
+        nominal = _curve(view.points, "nominal", "nominal", output)
+        if not view.discrete:
+            regimes = band_regimes(view.points, box[0], output)
+            shade_regimes(ax, list(regimes), list(regimes.values()), labels=BAND_REGIMES)
         for k, d in enumerate(box):
-            color, alpha, hatch, label = styles[d]
-            band = _band(bands, d, output)
+            color, alpha = colors[d]
+            band = _band(view.bands, d, output)
             # discrete levels: the two bands side by side, so that no bar hides the other's
-            offset = (k - (len(box) - 1) / 2) * 0.25 * step if discrete else 0.0
-            _band_with_noise(ax, band, color, alpha, f"{label} (± SE of its edges)", hatch=hatch, discrete=discrete,
-                             offset=offset, width=0.22 * step)
+            offset = (k - (len(box) - 1) / 2) * 0.25 * step if view.discrete else 0.0
+            _band_with_noise(ax, band, color, alpha, f"{labels[d]} ({BAND_SPAN}; bars: ± SE of its edges)",
+                             discrete=view.discrete, offset=offset, width=0.22 * step)
             _marks(ax, band, prefix=f"{d}: ", offset=offset)
-        _errorbar(ax, *nominal, "kD" if discrete else "k.--", ms=4, label=nominal_text)
-        stem, title, reference = box_figure(output)  # Fig. 8 for the resonant level, Fig. D.3 for r
+        _errorbar(ax, *nominal, "kD" if view.discrete else "k.--", ms=4, zorder=4,
+                  label=nominal_label(study["parameters"]))
         if reference is not None:
             ax.axhline(reference[0], color="k", lw=1, ls="-.", alpha=0.6, label=reference[1])
-        if discrete:
-            ax.set_xticks(np.unique(band["level"]))
-        if output in _RESTITUTION_AXIS:  # r is a share of a rebound speed: shown from 0.5 to 1, not magnified noise
-            bottom, top = _RESTITUTION_AXIS[output]
-            ax.set_ylim(min(bottom, ax.get_ylim()[0]), max(top, ax.get_ylim()[1]))
-        unresolved = sorted({lv for d in box for lv in _unresolved_levels(_band(bands, d, output))})
-        box_notes = notes + (f"\nat {', '.join(f'{lv:g}' for lv in unresolved)} a band is narrower than the noise of "
-                             "its edges (2 SE): not resolved" if unresolved else "")
+        if view.discrete:
+            ax.set_xticks(np.unique(nominal[0]))
         ax.set_xlabel(LEVEL_LABEL)
-        ax.set_ylabel(_YLABEL.get(output, output))
-        ax.set_title(title, fontsize=10)
+        ax.set_title(title, fontsize=10 if len(outputs) == 1 else 9)
         ax.grid(alpha=0.3)
-        legend_beside(ax, title=box_notes)
-        paths += _save(fig, folder, stem, options)
-        plt.close(fig)
-
-    if {"mean", "max"} <= set(meta["outputs"]):
-        paths += _nominal_levels(folder, points, nominal_text, "\n".join(t for t in (note, tip_note(factor)) if t),
-                                 options)
+    if len(outputs) > 1:
+        fig.suptitle(BOX_SUPTITLE, fontsize=10)
+    axes[0][0].set_ylabel(_YLABEL.get(outputs[0], outputs[0]) if len(outputs) == 1 else
+                          "modal coefficient of restitution $r$")
+    if outputs[0] in _DISCRETE_OUTPUTS:  # r: the data and the paper's 0.8 in view, not the whole of (0, 1]
+        _fit_y(axes[0], reference[0] if reference is not None else None)
+    legend_beside(axes[0][-1], title=view.notes, handles_of=list(axes[0]))
+    paths = _save(fig, folder, stem, options)
+    plt.close(fig)
     return paths
+
+
+def _fit_y(axes: Sequence[Any], reference: float | None) -> None:
+    """One y range for `axes` from their data and `reference`, with a tenth of the span as margin on either side."""
+    low, high = np.inf, -np.inf
+    for ax in axes:
+        for artist in [*ax.collections, *ax.patches, *ax.lines]:
+            if artist.get_zorder() <= 0 or not artist.get_visible():
+                continue
+            if hasattr(artist, "get_datalim"):
+                box = artist.get_datalim(ax.transData)
+                ys = [box.y0, box.y1] if np.isfinite([box.y0, box.y1]).all() else []
+            elif hasattr(artist, "get_bbox"):
+                ys = [artist.get_bbox().y0, artist.get_bbox().y1]
+            else:
+                ys = [y for y in np.asarray(artist.get_ydata(), dtype=float) if np.isfinite(y)]
+            if ys and not (len(ys) == 2 and ys[0] == ys[1] == reference):
+                low, high = min(low, *ys), max(high, *ys)
+    if reference is not None:
+        low, high = min(low, reference), max(high, reference)
+    if np.isfinite([low, high]).all() and high > low:
+        margin = 0.1 * (high - low)
+        axes[0].set_ylim(low - margin, high + margin)
 
 
 def _nominal_levels(folder: Path, points: list[dict], nominal_text: str, note: str, options: PlotOptions) -> list[Path]:
     """The nominal point's resonant mean and max against the excitation level, with their standard errors and the
-    regime of each level shaded (`uq.outputs.results.nominal_regimes`); `note` heads the legend."""
+    regime of each level shaded (`uq.outputs.results.nominal_regimes`); `note` heads the legend. A study of one's own
+    draws it (`ies reproduce` shows the nominal point's levels in Fig. 6, a study of their own)."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(9.5, 4.4), layout="constrained")
     regimes = nominal_regimes(points)
@@ -337,7 +451,7 @@ def _nominal_levels(folder: Path, points: list[dict], nominal_text: str, note: s
         _errorbar(ax, *_curve(points, "nominal", "nominal", output), fmt, color=color, label=f"resonant {output}")
     ax.set_xlabel(LEVEL_LABEL)
     ax.set_ylabel(f"resonant response level {RESPONSE_LABEL}")
-    ax.set_title(f"Resonant levels of the {nominal_text}", fontsize=9)
+    ax.set_title("Resonant levels of the nominal point " + nominal_text.removeprefix("nominal "), fontsize=9)
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
     legend_beside(ax, title=note)
@@ -428,11 +542,21 @@ def sobol_figure(folder: str | Path, options: PlotOptions | None = None) -> list
 def read_overview(folder: Path, options: PlotOptions | None = None) -> dict[str, list]:
     """A folder's overview.csv as `sim.stepped_sine.tables.overview_data` keys (numbers as floats, the regime as text); with
     `options`, only the chosen levels."""
+    path = folder / "overview.csv"
     data: dict[str, list] = defaultdict(list)
-    for r in _rows(folder / "overview.csv", options):
+    for r in _rows(path, options):
         for key, value in r.items():
-            data["levels" if key == "level" else key].append(value if key == "regime" else float(value))
+            data["levels" if key == "level" else key].append(value if key == "regime" else _number(path, key, value))
     return dict(data)
+
+
+def _number(path: Path, column: str, text: str) -> float:
+    """A table's cell as a number; one line naming the file and the column where it is none (a damaged file)."""
+    try:
+        return float(text)
+    except ValueError:
+        raise SimulationInputError(f"{path}: {text!r} in column {column!r} is not a number (the file is damaged); rerun "
+                                   "the command that wrote it") from None
 
 
 @dataclass(frozen=True)

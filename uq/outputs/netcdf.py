@@ -237,8 +237,40 @@ def open_results(folder: str | Path) -> Any:
     try:
         return xr.load_dataset(path, engine=ENGINE)
     except (OSError, ValueError, KeyError, RuntimeError) as exc:
-        detail = re.search(r"\(([^()]*)\)\s*$", str(exc))
-        reason = detail.group(1) if detail else (str(exc).splitlines() or [type(exc).__name__])[0]
-        raise StudyError(f"{path} cannot be read ({reason}: damaged or cut short); rerun the study's command with "
-                         f"--resume and --out {path.parent} to write it again from the stored runs, or redraw the "
-                         f"figures from the CSV tables with ies plot {path.parent}") from None
+        raise StudyError(f"{path} cannot be read ({_reason(exc)}: damaged or cut short); {_rewrite(path)}") from None
+
+
+def _reason(exc: BaseException) -> str:
+    detail = re.search(r"\(([^()]*)\)\s*$", str(exc))
+    return detail.group(1) if detail else (str(exc).splitlines() or [type(exc).__name__])[0]
+
+
+def _rewrite(path: Path) -> str:
+    """How to write a damaged results.nc again: its study's command with --resume, which reads the stored runs and
+    recomputes nothing (the study file and kind from study.json where it can be read)."""
+    import json
+
+    try:
+        study = json.loads((path.parent / "study.json").read_text())["study"]
+        command = f"`ies {study['kind']} {study['source']} --out {path.parent} --resume`"
+    except (OSError, ValueError, KeyError, TypeError):
+        command = f"the study's command with --resume and --out {path.parent}"
+    return f"rerun {command} to write it again from the stored runs (nothing is recomputed)"
+
+
+def check_readable(folder: str | Path) -> None:
+    """One line (StudyError) when a results.nc in `folder` or a folder in it (`ies reproduce`'s figures, a series'
+    values) is damaged or cut short: the tables beside it were written by the same run and may be no better, so
+    `ies plot` and `ies compare` name it instead of drawing from them; the line says how to write it again."""
+    import h5py
+
+    folder = Path(folder)
+    for path in [folder / "results.nc", *sorted(folder.glob("*/results.nc"))]:
+        if not path.is_file():
+            continue
+        try:
+            with h5py.File(path, "r") as handle:  # the whole file's structure and every variable's data
+                handle.visititems(lambda name, item: item[()] if isinstance(item, h5py.Dataset) else None)
+        except (OSError, ValueError, KeyError, RuntimeError) as exc:
+            raise StudyError(f"{path} is damaged or cut short ({_reason(exc)}); {_rewrite(path)}, then run this "
+                             "command again") from None

@@ -46,15 +46,22 @@ def _figures(name: str, *args: Any) -> Callable[..., list[Path]]:
 
 
 def interval_figures(folder: str | Path, options: "PlotOptions | None" = None) -> list[Path]:
-    """Figs. 7 and 8 of an interval study (`uq.outputs.figures.interval_figures`) under this table's names: the individual
-    variation as INDIVIDUAL_FIGURE, the joint band of an output as the row that shows it (`box_figure`)."""
+    """Figs. 7 and 8 of an interval study (`uq.outputs.figures.interval_figures`). A study `ies reproduce` ran (its
+    study.json names the `paper_figure`) names them after this table, the individual variation INDIVIDUAL_FIGURE and
+    the joint band of an output after the row that shows it (`box_figure`), and leaves the nominal point's levels to
+    Fig. 6 (a study of its own); a study of one's own names them by what they show (OWN_FIGURES) and draws the nominal
+    point's levels too."""
     from uq.outputs.figures import interval_figures as draw
+
+    paper = json.loads((Path(folder) / "study.json").read_text()).get("paper_figure")
 
     def box(output: str) -> tuple[str, str, tuple[float, str] | None]:
         row = box_figure(output)
-        return row.name, row.box_titles.get(output) or next(iter(row.box_titles.values())), row.reference
+        title = row.box_titles.get(output) or next(iter(row.box_titles.values()))
+        return (row.name if paper else OWN_FIGURES["joint"]), title, row.reference
 
-    return draw(folder, options, individual_stem=INDIVIDUAL_FIGURE, box_figure=box)
+    return draw(folder, options, individual_stem=INDIVIDUAL_FIGURE if paper else OWN_FIGURES["individual"],
+                box_figure=box, nominal_levels=not paper)
 
 
 def response_figures(folder: str | Path, options: "PlotOptions | None" = None) -> list[Path]:
@@ -165,13 +172,12 @@ PAPER_FIGURES: dict[str, PaperFigure] = {row.name: row for row in (
     PaperFigure("fig8", "joint and residual variation of D, g, k_H (Sect. 5.4)", "fig8", None, response_table, True,
                 box_titles={"mean": "Joint variation (cf. Fig. 8)"}),
     PaperFigure("figD2", "impacts per period vs excitation level (Appendix D)", "figD2",
-                _figures("scattering_figure", "impacts", "impacts per period (cf. Fig. D.2)"), scattering_table, True),
+                _figures("scattering_figure", "impacts", "Impacts per period (cf. Fig. D.2)"), scattering_table, True),
     PaperFigure("figD3", "restitution vs excitation level (Appendix D)", "figD3",
-                _figures("scattering_figure", "restitution", "restitution, APR levels (cf. Fig. D.3)"),
+                _figures("scattering_figure", "restitution", "Restitution, APR levels (cf. Fig. D.3)"),
                 scattering_table, True,
-                box_titles={"restitution": "Modal coefficient of restitution from the tip, joint variation (cf. Fig. D.3)",
-                            "restitution_wall": "Modal coefficient of restitution from the wall, joint variation "
-                                                "(cf. Fig. D.3)"},
+                box_titles={"restitution": "Modal coefficient of restitution $r$ from the tip",
+                            "restitution_wall": "Modal coefficient of restitution $r$ from the wall"},
                 reference=(0.8, "paper: $r$ ~ 0.8 (Fig. D.3)")),
     PaperFigure("fig11", "damped contact law, Eq. 10 (Sect. 5.5)", "fig11",
                 _figures("series_figure", "cf. Fig. 11", (7.5, "paper: contact dissipation matters above 7.5")),
@@ -181,8 +187,10 @@ PAPER_FIGURES: dict[str, PaperFigure] = {row.name: row for row in (
                 series=True, traced=(1.26, 5.3)),
 )}
 
-#: the name under which `interval_figures` writes the individual variation (Fig. 7)
+#: the name under which `interval_figures` writes the individual variation (Fig. 7) of the paper's study
 INDIVIDUAL_FIGURE = "fig7"
+#: the names of an interval study's figures of one's own: by what they show
+OWN_FIGURES = {"individual": "individual-variation", "joint": "joint-variation"}
 #: the joint band's figure when no row claims the banded output
 DEFAULT_BOX_FIGURE = "fig8"
 

@@ -58,7 +58,9 @@ FILES = {
     "fig6": "Fig. 6: resonant mean and max against the excitation level, regimes and the optimum (the paper's marked)",
     "fig7": "Fig. 7: the resonant mean's band from D, g and k_H varied one at a time",
     "fig8": "Fig. 8: the joint band of D, g, k_H and the residual band with k_H at its best estimate",
-    "nominal-levels": "the nominal point's resonant mean and max at the interval study's levels (a by-product)",
+    "nominal-levels": "the nominal point's resonant mean and max at an interval study's levels (a study of one's own)",
+    "individual-variation": "an interval study's band of each parameter varied alone (as Fig. 7)",
+    "joint-variation": "an interval study's joint band and residual band (as Fig. 8)",
     "figD2": "Fig. D.2: impacts and significant impacts per period at the resonant eta against the level",
     "figD3": "Fig. D.3: modal coefficient of restitution r with its band from D and g",
     "fig11": "Fig. 11: the resonant mean for each r_cont,diss of the damped contact law (Eq. 10)",
@@ -105,7 +107,8 @@ def write_index(out: Path) -> Path:
              "in the workbench's source. Figures are written as PNG and PDF.", ""]
     folders = sorted({p.parent for p in out.rglob("*") if p.is_file() and "tasks" not in p.relative_to(out).parts})
     for folder in folders:
-        files = sorted(p for p in folder.iterdir() if p.is_file() and p.name != "index.md")
+        files = sorted(p for p in folder.iterdir() if p.is_file() and p.name != "index.md"
+                       and not p.name.startswith("."))  # not the run's lock (sim.common.folder_lock)
         if not files:
             continue
         rel = folder.relative_to(out).as_posix()

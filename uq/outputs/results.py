@@ -9,7 +9,6 @@ confidence intervals and the noise share. All read only the study's files.
 """
 from __future__ import annotations
 
-import csv
 import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -40,8 +39,9 @@ class Effect:
 
 
 def _rows(path: Path) -> list[dict]:
-    with open(path, newline="") as fh:
-        return list(csv.DictReader(fh))
+    from sim.common.files import read_rows
+
+    return read_rows(path)
 
 
 def nominal_regimes(points: list[dict], output: str = "mean") -> dict[float, str]:
@@ -137,13 +137,28 @@ def _with_se(value: float, se: float) -> str:
     return f"{value:.4f} +- {se:.4f}" if np.isfinite(se) else f"{value:.4f}        "
 
 
+#: standard errors a band must be wider than to be resolved (`unresolved`)
+RESOLVED_Z = 2.0
+
+
+def unresolved(lower: float, upper: float, lower_se: float, upper_se: float, z: float = RESOLVED_Z) -> bool:
+    """Whether a band is narrower than `z` combined standard errors of its edges: the band is noise there, so it is
+    not drawn as an area, and where the nominal value lies against it is not judged (the figures and `band_checks`)."""
+    width = float(upper) - float(lower)
+    noise = z * float(np.hypot(np.nan_to_num(float(lower_se)), np.nan_to_num(float(upper_se))))
+    return bool(np.isfinite(width) and width < noise)
+
+
 def band_checks(row: dict) -> str:
-    """The checks of one row of bands.csv in words: the monotonicity check (ok, failed: band widened, not tested)
-    and where the nominal value lies outside the band (beyond or within the noise)."""
+    """The checks of one row of bands.csv in words: the monotonicity check (ok, failed: band widened, not tested), a
+    band narrower than its noise (`unresolved`), and elsewhere where the nominal value lies outside the band (beyond
+    or within the noise)."""
     words = ["monotonicity not tested" if row["tested"] == "0" else
              ("NOT MONOTONE (band widened)" if row["flagged"] == "1" else "monotone")]
     nominal, lower, upper = (float(row[k]) for k in ("nominal", "lower", "upper"))
-    if row["nominal_outside"] != "-1" and not lower <= nominal <= upper:  # the figure's legend says it alike
+    if unresolved(lower, upper, row["lower_se"], row["upper_se"]):
+        words.append(f"band not resolved (narrower than {RESOLVED_Z:g} SE of its edges)")
+    elif row["nominal_outside"] != "-1" and not lower <= nominal <= upper:  # the figure's legend says it alike
         side = "above" if nominal > upper else "below"
         words.append(f"nominal {side} its band, " + ("BEYOND the noise" if row["nominal_outside"] == "1"
                                                     else "within the noise"))

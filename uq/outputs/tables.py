@@ -28,6 +28,8 @@ STUDY_JSON = OutputFile("study.json", "every study folder", "", (
            "(per parameter nominal, min, max, unit, label; _extras: k_H_best_estimate, k_H_calibrated in N/m^1.5), "
            "interval, sobol, response, contact_law, series"),
     Column("series_folders", "", "a series study: its values' folders"),
+    Column("paper_figure", "", "a study `ies reproduce` ran: the paper's figure it reproduces (its figures carry the "
+           "paper's names; a study of one's own names them by what they show)"),
     Column("output_folder", "", "absolute path of the folder"),
     Column("code_version", "", "hash of the simulator's source (part of every task key)"),
     Column("outputs, warnings", "", "the banded outputs; every warning of the run"),

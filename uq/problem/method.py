@@ -97,6 +97,9 @@ class Method(ABC):
     tables: ClassVar[tuple[Table, ...]] = ()
     #: the models it can run: None for any (`uq.problem.models`), else e.g. ("ies",) for the simulator only
     models: ClassVar[tuple[str, ...] | None] = None
+    #: keys of its table that a file of an earlier release may hold and that it ignores, each with the setting that
+    #: does that job here (key -> setting): the file still runs, with one line saying so (`uq.problem.study`)
+    superseded: ClassVar[Mapping[str, str]] = {}
 
     def finish(self, values: dict[str, Any], context: Context) -> dict[str, Any]:
         """The settings after the cross-key checks and computed defaults (one-line StudyError); the values as read."""

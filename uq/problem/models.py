@@ -15,7 +15,8 @@ Each model also aggregates the runs of one (point, level) over the repetitions: 
 -> {output: (value, standard error, samples)}; the simulator does it exactly as `ies sweep` does.
 
 Models are small picklable objects: they travel to joblib and Dask workers, and their ``version()``
-(a hash of the code that computes the outputs) is part of every cached task's key.
+(a hash of the code that computes the outputs: for the simulator its code version, which `ies --version` prints) is
+part of every cached task's key.
 """
 from __future__ import annotations
 
@@ -186,7 +187,11 @@ class IESModel:
         return self.rig if self.rig is not None else self._rig()
 
     def version(self) -> str:
-        return _source_version("sim", "uq/problem/models.py")
+        """The simulator's code version (`sim.common.kernel_cache.code_version`: what `ies --version` prints and the
+        kernel folder is named by); this file's own code, which turns a run into outputs, is in `describe`."""
+        from sim.common.kernel_cache import code_version
+
+        return code_version()
 
     def resolved_protocol(self) -> dict:
         """The protocol with every default filled in (for the study metadata)."""
@@ -207,13 +212,18 @@ class IESModel:
         task runs (and before anything is written)."""
         from sim.common.errors import SimulationInputError
         from sim.integration.integrators import get_integrator
+        from sim.model.system import check_resonant_mode
 
         protocol = self._stepped_sine()
         try:
             get_integrator(protocol.integrator, dt_scale=protocol.dt_scale)
         except SimulationInputError as exc:
             raise StudyError(f"[excitation]: {exc}") from None
-        self._rig()
+        rig = self._rig()
+        try:
+            check_resonant_mode(rig)  # walls at a node of mode 1: refused before any task runs
+        except SimulationInputError as exc:
+            raise StudyError(f"[study] modal_model {rig.source}: {exc}") from None
         self.check_physics({})
 
     def check_physics(self, params: Mapping[str, float]) -> None:
@@ -285,6 +295,28 @@ class IESModel:
 
         warm_up_all(self.kernel_variants())
 
+    def seconds_per_run(self, levels: list[float], runs: int) -> dict[float, float] | None:
+        """Estimated seconds of one run at each of `levels` on one core of this machine now
+        (`sim.stepped_sine.cost.seconds_per_run`: a probe of the study's protocol at its nominal point, the kernels
+        loaded by `warm_up`); None when `runs` runs cannot take long enough to be worth the probe."""
+        from sim.stepped_sine.cost import seconds_per_run, simulated_seconds, worth_probing
+
+        protocol = self._stepped_sine()
+        model, impactor = self.simulated_system({})
+        if not worth_probing(runs, simulated_seconds(protocol, float(model.omega[0]))):
+            return None
+        return seconds_per_run(model, impactor, levels, protocol)
+
+    def typical_seconds_per_run(self) -> float:
+        """Seconds of one run at the integrator's typical cost on one quiet core (`Integrator.typical_cost`): a size
+        before anything is compiled or measured."""
+        from sim.integration.integrators import integrator_named
+        from sim.stepped_sine.cost import simulated_seconds
+
+        protocol = self._stepped_sine()
+        rig = self.rig if self.rig is not None else self._rig()
+        return simulated_seconds(protocol, float(rig.omega[0])) * integrator_named(protocol.integrator).typical_cost
+
     def kernel_variants(self) -> list[tuple[str, str]]:
         """(integrator, contact law) of every kernel specialisation this study's runs use: its law and, since
         r_cont = 1 runs it, the law's elastic counterpart."""
@@ -300,8 +332,9 @@ class IESModel:
 
     def describe(self) -> dict:
         """Settings that define a task's computation (part of its cache key; the built-in rig is covered by
-        version, a modal file by its content)."""
-        out = {"class": type(self).__name__, "protocol": dict(self.protocol), "n_modes": self.n_modes}
+        version, a modal file by its content, the code that turns a run into outputs, this file, by its hash)."""
+        out = {"class": type(self).__name__, "protocol": dict(self.protocol), "n_modes": self.n_modes,
+               "outputs_code": _source_version("uq/problem/models.py")}
         from sim.model.contact_law import DEFAULT_LAW
 
         if self._law_name() != DEFAULT_LAW:  # the default law is not in the key (keys from before the choice)

@@ -250,13 +250,6 @@ def resolve_value(name: str, value: object, *, base_dir: Path | None = None, k_H
     return value
 
 
-def plausibility_warning(name: str, value: float) -> str | None:
-    """`sim.common.units.implausible` for the parameters of `PARAMETERS` with a unit parser (a clearance above 10 mm,
-    a k_H below 1e6 N/m^1.5, ...)."""
-    row = PARAMETERS.get(name)
-    return None if row is None else row.implausible(value)
-
-
 def calibrated_k_H(source: str | Path | Mapping) -> float:
     """k_H (N/m^1.5) from the JSON output of `ies calibrate --json` (a file path or the parsed dict)."""
     if isinstance(source, Mapping):

@@ -77,7 +77,7 @@ from sim.model.parameters import PARAMETERS
 from uq.errors import StudyError
 from uq.problem.cluster_settings import ClusterSettings, parse_cluster_table
 from uq.problem.models import ResponseModel, make_model
-from uq.problem.space import K_H_STAR, Parameter, ParameterSpace, plausibility_warning, resolve_k_H, resolve_value
+from uq.problem.space import K_H_STAR, Parameter, ParameterSpace, resolve_k_H, resolve_value
 
 #: the tables every study may have; the method's own table is named after its kind (`Method.kind`)
 COMMON_TABLES = {
@@ -95,12 +95,14 @@ _PARAM_KEYS = {"nominal", "min", "max", "best_estimate"}
 @dataclass(frozen=True)
 class Context:
     """What a method's settings are read against: the study's kind, parameter space, the folder that relative paths
-    in the file start from, and the file read (for warnings)."""
+    in the file start from, the file read (for warnings), and whether values of implausible magnitude are allowed
+    (--allow-implausible, `check_plausible`)."""
 
     kind: str
     space: ParameterSpace
     base_dir: Path = Path(".")
     source: str = ""
+    allow_implausible: bool = False
 
 
 @dataclass(frozen=True)
@@ -155,6 +157,8 @@ class Study:
     g_star: float | None = None
     #: where the study runs ([cluster], uq.engine.cluster); not part of its results, so left out of to_dict and the key
     cluster: ClusterSettings | None = None
+    #: whether it was read with --allow-implausible (values of implausible magnitude computed as given)
+    allow_implausible: bool = field(default=False, compare=False)
 
     def make_model(self) -> ResponseModel:
         """The study's response model (`uq.problem.models.make_model`)."""
@@ -164,7 +168,8 @@ class Study:
 
     def context(self) -> Context:
         """What its method's settings are read against (`Context`)."""
-        return Context(self.kind, self.space, Path(self.source).parent if self.source else Path("."), self.source)
+        return Context(self.kind, self.space, Path(self.source).parent if self.source else Path("."), self.source,
+                       self.allow_implausible)
 
     def to_dict(self) -> dict:
         """The resolved study as plain data (study.json's "study", results.nc's attribute): the common keys and the
@@ -216,10 +221,12 @@ def with_calibration(study: Study, k_H_cal: float) -> Study:
     return replace(study, space=new_space, settings=settings)
 
 
-def read_study(path: str | Path, methods: Mapping[str, Any], elsewhere: Mapping[str, str] | None = None) -> Study:
+def read_study(path: str | Path, methods: Mapping[str, Any], elsewhere: Mapping[str, str] | None = None, *,
+               allow_implausible: bool = False) -> Study:
     """Read and validate a study file against the methods of a registry (`uq.methods.load_study` passes its own);
     errors are one-line `StudyError`s naming the file. `elsewhere`: kinds that another command runs (kind ->
-    that command), refused with its name."""
+    that command), refused with its name; allow_implausible: compute with values of implausible magnitude
+    (`check_plausible`) instead of refusing them."""
     path = Path(path)
     try:
         data = tomllib.loads(path.read_text())
@@ -232,7 +239,8 @@ def read_study(path: str | Path, methods: Mapping[str, Any], elsewhere: Mapping[
     except UnicodeDecodeError:
         raise StudyError(f"{path} is not a text (TOML) file")
     try:
-        return parse_study(data, methods, base_dir=path.parent, source=str(path), elsewhere=elsewhere)
+        return parse_study(data, methods, base_dir=path.parent, source=str(path), elsewhere=elsewhere,
+                           allow_implausible=allow_implausible)
     except StudyError as exc:
         raise StudyError(f"{path}: {exc}") from None
 
@@ -279,7 +287,7 @@ def kinds_of(methods: Mapping[str, Any]) -> dict[str, list[Any]]:
 
 
 def parse_study(data: Mapping[str, Any], methods: Mapping[str, Any], *, base_dir: Path = Path("."),
-                source: str = "", elsewhere: Mapping[str, str] | None = None) -> Study:
+                source: str = "", elsewhere: Mapping[str, str] | None = None, allow_implausible: bool = False) -> Study:
     """Validate the parsed TOML of a study (see `read_study`)."""
     kinds = kinds_of(methods)
     elsewhere = dict(elsewhere or {})
@@ -332,7 +340,7 @@ def parse_study(data: Mapping[str, Any], methods: Mapping[str, Any], *, base_dir
         raise StudyError(f"[variant] higher_mode_damping must lie in (0, 1), got {variant['higher_mode_damping']}")
     impactor = _parse_impactor(data.get("impactor", {}))
     exc = dict(data.get("excitation", {}))
-    g_star = _parse_g_star(exc.pop("g_star", None))
+    g_star = _parse_g_star(exc.pop("g_star", None), allow_implausible)
     if (impactor or g_star is not None) and model_spec != "ies":
         raise StudyError("[impactor] and [excitation] g_star only apply to model = \"ies\" (the simulator)")
     table = data.get("parameters")
@@ -342,7 +350,7 @@ def parse_study(data: Mapping[str, Any], methods: Mapping[str, Any], *, base_dir
         names = {by_key.get(key, key): spec for key, spec in names.items()}
     host_model = make_model(model_spec, parameters=tuple(names), modal_model=modal_model, variant=variant,
                             impactor=impactor, g_star=g_star)
-    space = _parse_parameters(table, model_spec, base_dir, source, host_model)
+    space = _parse_parameters(table, model_spec, base_dir, host_model, allow_implausible)
 
     levels_raw = exc.pop("levels", [1.0] if model_spec != "ies" else None)
     if levels_raw is None:
@@ -355,7 +363,7 @@ def parse_study(data: Mapping[str, Any], methods: Mapping[str, Any], *, base_dir
     protocol = _parse_protocol(exc)
 
     table = data.get(kind, {})
-    context = Context(kind, space, base_dir, source)
+    context = Context(kind, space, base_dir, source, allow_implausible)
     method, settings = method_settings(kinds[kind], table, context)
     if method.models is not None and model_spec not in method.models:
         raise StudyError(f"a{'n' if kind[0] in 'aeiou' else ''} {kind} study runs the simulator: model = \"ies\"")
@@ -367,7 +375,8 @@ def parse_study(data: Mapping[str, Any], methods: Mapping[str, Any], *, base_dir
     study = Study(name=name, kind=kind, method=method, settings=settings, table=dict(table), model=model_spec,
                   space=space, levels=levels, repetitions=reps, seed=seed, output=output, protocol=protocol,
                   source=source, modal_model=modal_model, variant=variant, outputs=tuple(outputs),
-                  contact_law=contact_law, impactor=impactor, g_star=g_star, cluster=cluster)
+                  contact_law=contact_law, impactor=impactor, g_star=g_star, cluster=cluster,
+                  allow_implausible=allow_implausible)
     for _, one in method.substudies(study):
         _parse_contact_law({"contact_law": contact_law}, one.space)  # every value of a series in range
     model = study.make_model()  # unknown model -> one line now
@@ -403,6 +412,7 @@ def method_settings(candidates: list[Any], table: Mapping[str, Any], context: Co
     own = {s.key for s in method.settings}
     if chosen and chosen != from_file:  # the command line switched the method: the file's keys of the other go
         table = {k: v for k, v in table.items() if k in own}
+    ignored = {k: table.pop(k) for k in list(table) if k in method.superseded}  # a file of an earlier release
     others: dict[str, list[str]] = {}
     for m in candidates:
         if m is not method:
@@ -430,7 +440,14 @@ def method_settings(candidates: list[Any], table: Mapping[str, Any], context: Co
             values[s.key] = s.read(table[s.key], context)
         else:
             values[s.key] = s.default
-    return method, method.finish(values, context)
+    values = method.finish(values, context)
+    for key, value in ignored.items():
+        instead = method.superseded[key]
+        where = f"{context.source}: " if context.source else ""
+        sys.stderr.write(f"warning: {where}[{kind}] {key} = {value!r} is not a setting of method = \"{method.name}\" "
+                         f"(an earlier release ignored it too) and is ignored: its setting is {instead}, here "
+                         f"{instead} = {values[instead]!r}; remove {key} or write {instead} = N\n")
+    return method, values
 
 
 def with_settings(study: Study, methods: Mapping[str, Any], given: Mapping[str, Any]) -> Study:
@@ -487,8 +504,9 @@ def _parse_impactor(table: Any) -> dict[str, Any]:
     return out
 
 
-def _parse_g_star(value: Any) -> float | None:
-    """[excitation] g_star: the nominal clearance g* (m, or with its unit) of the levels, None when not given."""
+def _parse_g_star(value: Any, allow_implausible: bool = False) -> float | None:
+    """[excitation] g_star: the nominal clearance g* (m, or with its unit) of the levels, None when not given; an
+    implausible magnitude refused unless `allow_implausible` (`check_plausible`)."""
     if value is None:
         return None
     from sim.common.errors import SimulationInputError
@@ -497,15 +515,16 @@ def _parse_g_star(value: Any) -> float | None:
         g_star = PARAMETERS["g"].check(PARAMETERS["g"].parse(value))
     except SimulationInputError as exc:
         raise StudyError(f"[excitation] g_star: {exc}") from None
-    warn_implausible("", "[excitation] g_star", "g", g_star)
+    check_plausible("[excitation] g_star", "g", g_star, value, allow_implausible)
     return g_star
 
 
-def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir: Path, source: str,
-                      model: ResponseModel | None = None) -> ParameterSpace:
+def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir: Path,
+                      model: ResponseModel | None = None, allow_implausible: bool = False) -> ParameterSpace:
     """The parameter space of [parameters.KEY] tables against `model`'s default space (for the simulator: Table 2 for
     its host and sphere); for the simulator KEY is a row's study key in `sim.model.parameters.PARAMETERS` (its name in
-    the space, CSV columns and messages is the row's name)."""
+    the space, CSV columns and messages is the row's name); a value of implausible magnitude is refused unless
+    `allow_implausible` (`check_plausible`)."""
     if table is not None and model_spec == "ies":
         by_key = {row.study_key: name for name, row in PARAMETERS.items()}
         table = {by_key.get(key, key): spec for key, spec in table.items()}
@@ -544,7 +563,9 @@ def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir
             # an optional parameter's missing bound is its nominal value (a fixed value needs nominal only)
             fallback = spec.get("nominal", p.nominal) if p in listed_optional else getattr(p, key)
             values[key] = resolve_value(p.name, spec.get(key, fallback), base_dir=base_dir, k_H_star=k_H_star)
-            warn_implausible(source, f"[parameters.{p.name}] {key}", p.name, values[key])
+            if key in spec:
+                check_plausible(f"[parameters.{PARAMETERS[p.name].study_key if p.name in PARAMETERS else p.name}] {key}",
+                                p.name, values[key], spec[key], allow_implausible)
         if "best_estimate" in spec:
             if p.name != "k_H":
                 raise StudyError(f"[parameters.{p.name}] best_estimate is only defined for k_H")
@@ -556,13 +577,19 @@ def _parse_parameters(table: Mapping[str, Any] | None, model_spec: str, base_dir
     return ParameterSpace(tuple(params), extras)
 
 
-def warn_implausible(source: str, where: str, name: str, value: object) -> None:
-    """One warning line on stderr when a value of g or k_H in study file `source` has an implausible magnitude
-    (probably a unit slip)."""
+def check_plausible(where: str, name: str, value: object, raw: object, allow: bool) -> None:
+    """A study file's value `raw` of the parameter `name` at `where` ("[parameters.g] max"), read as `value` (SI),
+    refused with one line (StudyError) when its magnitude is implausible for its quantity (a unit slip: 0.612 for
+    0.612 mm, 0.085 for 0.085 %), naming the reading that would make it plausible, unless `allow`
+    (`sim.model.parameters.check_plausible`, as on the command line)."""
+    from sim.common.errors import SimulationInputError
+    from sim.model.parameters import Typed, check_plausible as check
+
     if isinstance(value, (int, float)) and not isinstance(value, bool):
-        warning = plausibility_warning(name, value)
-        if warning:
-            sys.stderr.write(f"warning: {source + ': ' if source else ''}{where}: {warning}\n")
+        try:
+            check({name: Typed(value, str(raw))}, allow=allow, where=lambda row, v: f"{where} = {raw!r}")
+        except SimulationInputError as exc:
+            raise StudyError(str(exc)) from None
 
 
 def _check_param_table(name: str, spec: Any) -> Mapping[str, Any]:

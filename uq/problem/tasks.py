@@ -25,12 +25,17 @@ class Task:
         return Task(tuple(sorted((k, float(v)) for k, v in params.items())), float(level), int(rep))
 
 
-def check_run_total(points: int, levels: int, repetitions: int, *, allow_large: bool = False) -> int:
-    """The run total points x levels x repetitions, refused (one line with the count and how to ask for less) above
-    `MAX_RUNS` unless `allow_large`."""
+def check_run_total(points: int, levels: int, repetitions: int, *, allow_large: bool = False,
+                    per_run_s: float | None = None) -> int:
+    """The run total points x levels x repetitions, refused (one line with the count, the time at `per_run_s` seconds
+    per run, the model's typical cost where it has one, and how to ask for less) above `MAX_RUNS` unless
+    `allow_large`."""
+    from sim.stepped_sine.cost import duration_text
+
     runs = points * levels * repetitions
     if runs > MAX_RUNS and not allow_large:
-        raise StudyError(f"{runs:,} runs ({points:,} parameter points x {levels} levels x {repetitions} repetitions) "
-                         f"exceed the {MAX_RUNS:,} a study runs without --allow-large (days on a workstation): ask for "
-                         "fewer points, levels or repetitions, or pass --allow-large")
+        time = "" if not per_run_s else f", about {duration_text(runs * per_run_s)} on one core"
+        raise StudyError(f"{runs:,} runs ({points:,} parameter points x {levels} levels x {repetitions} repetitions"
+                         f"{time}) exceed the {MAX_RUNS:,} a study runs without --allow-large: ask for fewer points, "
+                         "levels or repetitions, or pass --allow-large")
     return runs

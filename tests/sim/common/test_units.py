@@ -3,7 +3,7 @@ import pytest
 
 from sim.common.errors import SimulationInputError
 from sim.model.system import CLEARANCE_NOMINAL, K_H_NOMINAL
-from sim.common.units import CLEARANCE, K_H, implausible, parse_quantity
+from sim.common.units import CLEARANCE, DAMPING, K_H, implausible, parse_quantity
 
 
 @pytest.mark.parametrize("text, value", [
@@ -33,9 +33,20 @@ def test_plausible_values_pass_silently():
         assert implausible(k, K_H) is None
 
 
-def test_unit_slips_name_the_value_probably_meant():
-    assert implausible(0.58, CLEARANCE) == ("clearance g = 0.58 m is implausible (above 10 mm); did you mean 0.58 mm "
-                                            "= 0.00058 m? Give the unit: 0.58mm")
-    k = implausible(282e3, K_H)
-    assert "below 1e+06 N/m^1.5" in k and "did you mean 282000 N/mm^1.5 = 8.918e+09 N/m^1.5" in k
-    assert implausible(1e-7, CLEARANCE) == "clearance g = 1e-07 m is implausible (below 10 um)"  # no unit fits
+def test_unit_slips_name_the_reading_probably_meant():
+    assert implausible(0.58, CLEARANCE) == "0.58 m is implausible for a clearance g (above 10 mm); did you mean 0.58mm?"
+    k = implausible(282e3, K_H, "282e3")
+    assert "below 1e+06 N/m^1.5" in k and k.endswith("did you mean 282e3N/mm^1.5?")
+    assert implausible(1e-7, CLEARANCE) == "1e-07 m is implausible for a clearance g (below 10 um)"  # no unit fits
+    assert implausible(0.085, DAMPING) == "8.5 % is implausible for a damping ratio (above 5 %); did you mean 0.085%?"
+    assert implausible(0.00085, DAMPING) is None and implausible(0.05, DAMPING) is None
+    # a number typed with its unit is no slip of that unit: 8.5% stays 8.5 %, 0.6m may be 0.6mm
+    assert implausible(0.085, DAMPING, "8.5%") == "8.5 % is implausible for a damping ratio (above 5 %)"
+    assert implausible(0.6, CLEARANCE, "0.6m").endswith("did you mean 0.6mm?")
+
+
+def test_a_damping_ratio_takes_percent():
+    assert parse_quantity("0.085%", DAMPING) == pytest.approx(0.00085, rel=1e-15)
+    assert parse_quantity("0.085 %", DAMPING) == parse_quantity(0.00085, DAMPING)
+    with pytest.raises(SimulationInputError, match="unknown unit 'mm'"):
+        parse_quantity("0.085mm", DAMPING)

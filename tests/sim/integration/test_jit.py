@@ -91,6 +91,28 @@ def test_an_edit_of_a_callee_file_reaches_the_cached_caller(tmp_path):
         "numba now follows edits of callee files by itself: sim.integration.jit's invalidation may no longer be needed")
 
 
+@pytest.mark.slow
+def test_an_edit_outside_the_kernels_is_a_new_code_version_that_compiles_nothing(tmp_path):
+    """The simulator's kernels live in the folder of its code version (the hash `ies --version` prints): an edit of a
+    file without kernels gives a new version and a new folder, which starts from the machine code of the same kernel
+    sources (hard links), so the cached kernel is loaded, not compiled."""
+    shutil.copytree(SIM_DIR, tmp_path / "sim", ignore=shutil.ignore_patterns("__pycache__"))
+    package = tmp_path / "sim" / "integration"
+    (package / "flight.py").write_text((package / "flight.py").read_text() + PROBE_CALLEE.format(value=1.0))
+    (package / "exact.py").write_text((package / "exact.py").read_text() + PROBE_CALLER)
+    run = ("from sim.integration import exact, jit; from sim.common.kernel_cache import code_version; "
+           "value = exact.probe_caller(); print(value, sum(exact.probe_caller.stats.cache_hits.values()), "
+           "jit.cache_folder().name, code_version())")
+    value, hits, folder, version = _run(tmp_path, run).split()
+    assert (value, hits, folder) == ("1.0", "0", f"sim-{version}")  # compiled into the folder of the code version
+    cli = tmp_path / "sim" / "cli.py"
+    cli.write_text(cli.read_text() + "\n# an edit outside the kernels\n")
+    value, hits, edited, new_version = _run(tmp_path, run).split()
+    assert (value, hits, edited) == ("1.0", "1", f"sim-{new_version}") and new_version != version
+    first, second = (next((tmp_path / "cache" / name).glob("exact.probe_caller-*.nbi")) for name in (folder, edited))
+    assert first.stat().st_ino == second.stat().st_ino  # one file on disk
+
+
 def test_every_module_with_kernels_is_fingerprinted():
     """A kernel module missing from KERNEL_MODULES (or, for the inlined contact laws, FINGERPRINT_FILES) would not
     invalidate its callers' caches."""

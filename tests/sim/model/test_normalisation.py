@@ -85,7 +85,7 @@ def test_modes_reports_the_impactor_and_the_mass_ratio(capsys):
     (["--wall-material", "wood"], "unknown wall material 'wood'; choose one of steel, aluminium, titanium, brass, cast-iron"),
     (["--material", "gold"], "unknown sphere material 'gold'; choose one of brass, steel, tungsten"),
     (["--radius", "5mm", "--material", "steel", "--mass", "1g"], "--mass 1 g disagrees with a solid steel sphere"),
-    (["--radius", "5"], "sphere radius R = 5 m is implausible"),
+    (["--radius", "5"], "5 m is implausible for a sphere radius R (above 0.1 m); did you mean 5mm?"),
 ])
 def test_bad_sphere_options_are_one_line(args, message, tmp_path, capsys):
     out = tmp_path / "out"

@@ -61,14 +61,14 @@ def test_table2_and_its_spreads_are_the_papers_numbers():
 
 def test_every_rule_is_the_rows_on_the_command_line_and_in_study_files():
     """One check per row (`UncertainParameter.problem`): the same sentence whichever way a value arrives."""
-    assert PARAMETERS["D"].problem(1.5) == "D must lie in (0, 1): must be below 1 (a damping ratio, e.g. 0.00085), got 1.5"
+    assert PARAMETERS["D"].problem(1.5) == "D must lie in (0, 1): must be below 1 (a damping ratio, e.g. 0.00085 or 0.085%), got 1.5"
     assert PARAMETERS["D"].problem(0.0).startswith("D must lie in (0, 1): must be > 0")
     assert PARAMETERS["r_cont"].problem(1.0) is None and "must be at most 1" in PARAMETERS["r_cont"].problem(1.2)
     assert PARAMETERS["friction"].problem(0.0) is None
     assert PARAMETERS["friction"].problem(-0.1).startswith("the friction coefficient mu must be >= 0")
     assert PARAMETERS["g"].problem(float("nan")).startswith("clearance g must be a positive number")
     assert PARAMETERS["g"].parse("0.6mm") == pytest.approx(0.6e-3, rel=1e-15)
-    assert "did you mean 0.58 mm" in PARAMETERS["g"].implausible(0.58)
+    assert "did you mean 0.58mm" in PARAMETERS["g"].implausible(0.58)
 
 
 def test_a_new_input_reaches_the_impactor_through_ies_sweep(undersize, model_file, capsys):

@@ -177,6 +177,6 @@ def test_open_study_of_a_damaged_results_file_is_one_line(tmp_path, damage):
         open_study(tmp_path)
     line = str(caught.value)
     assert "\n" not in line and line.startswith(f"{path} cannot be read (")
-    assert "damaged or cut short" in line and "--resume" in line and f"ies plot {tmp_path}" in line
+    assert "damaged or cut short" in line and "--resume" in line and "nothing is recomputed" in line
     path.write_bytes(whole)  # the file itself may be named too
     assert open_study(path)["mean"].values.tolist() == list(np.arange(200.0))
