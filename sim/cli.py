@@ -110,8 +110,8 @@ def modes_table(data: dict) -> str:
     if data["beam_mass_kg"] is not None:
         paper = f" (paper: ca. {data['rig']['beam_mass_paper_kg']:g} kg)" if data.get("rig") else ""
         lines.append(f"beam mass (free length without block, Eq. 10): {data['beam_mass_kg']:.4f} kg{paper}")
-    lines.append(host_text(data["host"]))
     sphere = data["impactor"]
+    lines.append(host_text(data["host"], sphere["wall_material"]["name"]))
     lines.append(f"sphere R = {1e3 * sphere['radius_m']:.4g} mm {sphere['material']['name']}, m_a = "
                  f"{1e3 * sphere['mass_kg']:.4g} g, k_H* = {sphere['k_H_star_N_per_m1p5'] / 1e3**1.5:.6g} N/mm^1.5 (Eq. 8 "
                  f"on {sphere['wall_material']['name']})")
@@ -346,10 +346,13 @@ def host_data(model: Any) -> dict:
             "wall_material": model.wall_material.describe(), "wall_material_given": model.wall is not None}
 
 
-def host_text(host: dict) -> str:
-    """One line of `host_data`: nominal damping, interval and wall."""
+def host_text(host: dict, sphere_wall: str | None = None) -> str:
+    """One line of `host_data`: nominal damping, interval and wall (and the wall the sphere is pressed on by Eq. 8
+    when --wall-material overrides the host's)."""
     low, high = host["damping_interval"]
     wall = host["wall_material"]["name"] + ("" if host["wall_material_given"] else " (none given: the rig's)")
+    if sphere_wall is not None and sphere_wall != host["wall_material"]["name"]:
+        wall += f"; --wall-material {sphere_wall} used for Eq. 8"
     source = "" if host["damping_interval_source"] == "the host's damping interval" else " (Table 2's, relative)"
     return (f"host: D_1* = {100 * host['D_star']:.4g} %, interval {100 * low:.4g}-{100 * high:.4g} %{source}; walls "
             f"{wall}")

@@ -62,6 +62,13 @@ def test_table_is_readable(capsys):
     assert "sphere R = 7.92 mm brass, m_a = 17.7 g, k_H* = 282000 N/mm^1.5 (Eq. 8 on steel)" in out
 
 
+def test_the_host_line_says_when_the_sphere_is_pressed_on_another_wall(capsys):
+    assert main(["modes", "--radius", "5mm", "--material", "steel", "--wall-material", "aluminium"]) == 0
+    out = capsys.readouterr().out
+    assert "walls steel; --wall-material aluminium used for Eq. 8" in out
+    assert "(Eq. 8 on aluminium)" in out
+
+
 def test_save_then_load_through_the_cli(tmp_path, capsys):
     path = tmp_path / "rig.toml"
     assert main(["modes", "--save", str(path)]) == 0
