@@ -61,3 +61,21 @@ def sleepy(params: dict, level: float, rep: int, seed: int) -> float:
 
     time.sleep(0.25)
     return sum(params.values()) + level
+
+
+def one_line(capsys, code: int, expected: int, *phrases: str, absent: tuple[str, ...] = ()) -> str:
+    """Assert exit code `expected` with one line on stderr holding `phrases` and none of `absent`; return the line."""
+    err = capsys.readouterr().err
+    assert code == expected, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    for phrase in phrases:
+        assert phrase in err, err
+    for phrase in absent:
+        assert phrase not in err, err
+    return err
+
+
+def refused(capsys, code: int, *phrases: str) -> str:
+    """Assert the one-line refusal (exit 2) and return its line."""
+    return one_line(capsys, code, 2, *phrases)
+

@@ -12,19 +12,7 @@ import pytest
 
 from uq.cli import main
 
-from tests.support import FAST, STUDIES
-
-
-
-
-def refused(capsys, code: int, *phrases: str) -> str:
-    """Assert the one-line refusal (exit 2) and return its line."""
-    err = capsys.readouterr().err
-    assert code == 2, err
-    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
-    for phrase in phrases:
-        assert phrase in err, err
-    return err
+from tests.support import FAST, STUDIES, refused
 
 
 def files_in(folder: Path) -> list[Path]:

@@ -18,21 +18,7 @@ import pytest
 import sim.common.files
 from uq.cli import main
 
-from tests.support import FAST, STUDIES
-
-
-
-
-def one_line(capsys, code: int, expected: int, *phrases: str, absent: tuple[str, ...] = ()) -> str:
-    """Assert exit code `expected` with one line on stderr holding `phrases` and none of `absent`; return the line."""
-    err = capsys.readouterr().err
-    assert code == expected, err
-    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
-    for phrase in phrases:
-        assert phrase in err, err
-    for phrase in absent:
-        assert phrase not in err, err
-    return err
+from tests.support import FAST, STUDIES, one_line
 
 
 def names(folder: Path) -> list[str]:

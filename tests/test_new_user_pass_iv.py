@@ -18,20 +18,10 @@ import pytest
 
 from uq.cli import main
 
-from tests.support import FAST
+from tests.support import FAST, one_line
 
 ROOT = Path(__file__).resolve().parents[1]
 ISHIGAMI = "[study]\nkind = 'sobol'\nmodel = 'ishigami'\nseed = 5\n[sobol]\nn = {n}\nbootstrap = 20\n"
-
-
-def one_line(capsys, code: int, expected: int, *phrases: str) -> str:
-    """Assert exit code `expected` with one line on stderr holding `phrases`; return the line."""
-    err = capsys.readouterr().err
-    assert code == expected, err
-    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
-    for phrase in phrases:
-        assert phrase in err, err
-    return err
 
 
 def ishigami(tmp_path: Path, n: int = 8) -> Path:

@@ -15,6 +15,8 @@ import pytest
 
 from uq.cli import build_parser, main
 
+from tests.support import refused
+
 README = Path(__file__).resolve().parents[3] / "README.md"
 
 
@@ -83,15 +85,6 @@ def test_identify_json(walked, capsys):
     assert len(data["frequencies_hz"]) == len(data["damping_ratios"]) == 4
     assert data["frequencies_hz"][0] == pytest.approx(117.4, rel=5e-4)
     assert data["damping_ratios"][0] == pytest.approx(0.0006, rel=0.1)  # the window's damping known from frf.csv
-
-
-def refused(capsys, code: int, *phrases: str) -> str:
-    err = capsys.readouterr().err
-    assert code == 2, err
-    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
-    for phrase in phrases:
-        assert phrase in err, err
-    return err
 
 
 def write(path: Path, header: str, rows: np.ndarray) -> str:

@@ -12,14 +12,7 @@ import pytest
 from sim.orbits.tables import ORBITS_COLUMNS
 from uq.cli import main
 
-
-def one_line(capsys, code: int, expected: int, *phrases: str) -> str:
-    err = capsys.readouterr().err
-    assert code == expected, err
-    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
-    for phrase in phrases:
-        assert phrase in err, err
-    return err
+from tests.support import one_line
 
 
 def test_the_frequency_response_of_a_three_mode_host(tmp_path, model_file, capsys):
