@@ -218,6 +218,25 @@ class DesignProblem:
             text += f"; the larger ones need a wider block (--block-width {math.ceil(wide * 1e4) / 10:g}mm takes them all)"
         return text
 
+    def edge_text(self, design: Design) -> str:
+        """Where a design lies on an edge of the grid that can hold it (the largest or smallest clearance of its sphere
+        that fits the block, the largest or smallest radius), in words with the option that would look beyond; "" inside.
+        The search sees only the grid: an optimum on its edge may lie beyond it."""
+        said = []
+        fitting = sorted(g for g in self.clearances if self.fits(Design(g, design.radius, design.material, self.wall)))
+        if len(fitting) > 1 and design.clearance == fitting[-1]:
+            cut = fitting[-1] < max(self.clearances)
+            said.append(f"the largest clearance {'that fits the block' if cut else 'of --clearance'} "
+                        f"({design.clearance * 1e3:.3g} mm): larger ones were not tried"
+                        f" ({'--block-width' if cut else 'widen --clearance'})")
+        elif len(fitting) > 1 and design.clearance == fitting[0]:
+            said.append(f"the smallest clearance of --clearance ({design.clearance * 1e3:.3g} mm): smaller ones were "
+                        "not tried (widen --clearance)")
+        if len(self.radii) > 1 and design.radius in (min(self.radii), max(self.radii)):
+            end = "largest" if design.radius == max(self.radii) else "smallest"
+            said.append(f"the {end} radius of --radius ({design.radius * 1e3:.3g} mm)")
+        return ("on the edge of the grid: " + "; ".join(said)) if said else ""
+
     def box_text(self) -> str:
         """The uncertainty box in words, with where D_1's interval comes from."""
         t, f = self.clearance_tolerance, self.k_H_factor

@@ -250,7 +250,9 @@ DESIGN_JSON = OutputFile("design.json", "ies design", "The design's settings, ho
                            "apr_seen_at_m, margin_worst, margin_nominal, admissible, round"),
     Column("recommendation", "", "the best admissible verified design (as in verified), its sentence, "
                                  "reduction_vs_no_absorber (-) and check_command: the ies sweep line that simulates it at "
-                                 "its deciding cell; null when no verified design is admissible (see refusal)"),
+                                 "its deciding cell, range_edge: where it lies on an edge of the grid (a larger or smaller clearance or "
+                                 "radius was not tried; null inside); null when no verified design is admissible (see "
+                                 "refusal)"),
     Column("refusal", "", "why no design is recommended (every verified design not admissible); null otherwise"),
     Column("baseline", "", "the baseline's verification and ratio_to_recommendation (-); null without --baseline"),
     Column("no_absorber", "", "the structure without IES: D_1 (the host's nominal D_1*) and tip_m (m) per level"),
@@ -451,7 +453,8 @@ def write_design(result: DesignResult, mode: Any) -> list[Any]:
                            {**verified_data(best), "sentence": result.sentence(),
                             "reduction_vs_no_absorber": (float(np.max(result.no_absorber)) / best.worst
                                                          if o.unit == "m" else None),
-                            "check_command": result.check_command()}),
+                            "check_command": result.check_command(),
+                            "range_edge": p.edge_text(best.design) or None}),
         "refusal": result.refusal,
         "baseline": (None if result.baseline is None else
                      {**verified_data(result.baseline), "ratio_to_recommendation": result.baseline.worst / best.worst}),
@@ -581,5 +584,8 @@ def design_table(result: DesignResult) -> str:
                      f"{result.baseline.worst / result.recommendation.worst:.2f}x lower")
     lines.append("the host's modes are taken as they are (the cavity's change of the host's mass is neglected)")
     lines.append("recommendation: " + result.sentence())
+    edge = p.edge_text(result.recommendation.design)
+    if edge:
+        lines.append(edge)
     lines.append("check it: " + result.check_command())
     return "\n".join(lines)

@@ -595,3 +595,21 @@ def test_overlapping_intervals_get_more_repetitions_until_they_part_or_the_budge
     assert reps_at[a][(0, 2)] == most and reps_at[b][(0, 2)] == most
     text = settling.text(verified, lambda x: f"{x:.3g}", "mm")
     assert ("ranking settled" in text) == settled and ("within the noise" in text) == (not settled)
+
+
+def test_a_design_on_the_edge_of_the_grid_says_what_was_not_tried():
+    """The search sees only the grid: the largest clearance (of the range, or that fits the block), the smallest, the
+    largest or smallest radius are said with the option that looks beyond; a design inside says nothing."""
+    wide = dp.DesignProblem(excitation=(2e-6,), clearances=(0.6e-3, 1.0e-3, 1.4e-3), radii=(6e-3, 7e-3, 7.92e-3),
+                            block_width=60e-3)
+    assert wide.edge_text(dp.Design(1.0e-3, 7e-3, "brass")) == ""
+    top = wide.edge_text(dp.Design(1.4e-3, 7e-3, "brass"))
+    assert "largest clearance of --clearance (1.4 mm)" in top and "widen --clearance" in top and "radius" not in top
+    bottom = wide.edge_text(dp.Design(0.6e-3, 7.92e-3, "brass"))
+    assert "smallest clearance" in bottom and "the largest radius of --radius (7.92 mm)" in bottom
+    # 2R + 2g <= 28 mm - 2 walls of 5.5 mm: R 7.92 mm holds g 0.3 and 0.5 mm, not 0.8 mm
+    tight = dp.DesignProblem(excitation=(2e-6,), clearances=(0.3e-3, 0.5e-3, 0.8e-3), radii=(7.92e-3,),
+                             block_width=28e-3)
+    assert not tight.fits(dp.Design(0.8e-3, 7.92e-3, "brass"))
+    cut = tight.edge_text(dp.Design(0.5e-3, 7.92e-3, "brass"))
+    assert "the largest clearance that fits the block (0.5 mm)" in cut and "--block-width" in cut
