@@ -15,8 +15,11 @@ column and its unit, as ``name_unit``, ``name [unit]`` or ``name (unit)``:
 
 UFF 58 (pyuff): function type 1 (time response) data sets make a time record, the force the one whose ordinate is a
 force (specific data type 13), the responses those of acceleration (12), velocity (11) or displacement (8); function
-type 4 (frequency response function) data sets of those responses per force make measured FRFs. Values are taken as
-SI (the data sets' unit exponents are not read); a data set of another kind is refused.
+type 4 (frequency response function) data sets of those responses per force make measured FRFs. Units, per axis of
+each data set (`_uff_factor`): its axis units label where it names a unit of the CSV table below (s, ms, Hz, N, kN,
+m/s^2, mm/s^2, g, m/s, mm/s, m, mm, um); else the file's units data set 164 (its factors to SI, raised to the axis's
+length and force exponents); else SI. A label of no known unit in a file without a data set 164 is refused rather than
+guessed. Data sets 151 (header) and 164 (units) may stand beside the data; any other kind is refused.
 
 Every reader refuses with one line naming the file: a missing or unnamed column, a unit it does not know, a NaN, a
 time or frequency axis that does not increase, a UFF data set of another kind.
@@ -265,15 +268,45 @@ def read_uff(path: str | os.PathLike) -> HammerRecord | MeasuredFrf:
     sets = _uff_sets(path)
     if not sets:
         raise SimulationInputError(f"{path}: no data sets; write time records or FRFs as UFF data sets 58")
+    units = [s for s in sets if s.get("type") == 164]
+    sets = [s for s in sets if s.get("type") not in (151, 164)]
+    if len(units) > 1:
+        raise SimulationInputError(f"{path}: {len(units)} units data sets (164); keep one")
+    if not sets:
+        raise SimulationInputError(f"{path}: no data sets 58; write time records or FRFs as UFF data sets 58")
     kinds = {(s.get("type"), s.get("func_type")) for s in sets}
     wrong = [k for k in kinds if k not in ((58, 1), (58, 4))]
     if wrong or len(kinds) != 1:
         described = ", ".join(f"type {t} function {ft}" if ft is not None else f"type {t}" for t, ft in sorted(kinds, key=str))
         raise SimulationInputError(f"{path}: holds UFF data sets of {described}; ies reads data sets 58 of time responses "
                                    "(function type 1) or of FRFs (function type 4), one kind per file")
+    unit = units[0] if units else None
     if kinds == {(58, 1)}:
-        return _uff_time(path, sets)
-    return _uff_frf(path, sets)
+        return _uff_time(path, sets, unit)
+    return _uff_frf(path, sets, unit)
+
+
+def _uff_factor(path: Path, s: dict, axis: str, quantity: str, units: dict | None) -> float:
+    """The factor to SI of one axis ("abscissa", "ordinate", "orddenom") of a data set 58 holding `quantity` (module
+    docstring): its units label if it names a known unit of that quantity, else the units data set 164 (SI = value /
+    (length^len_exp force^force_exp)), else 1 (SI); one line for a label of another quantity or of no known unit."""
+    label = str(s.get(f"{axis}_axis_units_lab", "") or "").strip()
+    if label and label.upper() != "NONE":
+        known = UNITS.get(_unit_key(label))
+        if known is not None:
+            if known[0] != quantity:
+                raise SimulationInputError(f"{path}: data set '{_uff_name(s, 0)}' labels its {axis} '{label}' ({known[0]}) "
+                                           f"where {quantity} belongs; fix the data set's units label")
+            return known[1]
+        if units is None:
+            raise SimulationInputError(f"{path}: data set '{_uff_name(s, 0)}' labels its {axis} '{label}', a unit ies "
+                                       f"does not know, and the file has no units data set 164; give one of {KNOWN} as "
+                                       "the label or add a data set 164")
+    if units is None:
+        return 1.0
+    length, force = float(units["length"]), float(units["force"])
+    exponents = (float(s.get(f"{axis}_len_unit_exp", 0) or 0), float(s.get(f"{axis}_force_unit_exp", 0) or 0))
+    return 1.0 / (length ** exponents[0] * force ** exponents[1])
 
 
 def _uff_name(s: dict, index: int) -> str:
@@ -285,41 +318,43 @@ def _uff_name(s: dict, index: int) -> str:
     return f"node{node}_dir{direction}" if node is not None else f"response{index + 1}"
 
 
-def _uff_time(path: Path, sets: list[dict]) -> HammerRecord:
+def _uff_time(path: Path, sets: list[dict], units: dict | None = None) -> HammerRecord:
     forces = [s for s in sets if s.get("ordinate_spec_data_type") == UFF_FORCE]
     responses = [s for s in sets if s.get("ordinate_spec_data_type") in UFF_QUANTITY]
     if len(forces) != 1 or not responses:
         raise SimulationInputError(f"{path}: a hammer record needs one force data set (ordinate type 13) and at least one "
                                    f"response (8, 11, 12); found {len(forces)} force(s) and {len(responses)} response(s)")
-    x = np.asarray(forces[0]["x"], float)
+    x = np.asarray(forces[0]["x"], float) * _uff_factor(path, forces[0], "abscissa", "time", units)
     _increasing(path, x, "the time", "samples")
     out, quantities = {}, {}
     for i, s in enumerate(responses):
-        values = np.asarray(s["data"], float)
+        quantity = UFF_QUANTITY[s["ordinate_spec_data_type"]]
+        values = np.asarray(s["data"], float) * _uff_factor(path, s, "ordinate", quantity, units)
         if values.size != x.size:
             raise SimulationInputError(f"{path}: response data set {i + 1} has {values.size} samples but the force {x.size}")
         name = _uff_name(s, i)
-        out[name], quantities[name] = values, UFF_QUANTITY[s["ordinate_spec_data_type"]]
-    force = np.asarray(forces[0]["data"], float)
+        out[name], quantities[name] = values, quantity
+    force = np.asarray(forces[0]["data"], float) * _uff_factor(path, forces[0], "ordinate", "force", units)
     for name, values in [("force", force), *out.items()]:
         if not np.all(np.isfinite(values)):
             raise SimulationInputError(f"{path}: the {name} data set holds NaN or infinite values; remove or interpolate them")
     return HammerRecord(1.0 / float(np.mean(np.diff(x))), force, out, quantities, str(path))
 
 
-def _uff_frf(path: Path, sets: list[dict]) -> MeasuredFrf:
+def _uff_frf(path: Path, sets: list[dict], units: dict | None = None) -> MeasuredFrf:
     frf, f0 = {}, None
     for i, s in enumerate(sets):
         quantity = UFF_QUANTITY.get(s.get("ordinate_spec_data_type"))
         if quantity is None or s.get("orddenom_spec_data_type", UFF_FORCE) != UFF_FORCE:
             raise SimulationInputError(f"{path}: FRF data set {i + 1} is not a displacement, velocity or acceleration per "
                                        "force (ordinate types 8, 11, 12 over 13)")
-        f = np.asarray(s["x"], float)
+        f = np.asarray(s["x"], float) * _uff_factor(path, s, "abscissa", "frequency", units)
         _increasing(path, f, "the frequency", "lines")
         if f0 is not None and (f.size != f0.size or not np.allclose(f, f0)):
             raise SimulationInputError(f"{path}: the FRF data sets have different frequency axes; give one axis")
         f0 = f
-        values = np.asarray(s["data"], complex)
+        values = np.asarray(s["data"], complex) * (_uff_factor(path, s, "ordinate", quantity, units)
+                                                   / _uff_factor(path, s, "orddenom", "force", units))
         if not np.all(np.isfinite(values)):
             raise SimulationInputError(f"{path}: FRF data set {i + 1} holds NaN or infinite values")
         positive = f > 0

@@ -73,3 +73,57 @@ def test_uff_round_trips_and_refuses_other_data_sets(tmp_path):
     f = np.linspace(10, 100, 20)
     frf = read_uff(write_uff_frf(tmp_path / "f.uff", f, {"tip": 1 / (1 + 1j * f)}))
     assert np.allclose(frf.frf["tip"], 1 / (1 + 1j * f), rtol=1e-6)
+
+
+def _uff_channel(name: str, data, x, code: int, abscissa: int, func_type: int = 1, **units):
+    import pyuff
+
+    return pyuff.prepare_58(func_type=func_type, rsp_node=1, rsp_dir=1, ref_node=1, ref_dir=1, rsp_ent_name=name,
+                            ref_ent_name="force", id1=name, data=data, x=x, abscissa_spacing=1,
+                            abscissa_spec_data_type=abscissa, ordinate_spec_data_type=code,
+                            orddenom_spec_data_type=13 if func_type == 4 else 0, **units)
+
+
+def test_uff_units_from_the_axis_labels_and_the_units_data_set(tmp_path):
+    """A hammer record in g and kN (the data sets' labels), and the same in a mm / mN unit system (data set 164:
+    SI = value / 1000^length exponent / 1000^force exponent) both read to SI; an FRF in g/N read as m/N."""
+    import pyuff
+
+    labelled = tmp_path / "labelled.uff"
+    uff = pyuff.UFF(str(labelled))
+    uff.write_sets(_uff_channel("force", np.sin(T), T, 13, 17, ordinate_axis_units_lab="kN",
+                                abscissa_axis_units_lab="s"), mode="add")
+    uff.write_sets(_uff_channel("tip", np.cos(T), T, 12, 17, ordinate_axis_units_lab="g"), mode="add")
+    back = read_uff(labelled)
+    assert np.allclose(back.force, 1e3 * np.sin(T)) and np.allclose(back.responses["tip"], 9.80665 * np.cos(T))
+
+    system = tmp_path / "mm.uff"
+    uff = pyuff.UFF(str(system))
+    uff.write_sets(pyuff.prepare_164(units_code=5, units_description="mm (milli newton)", temp_mode=1, length=1000.0,
+                                     force=1000.0, temp=1.0, temp_offset=273.15), mode="add")
+    uff.write_sets(_uff_channel("force", np.sin(T), T, 13, 17, ordinate_len_unit_exp=0, ordinate_force_unit_exp=1),
+                   mode="add")
+    uff.write_sets(_uff_channel("tip", np.cos(T), T, 12, 17, ordinate_len_unit_exp=1, ordinate_force_unit_exp=0),
+                   mode="add")
+    back = read_uff(system)
+    assert np.allclose(back.force, 1e-3 * np.sin(T)) and np.allclose(back.responses["tip"], 1e-3 * np.cos(T))
+
+    f = np.linspace(10, 100, 20)
+    accelerance = -((2 * np.pi * f) ** 2) / (1 + 1j * f)  # of the receptance 1 / (1 + i f), in m/s^2/N
+    path = tmp_path / "frf_g.uff"
+    pyuff.UFF(str(path)).write_sets(_uff_channel("tip", accelerance / 9.80665, f, 12, 18, func_type=4,
+                                                 ordinate_axis_units_lab="g", orddenom_axis_units_lab="N"), mode="add")
+    assert np.allclose(read_uff(path).frf["tip"], 1 / (1 + 1j * f), rtol=1e-6)
+
+
+@pytest.mark.parametrize("label, message", [("furlongs", "labels its ordinate 'furlongs', a unit ies does not know"),
+                                            ("kN", r"labels its ordinate 'kN' \(force\) where acceleration belongs")])
+def test_a_uff_label_of_no_known_unit_or_another_quantity_is_one_line(tmp_path, label, message):
+    import pyuff
+
+    path = tmp_path / "odd.uff"
+    uff = pyuff.UFF(str(path))
+    uff.write_sets(_uff_channel("force", np.sin(T), T, 13, 17), mode="add")
+    uff.write_sets(_uff_channel("tip", np.cos(T), T, 12, 17, ordinate_axis_units_lab=label), mode="add")
+    with pytest.raises(SimulationInputError, match=message):
+        read_uff(path)
