@@ -3,7 +3,9 @@
 Format (TOML, UTF-8): README.md, section "Your own structure", the one description for users (arrays of one value per
 retained mode in ascending frequency order: frequencies_hz, damping_ratios, phi_wall_left, phi_wall_right, phi_tip,
 participation; optional beam_mass_kg, phi_floor; an optional [host] table with damping_interval and wall_material, or
-wall_E_Pa and wall_nu; optional [units] naming the units, "Hz", "1", "1/sqrt(kg)", "sqrt(kg)", and a free-form
+wall_E_Pa and wall_nu; an optional [shapes] table of mode values at named measurement points, NAME = [one per mode],
+1/sqrt(kg), which `ies update` pairs measured modes by (MAC) where a test measured three or more of them; optional
+[units] naming the units, "Hz", "1", "1/sqrt(kg)", "sqrt(kg)", and a free-form
 [provenance] table, written by sim.hosts.solid and sim.hosts.calculix, that readers ignore). `format =
 "ies-modal-model"`, `version = 1` and `source` are optional.
 
@@ -153,9 +155,10 @@ def host_document(model: ModalModel) -> dict:
     return doc
 
 
-def modal_model_document(model: ModalModel, provenance: dict | None = None) -> dict:
-    """The file content of a model as plain data (what save_modal_model writes), with an optional [provenance]
-    table (plain TOML data: strings, numbers, booleans, lists and tables)."""
+def modal_model_document(model: ModalModel, provenance: dict | None = None,
+                         shapes: dict[str, np.ndarray] | None = None) -> dict:
+    """The file content of a model as plain data (what save_modal_model writes), with optional [shapes] (`load_shapes`)
+    and [provenance] tables (plain TOML data: strings, numbers, booleans, lists and tables)."""
     doc: dict = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "source": model.source}
     for key in ARRAY_KEYS:
         doc[key] = [float(v) for v in getattr(model, key)]
@@ -165,10 +168,27 @@ def modal_model_document(model: ModalModel, provenance: dict | None = None) -> d
         doc[BEAM_MASS_KEY] = model.beam_mass
     if host := host_document(model):
         doc["host"] = host
+    if shapes:
+        doc["shapes"] = {name: [float(v) for v in values] for name, values in shapes.items()}
     doc["units"] = dict(UNITS)
     if provenance:
         doc["provenance"] = provenance
     return doc
+
+
+def load_shapes(path: str | os.PathLike, n_modes: int) -> dict[str, np.ndarray]:
+    """The [shapes] table of a modal-model file (module docstring; {} when it has none): point name -> the mode values
+    there (1/sqrt(kg), one per mode); one line for a table of another form. Call load_modal_model first."""
+    path = Path(path)
+    table = tomllib.loads(path.read_text(encoding="utf-8")).get("shapes", {})
+    if not isinstance(table, dict):
+        raise SimulationInputError(f"{path}: 'shapes' must be a table of points, e.g. [shapes] tip = [1.36, 1.18]")
+    shapes = {str(name): _numbers(path, f"shapes.{name}", values) for name, values in table.items()}
+    wrong = [f"{name} has {v.size}" for name, v in shapes.items() if v.size != n_modes]
+    if wrong:
+        raise SimulationInputError(f"{path}: [shapes] needs {n_modes} values per point (one per mode) but "
+                                   f"{'; '.join(wrong)}")
+    return shapes
 
 
 def load_provenance(path: str | os.PathLike) -> dict:
@@ -177,12 +197,13 @@ def load_provenance(path: str | os.PathLike) -> dict:
     return dict(tomllib.loads(Path(path).read_text(encoding="utf-8")).get("provenance", {}))
 
 
-def save_modal_model(model: ModalModel, path: str | os.PathLike, provenance: dict | None = None) -> Path:
-    """Write `model` (and an optional [provenance] table) as a modal-model file (format in this module's
+def save_modal_model(model: ModalModel, path: str | os.PathLike, provenance: dict | None = None,
+                     shapes: dict[str, np.ndarray] | None = None) -> Path:
+    """Write `model` (and optional [shapes] and [provenance] tables) as a modal-model file (format in this module's
     docstring), atomically (`sim.common.files`)."""
     import tomli_w
 
     try:
-        return write_text(path, _HEADER + tomli_w.dumps(modal_model_document(model, provenance)))
+        return write_text(path, _HEADER + tomli_w.dumps(modal_model_document(model, provenance, shapes)))
     except (FileNotFoundError, IsADirectoryError) as exc:  # a missing folder, or a folder named as the file
         raise SimulationInputError(exc.strerror) from None

@@ -188,7 +188,8 @@ def add_update_arguments(parser: argparse.ArgumentParser) -> None:
 
     parser.add_argument("model_word", nargs="?", metavar="MODEL",
                         help="rig (the built-in beam, default), solid (the 3D model) or a model file (as --model)")
-    parser.add_argument("--measured", required=True, metavar="modes.csv", help="the modes.csv of `ies identify`")
+    parser.add_argument("--measured", required=True, metavar="modes.csv", help="the modes.csv of `ies identify`; with modal constants at 3 or more points that "
+                        "the model file's [shapes] table names, modes pair by MAC as well as frequency")
     parser.add_argument("--out", required=True, metavar="FILE.toml", help="write the updated modal-model file")
     parser.add_argument("--fit-mode", dest="fit_mode", default="1", metavar="N|all",
                         help="measured mode the stiffness scale matches (default 1, as the paper), or all (least squares)")
@@ -240,7 +241,7 @@ def update_command(args: argparse.Namespace) -> int:
     """`ies update`: pair, scale, damp, write."""
     from sim.common.files import check_writable, dumps, report_written, to_jsonable
     from sim.common.units import Quantity, parse_quantity
-    from sim.hosts.modal_file import save_modal_model
+    from sim.hosts.modal_file import load_shapes, save_modal_model
     from sim.measured.update import read_modes, update_model
 
     measured = read_modes(args.measured)
@@ -257,20 +258,28 @@ def update_command(args: argparse.Namespace) -> int:
     if args.plot:
         check_writable(args.plot, "--plot")
     model, E0, what = _model_and_E0(args)
+    model_file = getattr(args, "model", None) or (args.model_word if args.model_word not in (None, "rig", "solid")
+                                                   else None)
+    shapes = load_shapes(model_file, model.n_modes) if model_file else {}
     if args.E0:
         E0 = parse_quantity(args.E0, Quantity("--E0", "Pa", {"Pa": 1.0, "MPa": 1e6, "GPa": 1e9}, (1e6, 1e13), "210GPa"))
     result = update_model(model, measured, fit_mode=fit_mode, E_0=E0, default_damping=default,
                           tolerance=args.pair_tolerance,
-                          source=f"{model.source}, updated to {measured.source} (ies update)")
+                          source=f"{model.source}, updated to {measured.source} (ies update)", shapes=shapes)
     rows = [{"measured_mode": i + 1, "model_mode": int(j) + 1, "measured_hz": float(measured.frequencies_hz[i]),
              "model_hz": float(result.before_hz[j]), "updated_hz": float(result.model.frequencies_hz[j]),
-             "error": float(result.errors[i]), "damping_ratio": float(measured.damping_ratios[i])}
+             "error": float(result.errors[i]), "damping_ratio": float(measured.damping_ratios[i]),
+             **({} if result.mac is None else {"mac": float(result.mac[i])})}
             for i, j in enumerate(result.pairs)]
+    paired_by = (f"frequency and shape (MAC at {', '.join(result.mac_points)})" if result.mac_points else "frequency")
+    # TOML has no null: E_0 and E are left out for a model whose modulus is unknown (a modal file without --E0)
     provenance = to_jsonable({"updated_by": "ies update (sim.measured.update, Appendix A)", "measured": measured.source,
                               "model": what, "stiffness_scale": result.scale, "E_0_Pa": E0, "E_Pa": result.E,
-                              "fit_mode": args.fit_mode, "default_damping": default, "pairs": rows,
+                              "fit_mode": args.fit_mode, "default_damping": default, "paired_by": paired_by,
+                              "pairs": rows,
                               **({"note": result.note} if result.note else {})})
-    written = [save_modal_model(result.model, args.out, provenance)]
+    provenance = {k: v for k, v in provenance.items() if v is not None}
+    written = [save_modal_model(result.model, args.out, provenance, shapes)]
     if args.plot:
         from sim.measured.figures import draw_frf
         from sim.measured.update import model_frf
@@ -279,7 +288,7 @@ def update_command(args: argparse.Namespace) -> int:
         f = frf.frequencies_hz
         written.append(draw_frf(args.plot, f, {name: frf.frf[name]}, {name: model_frf(result.model, f, frf.window_decay)}, frf.coherence,
                                 "updated model", (max(20.0, 4 * float(f[0])), 0.78 * float(f[-1]))))
-    summary = {"E_Pa": result.E, "E_0_Pa": E0, "stiffness_scale": result.scale, "pairs": rows,
+    summary = {"E_Pa": result.E, "E_0_Pa": E0, "stiffness_scale": result.scale, "paired_by": paired_by, "pairs": rows,
                "frequency_errors": result.errors, "frequencies_hz": result.model.frequencies_hz,
                "damping_ratios": result.model.damping_ratios, "note": result.note}
     if args.json:
@@ -287,12 +296,14 @@ def update_command(args: argparse.Namespace) -> int:
     else:
         E = (f"E = {result.E / 1e9:.4g} GPa (from {E0 / 1e9:.4g} GPa), " if result.E else "") + \
             f"stiffness scale {result.scale:.5f}"
-        sys.stdout.write(f"{what} updated to {measured.source}: {E}\n")
+        sys.stdout.write(f"{what} updated to {measured.source}: {E}; modes paired by {paired_by}\n")
+        mac = result.mac is not None
         sys.stdout.write(f"{'mode':>4} {'measured (Hz)':>14} {'model (Hz)':>11} {'updated (Hz)':>13} {'error (%)':>10} "
-                         f"{'D (%)':>7}\n")
+                         f"{'D (%)':>7}" + (f" {'MAC':>6}" if mac else "") + "\n")
         for r in rows:
             sys.stdout.write(f"{r['model_mode']:>4} {r['measured_hz']:>14.2f} {r['model_hz']:>11.2f} "
-                             f"{r['updated_hz']:>13.2f} {100 * r['error']:>+10.3f} {100 * r['damping_ratio']:>7.3f}\n")
+                             f"{r['updated_hz']:>13.2f} {100 * r['error']:>+10.3f} {100 * r['damping_ratio']:>7.3f}"
+                             + (f" {r['mac']:>6.3f}" if mac else "") + "\n")
         others = [j + 1 for j in range(result.model.n_modes) if not result.damping_measured[j]]
         if others:
             sys.stdout.write(f"modes {', '.join(map(str, others))}: damping {100 * default:g} % (not measured)\n")

@@ -12,7 +12,11 @@ stated default for the rest (the paper: 0.1 % for modes 5-9).
 * Pairing: each measured mode with one model mode (scipy's linear_sum_assignment on |ln(f_measured / f_model)|); a
   measured mode farther than `tolerance` (relative) from its model mode pairs with none, which is refused with one
   line: the measurement found a mode the model lacks (the clamping's secondary peak of Fig. A.1, a torsion or y-mode),
-  or the model is far off.
+  or the model is far off. Where the test measured three or more points that the model file names in its [shapes]
+  table (modes.csv's modal_constant_NAME_per_kg, A = phi_NAME phi_drive), the shapes pair first: the cost is
+  1 - MAC + |ln(f_measured / f_model)| (MAC, the modal assurance criterion |a^T b|^2 / (a^T a b^T b) of the measured
+  and the model's values at the common points), so that two modes close in frequency pair by their shapes; a pair
+  with MAC below `MAC_MIN` is refused (the model's mode there is another mode).
 * Damping: the paired modes take the measured damping ratios; the others `default_damping`. A damping interval of D_1
   the model carried (Table 2's for the rig) is dropped when it no longer contains the new D_1: the hammer's D_1 is a
   small-amplitude value, and `ies linearity` measures the interval over the response range.
@@ -32,7 +36,8 @@ errors 0.05 / 1.4 / 0.5 / 0.7 %:
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, replace
+import re
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -45,15 +50,21 @@ from sim.model.system import ModalModel
 DEFAULT_DAMPING = 0.001
 #: a measured mode pairs with a model mode within this relative frequency distance
 PAIR_TOLERANCE = 0.15
+#: the smallest MAC of a pair where shapes are measured (0.9 and above is the usual "same mode")
+MAC_MIN = 0.6
+#: the fewest common measurement points for pairing by MAC (two points cannot tell most modes apart)
+MAC_POINTS = 3
 
 
 @dataclass(frozen=True)
 class MeasuredModes:
-    """Measured natural frequencies (Hz) and damping ratios (-) of modes.csv (`ies identify`), and its path."""
+    """Measured natural frequencies (Hz) and damping ratios (-) of modes.csv (`ies identify`), its path, and the modal
+    constants per response (name -> one per mode, 1/kg: phi_NAME phi_drive) where it has them."""
 
     frequencies_hz: np.ndarray
     damping_ratios: np.ndarray
     source: str
+    constants: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def read_modes(path: str | os.PathLike) -> MeasuredModes:
@@ -68,22 +79,26 @@ def read_modes(path: str | os.PathLike) -> MeasuredModes:
         raise SimulationInputError(f"{path}: no column {' or '.join(missing)}; give the modes.csv of `ies identify` "
                                    "(columns mode, frequency_hz, damping_ratio, ...)")
     fi, di = header.index("frequency_hz"), header.index("damping_ratio")
-    f, d = [], []
+    named = {m.group(1): i for i, c in enumerate(header) if (m := re.fullmatch(r"modal_constant_(.+)_per_kg", c))}
+    f, d, a = [], [], []
     for number, line in enumerate(lines[1:], start=2):
         cells = line.split(",")
         try:
             f.append(float(cells[fi]))
             d.append(float(cells[di]))
+            a.append([float(cells[i]) for i in named.values()])
         except (ValueError, IndexError):
-            raise SimulationInputError(f"{path}: row {number} has no number in frequency_hz or damping_ratio") from None
+            raise SimulationInputError(f"{path}: row {number} has no number in frequency_hz, damping_ratio or a "
+                                       "modal_constant column") from None
     f, d = np.array(f), np.array(d)
+    constants = {name: np.array([row[k] for row in a]) for k, name in enumerate(named)}
     if f.size == 0:
         raise SimulationInputError(f"{path}: no modes; identify at least one (`ies identify`)")
     if not (np.all(np.isfinite(f)) and np.all(f > 0) and np.all(np.diff(f) > 0)):
         raise SimulationInputError(f"{path}: frequency_hz must be positive and increase from row to row")
     if not (np.all(np.isfinite(d)) and np.all((d > 0) & (d < 1))):
         raise SimulationInputError(f"{path}: damping_ratio must lie in (0, 1), e.g. 0.0006 for 0.06 %")
-    return MeasuredModes(f, d, str(path))
+    return MeasuredModes(f, d, str(path), constants)
 
 
 @dataclass(frozen=True)
@@ -100,20 +115,40 @@ class Update:
     errors: np.ndarray
     damping_measured: np.ndarray
     note: str = ""
+    mac: np.ndarray | None = None
+    mac_points: tuple[str, ...] = ()
+
+
+def mac_matrix(measured: np.ndarray, model: np.ndarray) -> np.ndarray:
+    """The modal assurance criterion of every measured mode (rows of `measured`, values at the points) with every model
+    mode (rows of `model`, the same points): |a^T b|^2 / (a^T a b^T b), 1 for proportional shapes, 0 for orthogonal."""
+    num = np.abs(measured @ model.T) ** 2
+    return num / np.outer(np.sum(measured**2, axis=1), np.sum(model**2, axis=1))
 
 
 def pair_modes(measured_hz: np.ndarray, model_hz: np.ndarray, tolerance: float = PAIR_TOLERANCE,
-               source: str = "modes.csv") -> np.ndarray:
-    """The model mode (index) of each measured mode (module docstring); one line for a measured mode that pairs with
-    none."""
+               source: str = "modes.csv", mac: np.ndarray | None = None) -> np.ndarray:
+    """The model mode (index) of each measured mode (module docstring), by frequency, or by shape and frequency where
+    `mac` (measured x model modes, `mac_matrix`) is given; one line for a measured mode that pairs with none."""
     from scipy.optimize import linear_sum_assignment
 
     if measured_hz.size > model_hz.size:
         raise SimulationInputError(f"{source}: {measured_hz.size} measured modes but the model has {model_hz.size}; give "
                                    "the model more modes (--n-modes) or drop measured modes")
     cost = np.abs(np.log(measured_hz[:, None] / model_hz[None, :]))
+    if mac is not None:
+        cost = cost + (1.0 - mac)
     rows, cols = linear_sum_assignment(cost)
     pairs = cols[np.argsort(rows)]
+    if mac is not None:
+        for i, j in enumerate(pairs):
+            if mac[i, j] < MAC_MIN:
+                best = int(np.argmax(mac[i]))
+                raise SimulationInputError(
+                    f"{source}: the measured mode at {measured_hz[i]:.5g} Hz has no model mode of its shape (MAC "
+                    f"{mac[i, j]:.2f} with the mode at {model_hz[j]:.5g} Hz, below {MAC_MIN:g}; its best, "
+                    f"{mac[i, best]:.2f}, is the mode at {model_hz[best]:.5g} Hz); check the points' names and signs "
+                    "in [shapes], or drop the mode")
     for i, j in enumerate(pairs):
         if abs(measured_hz[i] / model_hz[j] - 1) > tolerance:
             nearest = model_hz[int(np.argmin(np.abs(model_hz - measured_hz[i])))]
@@ -126,11 +161,19 @@ def pair_modes(measured_hz: np.ndarray, model_hz: np.ndarray, tolerance: float =
 
 def update_model(model: ModalModel, measured: MeasuredModes, *, fit_mode: int | None = 1, E_0: float | None = None,
                  default_damping: float = DEFAULT_DAMPING, tolerance: float = PAIR_TOLERANCE,
-                 source: str = "") -> Update:
-    """The model updated to the measured modes (module docstring)."""
+                 source: str = "", shapes: dict[str, np.ndarray] | None = None) -> Update:
+    """The model updated to the measured modes (module docstring); `shapes`: the model's mode values at named points
+    (a modal file's [shapes] table), for pairing by MAC where modes.csv has three or more of them."""
     if not 0 < default_damping < 1:
         raise SimulationInputError(f"--default-damping must lie in (0, 1), e.g. 0.001 for 0.1 %, got {default_damping!r}")
-    pairs = pair_modes(measured.frequencies_hz, model.frequencies_hz, tolerance, measured.source)
+    points = tuple(name for name in measured.constants if name in (shapes or {}))
+    mac = None
+    if len(points) >= MAC_POINTS:
+        mac = mac_matrix(np.column_stack([measured.constants[n] for n in points]),
+                         np.column_stack([shapes[n] for n in points]))
+    else:
+        points = ()
+    pairs = pair_modes(measured.frequencies_hz, model.frequencies_hz, tolerance, measured.source, mac)
     ratio = measured.frequencies_hz / model.frequencies_hz[pairs]
     if fit_mode is None:
         scale = float(np.exp(2 * np.mean(np.log(ratio))))
@@ -154,7 +197,7 @@ def update_model(model: ModalModel, measured: MeasuredModes, *, fit_mode: int | 
                       nominal_damping=None, source=source or f"{model.source}, updated to {measured.source}")
     errors = updated.frequencies_hz[pairs] / measured.frequencies_hz - 1
     return Update(updated, pairs, scale, None if E_0 is None else scale * E_0, model.frequencies_hz.copy(), errors,
-                  measured_mask, note)
+                  measured_mask, note, None if mac is None else mac[np.arange(pairs.size), pairs], points)
 
 
 def model_frf(model: ModalModel, frequencies_hz: np.ndarray, window_decay: float = 0.0) -> np.ndarray:
