@@ -137,7 +137,7 @@ def modes_command(args: argparse.Namespace) -> int:
     """`ies modes`: show (and with --save write) the built-in rig's model, a modal-model file, the 3D solid
     model or the modes of a CalculiX job."""
     from sim.common.files import dumps, report_written
-    from sim.hosts.modal_file import save_modal_model
+    from sim.hosts.modal_file import load_shapes, save_modal_model
     from sim.hosts.sources import host_model
 
     if args.save:
@@ -150,7 +150,8 @@ def modes_command(args: argparse.Namespace) -> int:
     if provenance is not None:
         data["provenance"] = provenance
     if args.save:
-        data["saved_to"] = str(save_modal_model(model, args.save, provenance))
+        shapes = load_shapes(args.model, model.n_modes) if getattr(args, "model", None) else None
+        data["saved_to"] = str(save_modal_model(model, args.save, provenance, shapes))
     print(dumps(data) if args.json else "\n".join([*report, modes_table(data)]))
     report_written([data["saved_to"]] if args.save else [], json_mode=args.json)
     return 0

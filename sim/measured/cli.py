@@ -350,7 +350,7 @@ def linearity_command(args: argparse.Namespace, output_folder: Callable[..., Any
 
     from sim.common.files import check_writable, dumps, report_written, write_csv
     from sim.common.units import LENGTH_UNITS
-    from sim.hosts.modal_file import load_modal_model, load_provenance, save_modal_model
+    from sim.hosts.modal_file import load_modal_model, load_provenance, load_shapes, save_modal_model
     from sim.measured.figures import draw_linearity
     from sim.measured.linearity import damping_interval, fit_nonlinear_mode, half_power, read_level
     from sim.measured.tables import BACKBONE_CSV, LEVELS_CSV
@@ -409,7 +409,7 @@ def linearity_command(args: argparse.Namespace, output_folder: Callable[..., Any
             provenance["damping_interval"] = {"by": "ies linearity (sim.measured.linearity, Appendix B)",
                                               "records": list(args.files), "range_m": [a_lo, a_hi],
                                               "nominal_set": bool(args.set_nominal)}
-            written.append(save_modal_model(updated, target, provenance))
+            written.append(save_modal_model(updated, target, provenance, load_shapes(args.model, updated.n_modes)))
     if args.json:
         sys.stdout.write(dumps(summary) + "\n")
     else:

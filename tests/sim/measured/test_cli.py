@@ -142,3 +142,21 @@ def test_bad_linearity_options_are_one_line(walked, tmp_path, capsys):
     refused(capsys, main(["linearity", *levels, "--model", str(walked / "my-rig.toml"), "--out", out]),
             "--write FILE2 or --in-place")
     assert not Path(out).exists()
+
+
+def test_a_models_shapes_survive_its_rewrites(walked, tmp_path, capsys):
+    """A modal file's [shapes] (the points MAC pairs by) is the user's data: `ies linearity --write` and `ies modes
+    --save` carry it into the file they write."""
+    from sim.hosts.modal_file import load_shapes
+
+    shaped = tmp_path / "shaped.toml"
+    shapes = {"tip": [1.0] * 9, "mid": [0.5] * 9, "root": [0.1] * 9}
+    shaped.write_text((walked / "my-rig.toml").read_text().replace(
+        "[units]", "[shapes]\n" + "\n".join(f"{k} = {v}" for k, v in shapes.items()) + "\n\n[units]", 1))
+    levels = sorted(glob.glob(str(walked / "rig-tests" / "level-*.csv")))
+    assert main(["linearity", *levels, "--model", str(shaped), "--write", str(tmp_path / "lin.toml"),
+                 "--out", str(tmp_path / "lin")]) == 0
+    assert main(["modes", "--model", str(shaped), "--save", str(tmp_path / "saved.toml")]) == 0
+    capsys.readouterr()
+    for name in ("lin.toml", "saved.toml"):
+        assert {k: list(v) for k, v in load_shapes(tmp_path / name, 9).items()} == shapes, name
