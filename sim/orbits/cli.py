@@ -33,7 +33,7 @@ def _period_multiple(text: str) -> int:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The options of `ies orbits` besides the system's (module docstring)."""
-    from sim.orbits.response import STARTS
+    from sim.orbits.response import GROWTH_RUNS, STARTS
     from sim.integration.integrators import DEFAULT_INTEGRATOR, INTEGRATORS
     from sim.orbits.starts import DEFAULT_RESTITUTION
 
@@ -58,6 +58,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="branch switchings at symmetry-breaking and period-doubling points, those nearest to a "
                              "stable orbit first (default: every located one, within the response's budget; 0: the "
                              "start's branch and the direct-simulation searches only)")
+    parser.add_argument("--budget", type=count, default=GROWTH_RUNS, metavar="RUNS",
+                        help=f"runs of the one-period map for the switchings and searches of each response, beyond "
+                             f"its first branch (default {GROWTH_RUNS:,}: about 12 s of CPU on the rig; what it leaves "
+                             "undone is said)")
     parser.add_argument("--integrator", default=DEFAULT_INTEGRATOR, choices=tuple(INTEGRATORS),
                         help=f"time integrator of the shooting (default {DEFAULT_INTEGRATOR}; the others for checks)")
     scaled = " and ".join(name for name, record in INTEGRATORS.items() if record.dt_scale)
@@ -178,7 +182,8 @@ def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], t
                 try:
                     response = orbit_response(base, name, bounds, start=args.start, at=args.at,
                                               max_period=args.max_period, switches=args.switches,
-                                              restitution=args.restitution, progress=bar.update)
+                                              restitution=args.restitution, budget=args.budget,
+                                              progress=bar.update)
                 except StartFailed as failure:  # keep what it tried, say what else to try
                     written = write_or_fallback(lambda where: [write_start_attempts(where, failure)], folder,
                                                 "orbits")
@@ -191,7 +196,8 @@ def run(args: argparse.Namespace, build_system: Callable[[argparse.Namespace], t
         settings = {"command": "ies orbits", "parameter": "level" if curve else "eta",
                     "levels": levels if not curve else None, "level_range": level_range,
                     "eta_range": eta_range, "level_curve_eta": args.level_curve, "start": args.start,
-                    "max_period": args.max_period, "switches": args.switches, "restitution": args.restitution,
+                    "max_period": args.max_period, "switches": args.switches, "budget": args.budget,
+                    "restitution": args.restitution,
                     "integrator": args.integrator, "dt_scale": args.dt_scale, **system_data(model, impactor, nominal),
                     "wall_time_s": time.perf_counter() - started}
         rows = orbit_rows(responses)

@@ -194,13 +194,14 @@ def _start(base: OrbitSetting, name: str, lo: float, hi: float, how: str, *, at:
 
 def orbit_response(base: OrbitSetting, name: str, bounds: tuple[float, float], *, start: str = "slow-flow",
                    at: float | None = None, max_period: int = 2, switches: int | None = None, searches: bool = True,
-                   restitution: float = DEFAULT_RESTITUTION,
+                   restitution: float = DEFAULT_RESTITUTION, budget: int = GROWTH_RUNS,
                    progress: Callable[[], None] | None = None) -> OrbitResponse:
     """The periodic orbits of `base` with the parameter `name` ("eta" or "level") over `bounds` (module docstring).
     start: one of STARTS; at: the parameter value to start at (None: the start's own choice); max_period: the
     largest period multiple k of a switched or found branch (1..MAX_PERIOD_MULTIPLE); switches: branch switchings
     at most (None: every located one); searches: the direct simulations at the changes of stability; restitution:
-    the slow flow's r for the slow-flow start; progress: called once per accepted point."""
+    the slow flow's r for the slow-flow start; budget: map runs for the switchings and searches (steps 3-4);
+    progress: called once per accepted point."""
     if name not in ("eta", "level"):
         raise SimulationInputError(f"orbits: the response is continued in eta or the level, not {name!r}")
     lo, hi = check_range(name, bounds)
@@ -209,6 +210,8 @@ def orbit_response(base: OrbitSetting, name: str, bounds: tuple[float, float], *
     if isinstance(max_period, bool) or not isinstance(max_period, int) or not 1 <= max_period <= MAX_PERIOD_MULTIPLE:
         raise SimulationInputError(f"orbits: the largest period multiple must be an integer in 1..{MAX_PERIOD_MULTIPLE}, "
                                    f"got {max_period!r}")
+    if isinstance(budget, bool) or not isinstance(budget, int) or budget < 0:
+        raise SimulationInputError(f"orbits: the budget is a number of map runs >= 0, got {budget!r}")
     if at is not None and not lo <= at <= hi:
         raise SimulationInputError(f"orbits: the start's {name} {at:g} lies outside the range {lo:g}:{hi:g}")
     par = parameter(name)
@@ -227,7 +230,7 @@ def orbit_response(base: OrbitSetting, name: str, bounds: tuple[float, float], *
     if orbit.linear and start != "linear":
         result.notes.append("the start converged to the linear orbit (no impacts)")
     result.branches.append(_both_ways(orbit, name, (lo, hi), f"{start} start", progress))
-    _grow(result, max_period=max_period, switches=switches, searches=searches, progress=progress)
+    _grow(result, max_period=max_period, switches=switches, searches=searches, budget=budget, progress=progress)
     return result
 
 
@@ -286,10 +289,10 @@ def _reached(point: BranchPoint, branches: list[Branch]) -> bool:
 
 
 def _grow(result: OrbitResponse, *, max_period: int, switches: int | None, searches: bool,
-          progress: Callable[[], None] | None) -> None:
+          progress: Callable[[], None] | None, budget: int = GROWTH_RUNS) -> None:
     """Steps 3 and 4 of the module docstring on `result`'s branches, appending the new ones: one list of tasks, the
     searches at changes of stability first, then the switchings by their point's unstable multipliers (the nearest
-    to a stable orbit first), each new branch's tasks added as it comes, within GROWTH_RUNS map runs."""
+    to a stable orbit first), each new branch's tasks added as it comes, within `budget` map runs."""
     name, (lo, hi) = result.parameter, result.bounds
     par = parameter(name)
     tasks: list[tuple[tuple, int, str, Branch, BranchPoint, int]] = []
@@ -323,12 +326,12 @@ def _grow(result: OrbitResponse, *, max_period: int, switches: int | None, searc
             if key in searched:  # one search per branch, side and scale unit of the parameter
                 continue
             searched.add(key)
-        if ShootingMap.runs - budget_from > GROWTH_RUNS or len(result.branches) >= MAX_BRANCHES:
+        if ShootingMap.runs - budget_from >= budget or len(result.branches) >= MAX_BRANCHES:
             skipped.append(f"{'the ' + point.label if kind == 'switch' else 'a search'} at {where}")
             continue
         if kind == "switch":
             try:
-                left = (GROWTH_RUNS - (ShootingMap.runs - budget_from)) // RUNS_PER_POINT
+                left = (budget - (ShootingMap.runs - budget_from)) // RUNS_PER_POINT
                 new = switch_branch(point, name, (lo, hi), max_points=int(max(10, min(SWITCHED_POINTS, left))),
                                     progress=progress,
                                     also_stop=_joins(name, [b for b in result.branches if b is not branch]))
@@ -347,8 +350,8 @@ def _grow(result: OrbitResponse, *, max_period: int, switches: int | None, searc
         result.branches.append(new)
         add(new)
     if skipped:
-        result.notes.append(f"not done ({len(skipped)}; the response's {GROWTH_RUNS:,} map runs for switchings and "
-                            f"searches, or its {MAX_BRANCHES} branches, were spent): {', '.join(skipped)}")
+        result.notes.append(f"not done ({len(skipped)}; the response's {budget:,} map runs for switchings and "
+                            f"searches (--budget), or its {MAX_BRANCHES} branches, were spent): {', '.join(skipped)}")
 
 
 def parameter_branch(setting: OrbitSetting, name: str, bounds: tuple[float, float], *,

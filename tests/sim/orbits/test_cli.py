@@ -152,3 +152,22 @@ def test_the_rigs_first_mode_alone_has_its_stable_asymmetric_orbit_on_the_diagra
     assert x1 - x0 < 2e-3 and r0["stable"] == r1["stable"] == "1"
     assert y0 + (0.95707 - x0) / (x1 - x0) * (y1 - y0) == pytest.approx(0.08789, abs=2e-4)
     assert 0.9995 < float(r0["max_multiplier"]) < 1.0
+
+
+def test_the_budget_of_switchings_and_searches_is_the_users(tmp_path, capsys):
+    """`--budget 0` leaves the switching at the located symmetry breaking and the searches undone, says so and
+    records the budget; the default budget finds the stable asymmetric orbit (the test above)."""
+    one = tmp_path / "one.toml"
+    assert main(["modes", "--n-modes", "1", "--save", str(one)]) == 0
+    out = tmp_path / "res"
+    assert main(["orbits", "--model", str(one), "--level", "7.4", "--eta", "0.953:0.958", "--budget", "0",
+                 "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "symmetry-breaking at eta 0.9552" in printed
+    assert "the response's 0 map runs for switchings and searches (--budget)" in printed
+    with (out / "orbits.csv").open(newline="") as handle:
+        rows = [r for r in csv.DictReader(handle) if r["origin"] != "linear solution"]
+    assert rows and all(r["symmetric"] == "1" for r in rows)  # the asymmetric branch was not reached
+    assert json.loads((out / "orbits.json").read_text())["budget"] == 0
+    one_line(capsys, main(["orbits", "--model", str(one), "--level", "7.4", "--budget", "-1", "--out",
+                           str(tmp_path / "x")]), 2, "--budget")
