@@ -196,8 +196,9 @@ def update_model(model: ModalModel, measured: MeasuredModes, *, fit_mode: int | 
     updated = replace(model, frequencies_hz=frequencies, damping_ratios=damping, damping_interval=interval,
                       nominal_damping=None, source=source or f"{model.source}, updated to {measured.source}")
     errors = updated.frequencies_hz[pairs] / measured.frequencies_hz - 1
-    return Update(updated, pairs, scale, None if E_0 is None else scale * E_0, model.frequencies_hz.copy(), errors,
-                  measured_mask, note, None if mac is None else mac[np.arange(pairs.size), pairs], points)
+    return Update(model=updated, pairs=pairs, scale=scale, E=None if E_0 is None else scale * E_0,
+                  before_hz=model.frequencies_hz.copy(), errors=errors, damping_measured=measured_mask, note=note,
+                  mac=None if mac is None else mac[np.arange(pairs.size), pairs], mac_points=points)
 
 
 def model_frf(model: ModalModel, frequencies_hz: np.ndarray, window_decay: float = 0.0) -> np.ndarray:
