@@ -526,13 +526,13 @@ def simulation(args: argparse.Namespace, levels: Sequence[float], *, label: str)
 
 def write_results(folder: Path | None, stem: str, header: Sequence[str], rows: Any, data: dict) -> list[Path]:
     """With --out: the table as STEM.csv (data) and `data` as STEM.json (data + metadata); the paths written."""
-    from sim.common.files import dumps, write_csv, write_or_fallback, write_text
+    from sim.common.files import write_csv, write_json, write_or_fallback
 
     if folder is None:
         return []
     rows = list(rows)
     return write_or_fallback(lambda where: [write_csv(where / f"{stem}.csv", header, rows),
-                                            write_text(where / f"{stem}.json", dumps(data) + "\n")], folder, stem)
+                                            write_json(where / f"{stem}.json", data)], folder, stem)
 
 
 def report(args: argparse.Namespace, data: dict, written: list, plot: Any, text: str) -> int:

@@ -309,7 +309,7 @@ def write_trace(folder: Path, trace: Trace, settings: dict[str, Any], plot: str 
     caller with `plot` (the analysis imports no figure code: the figures sit above it); nature: the keys of
     `trace_nature`, added to trace.json; draw_poincare(data, path): with nature's "poincare", the figure
     poincare.png in `folder` (`sim.plots.dynamics.plot_poincare`)."""
-    from sim.common.files import dumps, write_csv, write_text
+    from sim.common.files import write_csv, write_json
 
     if plot and draw is None:
         raise ValueError("write_trace: a plot needs its drawing function (draw=sim.plots.figures.plot_trace)")
@@ -320,7 +320,7 @@ def write_trace(folder: Path, trace: Trace, settings: dict[str, Any], plot: str 
         written.append(write_csv(folder / "trace.csv", COLUMNS, trace_rows(trace)))
         if started is not None:
             data["wall_time_s"] = time.perf_counter() - started
-        written.append(write_text(folder / "trace.json", dumps(data) + "\n"))
+        written.append(write_json(folder / "trace.json", data))
         if plot:
             draw(data, trace.signal.t, trace.signal["q_tip"], trace.signal["v_tip"], plot)
             written.append(plot)

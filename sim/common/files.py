@@ -229,13 +229,20 @@ def csv_value(value: Any) -> str:
     return str(value)
 
 
-def write_csv(path: str | os.PathLike, header: Sequence[str], rows: Iterable[Sequence[Any]]) -> Path:
-    """A CSV table (one header line, `csv_value` cells, "\\n" line ends) written atomically; returns the path."""
+def write_csv(path: str | os.PathLike, header: Sequence[str], rows: Iterable[Sequence[Any]], comment: str = "") -> Path:
+    """A CSV table (optional `# comment` lines first, one header line, `csv_value` cells, "\\n" line ends) written
+    atomically; returns the path."""
     buffer = io.StringIO()
+    buffer.writelines(f"# {line}\n" for line in comment.splitlines())
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(header)
     writer.writerows([csv_value(v) for v in row] for row in rows)
     return write_text(path, buffer.getvalue())
+
+
+def write_json(path: str | os.PathLike, data: Any) -> Path:
+    """One JSON object (`dumps`) and a line end, written atomically; returns the path."""
+    return write_text(path, dumps(data) + "\n")
 
 
 def read_rows(path: str | os.PathLike) -> list[dict[str, str]]:

@@ -106,7 +106,7 @@ def load_modal_model(path: str | os.PathLike) -> ModalModel:
 def host_table(table: object) -> dict:
     """The `ModalModel` fields of a [host] table (damping_interval, wall; format in the module docstring); one
     `SimulationInputError` line (without the file's name) for an unknown key or a value of the wrong kind."""
-    from sim.model.materials import Material, wall_material
+    from sim.model.materials import wall_material
 
     if not isinstance(table, dict):
         raise SimulationInputError("'host' must be a table, e.g. [host] wall_material = \"steel\"")

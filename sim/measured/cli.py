@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 from typing import Any, Callable
 
 from sim.common.errors import SimulationInputError
@@ -96,7 +95,7 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
     """`ies identify`: read, estimate, identify (all before writing), then write the outputs."""
     import numpy as np
 
-    from sim.common.files import dumps, report_written, write_csv, write_text
+    from sim.common.files import dumps, report_written, write_csv, write_json
     from sim.measured.figures import draw_frf, draw_stabilization
     from sim.measured.hammer import HammerSettings, frf_estimate
     from sim.measured.identification import Band, identify
@@ -146,10 +145,9 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
         data = [frequencies]
         for n in names:
             data += [frf[n].real, frf[n].imag] + ([coherence[n]] if n in coherence else [])
-        written.append(write_csv(folder / "frf.csv", columns, np.column_stack(data)))
-        if decay:  # the exponential window's decay rate, for a later `ies identify frf.csv` (sim.measured.records)
-            text = (folder / "frf.csv").read_text()
-            write_text(folder / "frf.csv", f"# window_decay_per_s = {float(decay)!r}\n" + text)
+        # the exponential window's decay rate, for a later `ies identify frf.csv` (sim.measured.records)
+        written.append(write_csv(folder / "frf.csv", columns, np.column_stack(data),
+                                 comment=f"window_decay_per_s = {float(decay)!r}" if decay else ""))
         d = result.diagram
         written.append(write_csv(folder / "poles.csv", list(POLES_CSV.names),
                                  zip(d.order, d.frequency_hz, d.damping_ratio, d.status)))
@@ -171,13 +169,6 @@ def identify_command(args: argparse.Namespace, output_folder: Callable[..., Any]
             sys.stdout.write(f"{j + 1:>4} {f:>10.2f} {100 * D:>8.4f}\n")
     report_written(written, json_mode=args.json)
     return 0
-
-
-def write_json(path: Path, data: dict) -> Path:
-    """One JSON object written atomically."""
-    from sim.common.files import dumps, write_text
-
-    return write_text(path, dumps(data) + "\n")
 
 
 # ---- ies update ------------------------------------------------------------------------------------------------
@@ -207,8 +198,8 @@ def add_update_arguments(parser: argparse.ArgumentParser) -> None:
     add_host_arguments(parser)
 
 
-def _model_and_E0(args: argparse.Namespace) -> tuple[Any, float | None, str]:
-    """The model to update, its E_0 (Pa, or None) and a word for the report."""
+def _model_and_E0(args: argparse.Namespace) -> tuple[Any, float | None, str, str | None]:
+    """The model to update, its E_0 (Pa, or None), a word for the report and its modal file (None: built)."""
     from sim.hosts.sources import HOST_OPTIONS, HOST_SOURCES, resolve_host
 
     options = {k: getattr(args, k) for k in HOST_OPTIONS if hasattr(args, k)}
@@ -234,7 +225,7 @@ def _model_and_E0(args: argparse.Namespace) -> tuple[Any, float | None, str]:
         from sim.hosts.sources import solid_geometry
 
         E0, what = solid_geometry(args.geometry)[1].E, "3D solid"
-    return host.model, E0, what
+    return host.model, E0, what, options.get("model")
 
 
 def update_command(args: argparse.Namespace) -> int:
@@ -257,9 +248,7 @@ def update_command(args: argparse.Namespace) -> int:
     check_writable(args.out, "--out")
     if args.plot:
         check_writable(args.plot, "--plot")
-    model, E0, what = _model_and_E0(args)
-    model_file = getattr(args, "model", None) or (args.model_word if args.model_word not in (None, "rig", "solid")
-                                                   else None)
+    model, E0, what, model_file = _model_and_E0(args)
     shapes = load_shapes(model_file, model.n_modes) if model_file else {}
     if args.E0:
         E0 = parse_quantity(args.E0, Quantity("--E0", "Pa", {"Pa": 1.0, "MPa": 1e6, "GPa": 1e9}, (1e6, 1e13), "210GPa"))
@@ -348,7 +337,7 @@ def linearity_command(args: argparse.Namespace, output_folder: Callable[..., Any
 
     import numpy as np
 
-    from sim.common.files import check_writable, dumps, report_written, write_csv
+    from sim.common.files import check_writable, dumps, report_written, write_csv, write_json
     from sim.common.units import LENGTH_UNITS
     from sim.hosts.modal_file import load_modal_model, load_provenance, load_shapes, save_modal_model
     from sim.measured.figures import draw_linearity

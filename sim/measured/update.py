@@ -123,7 +123,8 @@ def mac_matrix(measured: np.ndarray, model: np.ndarray) -> np.ndarray:
     """The modal assurance criterion of every measured mode (rows of `measured`, values at the points) with every model
     mode (rows of `model`, the same points): |a^T b|^2 / (a^T a b^T b), 1 for proportional shapes, 0 for orthogonal."""
     num = np.abs(measured @ model.T) ** 2
-    return num / np.outer(np.sum(measured**2, axis=1), np.sum(model**2, axis=1))
+    den = np.outer(np.sum(measured**2, axis=1), np.sum(model**2, axis=1))
+    return np.divide(num, den, out=np.zeros_like(num), where=den > 0)  # a shape of zeros matches nothing
 
 
 def pair_modes(measured_hz: np.ndarray, model_hz: np.ndarray, tolerance: float = PAIR_TOLERANCE,

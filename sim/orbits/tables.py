@@ -13,7 +13,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from sim.common.files import atomic_path, dumps, write_csv, write_text
+from sim.common.files import atomic_path, dumps, write_csv, write_json
 from sim.common.outputs import Column, OutputFile
 from sim.orbits.bifurcations import outside_count
 from sim.orbits.continuation import Branch, BranchPoint
@@ -137,7 +137,7 @@ def write_orbit_files(folder: Path, responses: Sequence[OrbitResponse], settings
     data = {**settings, "responses": [response_summary(r) for r in responses]}
     return [write_csv(folder / "orbits.csv", ORBITS_COLUMNS, rows),
             write_results_nc(folder / "results.nc", responses, rows, settings),
-            write_text(folder / "orbits.json", dumps(data) + "\n")]
+            write_json(folder / "orbits.json", data)]
 
 
 def write_results_nc(path: Path, responses: Sequence[OrbitResponse], rows: list[tuple], settings: dict) -> Path:
@@ -220,4 +220,4 @@ def write_start_attempts(folder: Path, failure: Any) -> Path:
                          for a in failure.attempts],
             "suggestion": "--start slow-flow (the slow flow's two-impact orbit), another --at, or a larger --max-period; "
                           "ies trace --lyapunov at this point tells whether the response is periodic at all"}
-    return write_text(folder / "start-attempts.json", dumps(data) + "\n")
+    return write_json(folder / "start-attempts.json", data)

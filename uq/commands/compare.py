@@ -28,7 +28,7 @@ def add_compare_arguments(parser: argparse.ArgumentParser) -> None:
 def compare_command(args: argparse.Namespace) -> int:
     """`ies compare`: every folder is read and checked before anything is written (`uq.outputs.compare`)."""
     from sim.common.errors import SimulationInputError
-    from sim.common.files import dumps, report_written, write_csv, write_text
+    from sim.common.files import dumps, report_written, write_csv, write_json
     from sim.plots.figures import plot_series
     from sim.plots.redraw import style
     from uq.outputs.compare import (
@@ -60,7 +60,7 @@ def compare_command(args: argparse.Namespace) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     written = [write_csv(args.out / "compare.csv", COMPARE_COLUMNS,
                          [[row[key] for key in COMPARE_COLUMNS] for row in (*rows, PAPER_ROW)]),
-               write_text(args.out / "compare.json", dumps({"studies": rows, "paper": PAPER_ROW}) + "\n")]
+               write_json(args.out / "compare.json", {"studies": rows, "paper": PAPER_ROW})]
     with context:
         for suffix in args.formats:
             path = args.out / f"fig6-compare{suffix}"

@@ -368,7 +368,7 @@ def verified_row(result: DesignResult, v: Verified) -> dict[str, Any]:
 
 def write_design(result: DesignResult, mode: Any) -> list[Any]:
     """design.csv, design-levels.csv, design.json and results.nc (all written atomically)."""
-    from sim.common.files import dumps, write_csv, write_text
+    from sim.common.files import write_csv, write_json
 
     p, s, o = result.problem, result.screened, result.objective
     verified = {v.design: v for v in result.verified}
@@ -467,7 +467,7 @@ def write_design(result: DesignResult, mode: Any) -> list[Any]:
                   "references simulated with the design's protocol",
                   f"a box point counts as almost periodic at a level when {APR_RULE} of it is (the conservative rule)"],
     }
-    files.append(write_text(folder / "design.json", dumps(data) + "\n"))
+    files.append(write_json(folder / "design.json", data))
     files.append(write_design_netcdf(result, data))
     return files
 
