@@ -95,7 +95,8 @@ def seconds_per_run(model: ModalModel, impactor: Impactor | None, levels: Sequen
     nearest)."""
     ordered = sorted(set(float(level) for level in levels))
     probed = [ordered[int(round(i))] for i in np.linspace(0, len(ordered) - 1, min(PROBE_LEVELS, len(ordered)))]
-    probe_cost(model, impactor, probed[-1], protocol, nominal)  # untimed: what the first runs load (kernel paths)
+    # untimed: what the first run loads (the kernels' paths, the contacts' included) is loaded by one point already
+    probe_cost(model, impactor, probed[-1], replace(protocol, n_eta=1, eta_stop=protocol.eta_start), nominal)
     cost = {level: probe_cost(model, impactor, level, protocol, nominal) for level in dict.fromkeys(probed)}
     per_run = simulated_seconds(protocol, float(model.omega[0]))
     return {level: per_run * cost[min(cost, key=lambda p: abs(p - level))] for level in ordered}
