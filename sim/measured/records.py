@@ -140,8 +140,8 @@ def _increasing(path: Path, axis: np.ndarray, name: str, what: str) -> None:
     step = np.diff(axis)
     if np.any(step <= 0):
         i = int(np.flatnonzero(step <= 0)[0])
-        raise SimulationInputError(f"{path}: {name} must increase, but {axis[i + 1]!r} at data row {i + 2} follows "
-                                   f"{axis[i]!r}; sort the {what} and remove repeated ones")
+        raise SimulationInputError(f"{path}: {name} must increase, but {float(axis[i + 1])!r} at data row {i + 2} follows "
+                                   f"{float(axis[i])!r}; sort the {what} and remove repeated ones")
 
 
 def read_time_csv(path: str | os.PathLike) -> HammerRecord:
