@@ -296,9 +296,9 @@ def plot_design_curves(result: Any, path: Path) -> Path:
             ys += list(v.low * scale) + list(v.high * scale) + list(v.nominal * scale)
         right = margin_at
         ax.axvline(margin_at, color="0.4", ls="-.", lw=1.0)
-        ax.text(margin_at, 0.98, f"margin level, top + {p.margin:.0%} ({margin_at:.3g} {MICROMETRE});"
-                "\n\u25b2: highest over the box ", transform=ax.get_xaxis_transform(), rotation=90, ha="right", va="top",
-                fontsize=LEGEND_PT, color="0.3")
+        ax.annotate(f"margin level, top + {p.margin:.0%} ({margin_at:.3g} {MICROMETRE}); \u25b2: highest over the box",
+                    (margin_at, 0.98), xycoords=ax.get_xaxis_transform(), xytext=(-3, 0), textcoords="offset points",
+                    rotation=90, ha="right", va="top", fontsize=LEGEND_PT, color="0.3")
         prediction = best.prediction
         if prediction is not None and prediction.switch_worst_kind == "found" and np.all(np.isfinite(prediction.jump)):
             at = prediction.switch_worst * 1e6
