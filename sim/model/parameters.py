@@ -337,6 +337,9 @@ class Typed(float):
         number.text = str(text)
         return number
 
+    def __getnewargs__(self) -> tuple[float, str]:  # pickled or copied (to a worker) with its text
+        return float(self), self.text
+
 
 #: the option that runs a value whose magnitude is implausible (`check_plausible`)
 ALLOW_IMPLAUSIBLE = "--allow-implausible"
@@ -358,10 +361,10 @@ def check_plausible(values: Mapping[str, float | None], *, allow: bool = False,
             place = where(row, value)
         else:
             place = f"{row.option.flag if row.option else row.name} {getattr(value, 'text', f'{value:g}')}"
-        allow = f"pass {ALLOW_IMPLAUSIBLE} to compute with it as given"
+        way_out = f"pass {ALLOW_IMPLAUSIBLE} to compute with it as given"
         if why.endswith("?"):  # a reading that is plausible: the number typed without its unit
-            raise SimulationInputError(f"{place}: {why} Give the unit, or {allow}")
-        raise SimulationInputError(f"{place}: {why}; {allow}")
+            raise SimulationInputError(f"{place}: {why} Give the unit, or {way_out}")
+        raise SimulationInputError(f"{place}: {why}; {way_out}")
 
 
 def _table2(name: str, unit: str, label: str, nominal: float, spread: Spread, feeds: Feed, **kwargs: Any) -> UncertainParameter:

@@ -114,11 +114,13 @@ def _clearance_curves(result: Any, path: Path) -> Path:
         shown = [v for v in result.verified if v.design.radius == R]
         values = {m: _values(result, m, R) for m in p.materials}
         best = result.recommendation.worst
-        decisive = [v for v in shown if v.design in set(p.grid()) and v.worst <= DECISIVE * best] or shown
+        grid = set(p.grid())
+        decisive = [v for v in shown if v.design in grid and v.worst <= DECISIVE * best] or shown
         span = [y for v in decisive for y in (v.worst, *v.worst_interval) if np.isfinite(y)]
         top = HEADROOM * max(span) * scale if span else math.inf
         above_label = f"above the axis (predicted, verified: value in {o.shown_in})"
         edges = []
+        worst = {v.design: min(v.worst * scale, top * 0.97) for v in result.verified}
         for k, material in enumerate(p.materials):
             colour = CURVE_COLOURS[(k + 1) % len(CURVE_COLOURS)]
             name = f" ({material})" if len(p.materials) > 1 else ""
@@ -152,7 +154,6 @@ def _clearance_curves(result: Any, path: Path) -> Path:
                 ax.errorbar(x, y, yerr=[np.maximum(y - lo, 0), np.maximum(np.minimum(hi, top) - y, 0)], fmt="o",
                             color=colour, mfc=colour if admissible else "w", capsize=3,
                             label=f"verified, 95 % interval{name}" if admissible else f"verified, not admissible{name}")
-            worst = {v.design: min(v.worst * scale, top * 0.97) for v in result.verified}
             _marks(ax, result, material, R, lambda s: worst.get(s, math.nan))
             edge = _margin_edge(result, material, R)
             if edge is not None:

@@ -179,7 +179,7 @@ class Predictor:
             for request in batch:
                 runs = [records[t] for t in tasks[request]]
                 i, own = request
-                linear = own < realisations[i][2] / self.rig.D_star  # below its first impacts (`onset_own_level`)
+                linear = own < realisations[i][2] / self.rig.D_star  # below its first impacts (`first_impacts`)
                 apr = [0.0 if linear else r["outputs"].get("apr", 0.0) for r in runs if not r.get("error")]
                 values = [self.objective.of_run(r, omega_1) / r["trace"]["a_noabs"] for r in runs
                           if not r.get("error") and "trace" in r]

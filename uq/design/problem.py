@@ -1,5 +1,5 @@
 """What `ies design` is asked (the design problem): the operating range, the grid of clearances and spheres, the
-uncertainty box (Table 2's intervals by default), the host, and the reading of its options and study file with
+uncertainty box (D_1's interval from the host, `ModalModel.damping_box`; Table 2's others), the host, and the reading of its options and study file with
 units; one line (StudyError) for anything wrong."""
 from __future__ import annotations
 
@@ -68,19 +68,19 @@ class Design:
 
     @property
     def sphere(self) -> Any:
-        """The sphere (`sim.model.sphere.Design`) on this design's walls."""
+        """The sphere (`sim.model.sphere.Sphere`) on this design's walls."""
         from sim.model.sphere import sphere_of
 
         return sphere_of(self.radius, material(self.material), wall=self.wall)
 
     @property
     def mass(self) -> float:
-        """m_a (kg) of the sphere (`sim.model.sphere.Design.mass`)."""
+        """m_a (kg) of the sphere (`sim.model.sphere.Sphere.mass`)."""
         return self.sphere.mass
 
     @property
     def k_H(self) -> float:
-        """k_H* (N/m^1.5) of Eq. 8, the sphere on the host's wall (`sim.model.sphere.Design.k_H_star`)."""
+        """k_H* (N/m^1.5) of Eq. 8, the sphere on the host's wall (`sim.model.sphere.Sphere.k_H_star`)."""
         return self.sphere.k_H_star
 
     def cavity(self) -> float:

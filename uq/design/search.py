@@ -430,7 +430,6 @@ def run_design(problem: DesignProblem, out: Any, *, jobs: int | None = 1, schedu
         check_first_runs_cost(problem, model, Path(out), verify_runs + reference_runs, jobs=jobs, client=connected,
                               quiet=not progress)
         folder = prepare_output(Path(out), resume=resume, study=("design", design_key(problem, model)))
-        model.warm_up()
         store = ResultStore(folder)
 
         def run(tasks: list[Any]) -> Mapping[Any, Any]:

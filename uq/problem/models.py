@@ -305,7 +305,9 @@ class IESModel:
         model, impactor = self.simulated_system({})
         if not worth_probing(runs, simulated_seconds(protocol, float(model.omega[0]))):
             return None
-        return seconds_per_run(model, impactor, levels, protocol)
+        from sim.model.system import Nominal
+
+        return seconds_per_run(model, impactor, levels, protocol, nominal=Nominal.of(model, self.g_star))
 
     def typical_seconds_per_run(self) -> float:
         """Seconds of one run at the integrator's typical cost on one quiet core (`Integrator.typical_cost`): a size
@@ -314,8 +316,7 @@ class IESModel:
         from sim.stepped_sine.cost import simulated_seconds
 
         protocol = self._stepped_sine()
-        rig = self.rig if self.rig is not None else self._rig()
-        return simulated_seconds(protocol, float(rig.omega[0])) * integrator_named(protocol.integrator).typical_cost
+        return simulated_seconds(protocol, float(self._host().omega[0])) * integrator_named(protocol.integrator).typical_cost
 
     def kernel_variants(self) -> list[tuple[str, str]]:
         """(integrator, contact law) of every kernel specialisation this study's runs use: its law and, since
