@@ -146,6 +146,7 @@ def modes_command(args: argparse.Namespace) -> int:
         check_writable(args.save, "--save")  # before a solid model or a re-update takes minutes
     host = host_model(args)  # the row of sim.hosts.sources.HOST_SOURCES the options select
     model, rig, provenance, report = host.model, host.rig, host.provenance, host.report
+    check_host_moves(model)
     data = describe_modes(model, rig, sphere_for(args, model), nominal_of(args, model))
     if provenance is not None:
         data["provenance"] = provenance
@@ -373,6 +374,17 @@ def nominal_of(args: argparse.Namespace, model: Any) -> Any:
     return Nominal.of(model, getattr(args, "g_star", None))
 
 
+def check_host_moves(model: Any) -> None:
+    """Walls at a node of mode 1, or a mode 1 the base does not excite: one line naming the host, before any work
+    (`sim.model.system.check_resonant_mode`)."""
+    from sim.model.system import check_resonant_mode
+
+    try:
+        check_resonant_mode(model)
+    except SimulationInputError as exc:
+        raise SimulationInputError(f"{model.source}: {exc}") from None
+
+
 def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     """(modal model, impactor or None) of the host and impactor options (Eqs. 3-7, Table 2): the host through the
     one resolver (`sim.hosts.sources.resolve_host`), the sphere of --radius, --material, --mass and --wall-material
@@ -382,17 +394,14 @@ def build_system(args: argparse.Namespace) -> tuple[Any, Any]:
     from sim.hosts.sources import resolve_host
     from sim.integration.integrators import integrator_named
     from sim.model.parameters import PARAMETERS, SystemSettings, check_plausible, system_settings
-    from sim.model.system import build_impactor, check_resonant_mode
+    from sim.model.system import build_impactor
     from sim.model.system import build_system as build
 
     values = {name: getattr(args, name, None) for name in PARAMETERS}
     check_plausible(values, allow=args.allow_implausible)  # a unit slip is refused, not computed with
     integrator = integrator_named(args.integrator)
     model = resolve_host(args).model
-    try:
-        check_resonant_mode(model)  # walls at a node of mode 1: refused before any work
-    except SimulationInputError as exc:
-        raise SimulationInputError(f"{model.source}: {exc}") from None
+    check_host_moves(model)
     sphere = sphere_for(args, model)  # radius, material, mass, walls: the mass and Eq. 8's k_H* the options start from
     settings = system_settings(values, sphere.settings(SystemSettings(contact_law=args.contact_law)))
     if args.no_impactor:  # the impactor's values are checked all the same

@@ -297,9 +297,11 @@ def host_mode(model: Any) -> Any:
     """The slow flow's view of the host (`sim.reduced.slow_flow.HostMode`), refused with one line when the host lacks
     what the design needs (a first mode that moves the walls and is excited by the base)."""
     from sim.common.errors import SimulationInputError
+    from sim.model.system import check_resonant_mode
     from sim.reduced.slow_flow import host_mode as mode_of
 
     try:
+        check_resonant_mode(model)  # the command's own words for a host the IES cannot act on
         return mode_of(model)
     except SimulationInputError as exc:
         raise StudyError(f"the host model cannot be designed for: {exc}") from None
