@@ -46,7 +46,8 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
                              "--excitation at every corner of the box, as a fraction in (0, 1] (default 0.2: 20 %%)")
     D, g, k_H = (PARAMETERS[name].spread for name in ("D", "g", "k_H"))  # Table 2's intervals (the one vocabulary)
     parser.add_argument("--damping", metavar="LOW:HIGH",
-                        help="interval of D_1, containing the host's nominal D_1* (default: the host's [host] "
+                        help="interval of D_1 (ratios, or in %%: 0.075%%:0.09%%), containing the host's nominal D_1* "
+                             "(default: the host's [host] "
                              f"damping_interval, else Table 2's relative interval around its D_1*; the rig: "
                              f"{D.low:g}:{D.high:g})")
     parser.add_argument("--clearance-tolerance", metavar="LOW:HIGH",

@@ -339,7 +339,7 @@ def _quantities() -> dict[str, Any]:
 
     return {"excitation": Quantity("base amplitude a_base", "m", {**LENGTH_UNITS, "nm": 1e-9}, (1e-10, 1e-2), "2um"),
             "acceleration": Quantity("base acceleration", "m/s2", {"m/s2": 1.0, "m/s^2": 1.0}, (1e-4, 1e4), "1m/s2"),
-            "clearance": PARAMETERS["g"].quantity, "radius": RADIUS,
+            "clearance": PARAMETERS["g"].quantity, "radius": RADIUS, "damping": PARAMETERS["D"].quantity,
             "block_width": Quantity("block width", "m", LENGTH_UNITS, (1e-3, 1.0), "28mm"),
             "min_wall": Quantity("wall thickness", "m", LENGTH_UNITS, (1e-5, 0.5), "5.5mm")}
 
@@ -435,7 +435,8 @@ def _number(value: Any, option: str, what: str) -> float:
 
 
 def parse_interval(text: str, what: str, quantity: str | None = None) -> tuple[float, float]:
-    """`LOW:HIGH` (plain numbers, or lengths with units for the clearance tolerance) -> (low, high)."""
+    """`LOW:HIGH` (plain numbers, or with units: lengths for the clearance tolerance, % for the damping) -> (low,
+    high)."""
     from sim.common.errors import SimulationInputError
     from sim.common.units import parse_quantity
 
@@ -579,7 +580,7 @@ def problem_of(settings: Mapping[str, Any], protocol: Mapping[str, Any] = PROTOC
         objective=value["objective"], candidates=int(value["candidates"]), repetitions=int(value["reps"]), wall=wall,
         D=tuple(box), damping_source=said)
     if value["damping"] is not None:
-        interval = parse_interval(value["damping"], "--damping")
+        interval = parse_interval(value["damping"], "--damping", "damping")
         try:
             fields["D"] = check_damping_interval(interval, model.D_star)
         except SimulationInputError as exc:
