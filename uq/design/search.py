@@ -104,9 +104,10 @@ def check_first_runs_cost(problem: DesignProblem, model: Any, out: Any, runs: in
                allow_large=problem.allow_large, quiet=quiet)
 
 
-def check_size(problem: DesignProblem) -> None:
+def check_size(problem: DesignProblem, seconds_per_run: float = SECONDS_PER_RUN) -> None:
     """Refuse, before any work, a design whose first batch and references exceed a study's run limit
-    (`uq.problem.tasks.MAX_RUNS`) unless `allow_large`, with the estimate in the line."""
+    (`uq.problem.tasks.MAX_RUNS`) unless `allow_large`, with the estimate in the line (`seconds_per_run` on one core:
+    the host's, `IESModel.typical_seconds_per_run`, where the caller has it)."""
     from uq.problem.tasks import MAX_RUNS
 
     verify, references = first_runs(problem)
@@ -115,7 +116,7 @@ def check_size(problem: DesignProblem) -> None:
         raise StudyError(f"this design would run at least {total} simulations before its search adds neighbours "
                          f"({verify} to verify the first {min(problem.candidates, len(problem.grid()))} design(s) at "
                          f"{len(problem.excitation)} levels, {problem.repetitions} repetitions; up to {references} for the "
-                         f"similarity references), about {duration(total * SECONDS_PER_RUN)} on one core; a design runs at "
+                         f"similarity references), about {duration(total * seconds_per_run)} on one core; a design runs at "
                          f"most {MAX_RUNS:,} without --allow-large: give fewer levels, candidates or repetitions, or pass "
                          "--allow-large")
 
@@ -408,9 +409,9 @@ def run_design(problem: DesignProblem, out: Any, *, jobs: int | None = 1, schedu
     from uq.engine.runner import ResultStore, dask_client, prepare_output, run_tasks
 
     problem.check()
-    check_size(problem)
-    objective = objective_named(problem.objective)
     model = verification_model(problem)
+    check_size(problem, model.typical_seconds_per_run())
+    objective = objective_named(problem.objective)
     mode = host_mode(host_model(problem))
     g_min = min(problem.clearances) + problem.clearance_tolerance[0]
     start = first_impacts(dataclasses.replace(mode, D=min(problem.D)), g_min)
